@@ -1,0 +1,123 @@
+#pragma once
+
+#include <facet/color.h>
+#include <facet/interaction.h>
+#include <facet/object.h>
+
+#include <utility>
+#include <vector>
+
+/**
+ * BSDF conventions, followed by every BSDF plugin:
+ * - Directions are in the local shading frame: the normal is +Z and Frame::cos_theta(v) == v.z.
+ * - `si.wi` points away from the surface (towards where the light goes in radiance mode).
+ * - `eval` returns f(wi, wo)·|cos θo|.
+ * - `sample` returns the sampled record and the weight f·|cos θo| / pdf; for delta lobes the
+ *   lobe's value divided by its discrete probability. A zero weight means the sample failed.
+ * - `pdf` is the solid-angle density of exactly what `sample` does, lobe selection included;
+ *   delta lobes have pdf 0 in `pdf` and their discrete probability in BSDFSample::pdf.
+ * - Each method first checks that a lobe is enabled in the context and that wi is on a supported
+ *   side. Two-sidedness belongs to the `twosided` adapter.
+ */
+namespace facet {
+
+enum class TransportMode : uint32_t { Radiance = 0, Importance = 1 };
+
+enum class BSDFFlags : uint32_t {
+    Empty = 0,
+    Null = 0x1,
+    DiffuseReflection = 0x2,
+    DiffuseTransmission = 0x4,
+    GlossyReflection = 0x8,
+    GlossyTransmission = 0x10,
+    DeltaReflection = 0x20,
+    DeltaTransmission = 0x40,
+    Delta1DReflection = 0x80,
+    Delta1DTransmission = 0x100,
+    Anisotropic = 0x1000,
+    SpatiallyVarying = 0x2000,
+    NonSymmetric = 0x4000,
+    FrontSide = 0x8000,
+    BackSide = 0x10000,
+    NeedsDifferentials = 0x20000,
+
+    Reflection = DiffuseReflection | DeltaReflection | Delta1DReflection | GlossyReflection,
+    Transmission = DiffuseTransmission | DeltaTransmission | Delta1DTransmission |
+                   GlossyTransmission | Null,
+    Diffuse = DiffuseReflection | DiffuseTransmission,
+    Glossy = GlossyReflection | GlossyTransmission,
+    Smooth = Diffuse | Glossy,
+    Delta = Null | DeltaReflection | DeltaTransmission,
+    Delta1D = Delta1DReflection | Delta1DTransmission,
+    All = Diffuse | Glossy | Delta | Delta1D,
+};
+
+constexpr BSDFFlags operator|(BSDFFlags a, BSDFFlags b) { return BSDFFlags(uint32_t(a) | uint32_t(b)); }
+constexpr BSDFFlags operator&(BSDFFlags a, BSDFFlags b) { return BSDFFlags(uint32_t(a) & uint32_t(b)); }
+constexpr BSDFFlags operator~(BSDFFlags a) { return BSDFFlags(~uint32_t(a)); }
+inline BSDFFlags &operator|=(BSDFFlags &a, BSDFFlags b) { return a = a | b; }
+inline BSDFFlags &operator&=(BSDFFlags &a, BSDFFlags b) { return a = a & b; }
+/// True when any bit of `b` is set in `a`.
+constexpr bool has_flag(BSDFFlags a, BSDFFlags b) { return (uint32_t(a) & uint32_t(b)) != 0; }
+
+/// What the caller wants from a BSDF query: transport mode, enabled lobe types, one component.
+struct BSDFContext {
+    TransportMode mode = TransportMode::Radiance;
+    uint32_t type_mask = uint32_t(BSDFFlags::All);
+    uint32_t component = uint32_t(-1);
+
+    BSDFContext() = default;
+    explicit BSDFContext(TransportMode m) : mode(m) {}
+    /// True when lobe type `type` of component `comp` takes part in this query.
+    bool is_enabled(BSDFFlags type, uint32_t comp = 0) const {
+        return (type_mask & uint32_t(type)) == uint32_t(type) &&
+               (component == uint32_t(-1) || component == comp);
+    }
+};
+
+struct BSDFSample {
+    Vector3f wo;
+    float pdf = 0.f;
+    float eta = 1.f; ///< relative IOR along the sampled direction (1 for reflection)
+    BSDFFlags sampled_type = BSDFFlags::Empty;
+    uint32_t sampled_component = uint32_t(-1);
+};
+
+class BSDF : public Object {
+public:
+    ObjectType type() const override { return ObjectType::BSDF; }
+
+    /// Samples wo given si.wi. `sample1` picks the lobe, `sample2` the direction.
+    /// Returns the record and the weight f·|cos θo|/pdf (zero on failure).
+    virtual std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                                  float sample1, const Point2f &sample2) const = 0;
+    /// f(wi, wo)·|cos θo|; zero for delta lobes.
+    virtual Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const = 0;
+    /// Solid-angle density of sample(); zero for delta lobes.
+    virtual float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const = 0;
+    virtual std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                               const Vector3f &wo) const {
+        return {eval(ctx, si, wo), pdf(ctx, si, wo)};
+    }
+    /// Fraction of light passed straight through (wo = -wi) by Null lobes.
+    virtual Color3f eval_null_transmission(const SurfaceInteraction &si) const { return Color3f(0.f); }
+    /// Albedo for AOVs and denoisers.
+    virtual Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const { return Color3f(0.f); }
+
+    BSDFFlags flags() const { return m_flags; }
+    BSDFFlags flags(size_t component) const { return m_components.at(component); }
+    size_t component_count() const { return m_components.size(); }
+    bool needs_differentials() const { return has_flag(m_flags, BSDFFlags::NeedsDifferentials); }
+
+protected:
+    /// Sets the per-component flags and their union.
+    void set_components(std::vector<BSDFFlags> components) {
+        m_components = std::move(components);
+        m_flags = BSDFFlags::Empty;
+        for (BSDFFlags f : m_components) m_flags |= f;
+    }
+    BSDFFlags m_flags = BSDFFlags::Empty;
+    std::vector<BSDFFlags> m_components;
+};
+
+} // namespace facet

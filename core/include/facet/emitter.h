@@ -1,0 +1,58 @@
+#pragma once
+
+#include <facet/color.h>
+#include <facet/interaction.h>
+#include <facet/object.h>
+
+#include <utility>
+
+namespace facet {
+
+enum class EmitterFlags : uint32_t {
+    Empty = 0,
+    DeltaPosition = 0x1,  ///< point-like (point, spot)
+    DeltaDirection = 0x2, ///< one direction (directional)
+    Infinite = 0x4,       ///< at infinity (constant, envmap, directional)
+    Surface = 0x8,        ///< attached to a shape (area)
+    SpatiallyVarying = 0x10,
+    Delta = DeltaPosition | DeltaDirection,
+};
+constexpr EmitterFlags operator|(EmitterFlags a, EmitterFlags b) { return EmitterFlags(uint32_t(a) | uint32_t(b)); }
+constexpr EmitterFlags operator&(EmitterFlags a, EmitterFlags b) { return EmitterFlags(uint32_t(a) & uint32_t(b)); }
+constexpr bool has_flag(EmitterFlags a, EmitterFlags b) { return (uint32_t(a) & uint32_t(b)) != 0; }
+
+/// A light source.
+///
+/// Conventions: sample_direction() samples a point on the emitter as seen from `ref` and returns the
+/// record (direction, distance, solid-angle pdf; pdf = 1 and delta = true for delta emitters) and the
+/// weight L·G/pdf that the integrator multiplies by the BSDF, without any visibility test.
+/// eval() gives the radiance arriving along a ray that hit the emitter: for area emitters `si` is the
+/// hit (si.wi in the local shading frame); for infinite emitters `si` is a miss record whose
+/// sh_frame is the identity and whose si.wi = -ray.d in world space.
+class Emitter : public Object {
+public:
+    ObjectType type() const override { return ObjectType::Emitter; }
+
+    virtual std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                                 const Point2f &u) const = 0;
+    /// Solid-angle density of sample_direction() for the point ds.p seen from ref (0 for delta).
+    virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const = 0;
+    /// Emitted radiance; zero for delta emitters.
+    virtual Color3f eval(const SurfaceInteraction &si) const = 0;
+
+    /// Called by the shape that owns an area emitter.
+    virtual void set_shape(const Shape *shape) { m_shape = shape; }
+    const Shape *shape() const { return m_shape; }
+    /// Called once the scene's bounds are known (infinite emitters need them).
+    virtual void set_scene(const Scene &scene) {}
+
+    EmitterFlags flags() const { return m_flags; }
+    bool is_delta() const { return has_flag(m_flags, EmitterFlags::Delta); }
+    bool is_infinite() const { return has_flag(m_flags, EmitterFlags::Infinite); }
+
+protected:
+    EmitterFlags m_flags = EmitterFlags::Empty;
+    const Shape *m_shape = nullptr;
+};
+
+} // namespace facet

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+namespace facet {
+
+constexpr float Pi = 3.14159265358979323846f;
+constexpr float InvPi = 0.31830988618379067154f;
+constexpr float InvTwoPi = 0.15915494309189533577f;
+constexpr float InvFourPi = 0.07957747154594766788f;
+constexpr float Infinity = std::numeric_limits<float>::infinity();
+constexpr float OneMinusEpsilon = 0x1.fffffep-1f;
+/// Relative offset used to spawn rays (see Interaction::spawn_ray).
+constexpr float RayEpsilon = 1e-4f;
+
+template <typename T> constexpr T sqr(T x) { return x * x; }
+template <typename T> constexpr T clamp(T v, T lo, T hi) { return v < lo ? lo : (v > hi ? hi : v); }
+template <typename T> constexpr T lerp(float t, T a, T b) { return a * (1.f - t) + b * t; }
+
+inline float safe_sqrt(float x) { return std::sqrt(std::max(x, 0.f)); }
+inline double safe_sqrt(double x) { return std::sqrt(std::max(x, 0.0)); }
+inline float safe_acos(float x) { return std::acos(clamp(x, -1.f, 1.f)); }
+inline float safe_asin(float x) { return std::asin(clamp(x, -1.f, 1.f)); }
+inline float deg_to_rad(float d) { return d * (Pi / 180.f); }
+inline float rad_to_deg(float r) { return r * (180.f / Pi); }
+inline float mulsign(float x, float s) { return std::signbit(s) ? -x : x; }
+inline float sign(float x) { return std::signbit(x) ? -1.f : 1.f; }
+
+/// Inverse error function (Giles' single-precision approximation, refined by one Newton step).
+float erfinv(float x);
+
+} // namespace facet

@@ -1,0 +1,26 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace facet {
+
+/// Ordered list of folders in which relative file names are looked up.
+class FileResolver {
+public:
+    /// First existing dir/path, or `path` unchanged when it is absolute or nothing matches.
+    std::string resolve(const std::string &path) const;
+    void prepend(const std::string &dir);
+    void append(const std::string &dir);
+    const std::vector<std::string> &dirs() const { return m_dirs; }
+    void clear() { m_dirs.clear(); }
+
+private:
+    std::vector<std::string> m_dirs;
+};
+
+/// The process-wide resolver that plugins use for their file names. The scene loader sets it up
+/// (scene folder, <path> entries) while a scene loads.
+FileResolver &file_resolver();
+
+} // namespace facet

@@ -1,0 +1,67 @@
+#pragma once
+
+#include <facet/bbox.h>
+#include <facet/color.h>
+#include <facet/interaction.h>
+#include <facet/object.h>
+#include <facet/properties.h>
+
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace facet {
+
+/// The scene: shapes in one Embree scene, emitters, sensors and the integrator.
+/// Immutable once built; every query is thread-safe.
+class Scene : public Object {
+public:
+    /// Collects the children of a <scene> and builds the Embree scene. Missing pieces get
+    /// Mitsuba's defaults (a perspective sensor, the path integrator, diffuse BSDFs).
+    explicit Scene(const Properties &props);
+    ~Scene() override;
+    ObjectType type() const override { return ObjectType::Scene; }
+
+    /// Closest hit; fills si and returns true, or returns false (si.t stays Infinity).
+    bool ray_intersect(const Ray &ray, SurfaceInteraction &si) const;
+    /// Any hit in [ray.mint, ray.maxt] (rtcOccluded1).
+    bool ray_test(const Ray &ray) const;
+
+    /// Picks an emitter uniformly and samples a direction to it from ref. The weight includes the
+    /// selection probability; with `test_visibility` an occluded sample gets weight zero.
+    std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
+                                                                 bool test_visibility) const;
+    /// Density of sample_emitter_direction() for ds (selection probability included).
+    float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const;
+    /// Radiance of the infinite emitters along a ray that left the scene.
+    Color3f eval_environment(const Ray &ray) const;
+
+    const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
+    const std::vector<std::shared_ptr<Emitter>> &emitters() const { return m_emitters; }
+    const std::vector<std::shared_ptr<Emitter>> &environment_emitters() const { return m_environment; }
+    const std::vector<std::shared_ptr<Sensor>> &sensors() const { return m_sensors; }
+    std::shared_ptr<Integrator> integrator() const { return m_integrator; }
+    const BoundingBox3f &bbox() const { return m_bbox; }
+    RTCScene embree_scene() const { return m_rtc_scene; }
+    RTCDevice embree_device() const { return m_device; }
+    std::string to_string() const override;
+
+private:
+    std::vector<std::shared_ptr<Shape>> m_shapes;
+    std::vector<std::shared_ptr<Emitter>> m_emitters;
+    std::vector<std::shared_ptr<Emitter>> m_environment;
+    std::vector<std::shared_ptr<Sensor>> m_sensors;
+    std::shared_ptr<Integrator> m_integrator;
+    std::vector<const Shape *> m_geometry_shapes; ///< Embree geometry id -> shape
+    BoundingBox3f m_bbox;
+    RTCDevice m_device = nullptr;
+    RTCScene m_rtc_scene = nullptr;
+};
+
+/// Embree device shared by all scenes of the process; `threads` = 0 lets Embree decide.
+/// The first call fixes the configuration.
+RTCDevice embree_device(int threads = 0);
+
+} // namespace facet

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <facet/bbox.h>
+#include <facet/interaction.h>
+#include <facet/object.h>
+#include <facet/properties.h>
+
+#include <embree3/rtcore.h>
+
+#include <memory>
+
+namespace facet {
+
+/// Geometry. Plugins derive from Shape (exact primitives, Embree user geometry) or Mesh
+/// (triangles). The base class takes the nested `bsdf` and `emitter` children.
+class Shape : public Object {
+public:
+    explicit Shape(const Properties &props);
+    ObjectType type() const override { return ObjectType::Shape; }
+
+    virtual BoundingBox3f bbox() const = 0;
+    virtual float surface_area() const = 0;
+
+    /// Creates and commits this shape's Embree geometry on `device`. The scene attaches it and
+    /// keeps the mapping from geometry id back to the shape.
+    virtual RTCGeometry embree_geometry(RTCDevice device) const = 0;
+
+    /// Fills `si` for a hit at distance t on primitive `prim_index`; `uv` is what Embree
+    /// reported (barycentrics for triangles, whatever the user geometry stored otherwise).
+    virtual void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
+                                             const Point2f &uv, SurfaceInteraction &si) const = 0;
+
+    /// Uniform point on the surface; pdf per unit area.
+    virtual PositionSample sample_position(const Point2f &u) const = 0;
+    virtual float pdf_position(const PositionSample &ps) const { return 1.f / surface_area(); }
+
+    /// A point on the surface seen from `ref`, with a solid-angle pdf. The default converts
+    /// sample_position(); shapes with a better strategy (spheres) override both.
+    virtual DirectionSample sample_direction(const Interaction &ref, const Point2f &u) const;
+    virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const;
+
+    const BSDF *bsdf() const { return m_bsdf.get(); }
+    const Emitter *emitter() const { return m_emitter.get(); }
+    std::shared_ptr<BSDF> bsdf_ptr() const { return m_bsdf; }
+    std::shared_ptr<Emitter> emitter_ptr() const { return m_emitter; }
+    /// The scene gives shapes without a BSDF a default diffuse one.
+    void set_bsdf(std::shared_ptr<BSDF> bsdf) { m_bsdf = std::move(bsdf); }
+    virtual bool is_mesh() const { return false; }
+    std::string to_string() const override;
+
+protected:
+    std::shared_ptr<BSDF> m_bsdf;
+    std::shared_ptr<Emitter> m_emitter;
+};
+
+} // namespace facet

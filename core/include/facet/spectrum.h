@@ -1,0 +1,45 @@
+#pragma once
+
+#include <facet/color.h>
+
+#include <string>
+#include <vector>
+
+namespace facet {
+
+/// How a spectrum is turned into RGB (shared/REFERENCE.md 1.6).
+enum class SpectrumKind {
+    Reflectance, ///< weighted by D65, clamped to [0, 1]
+    Emission,    ///< unweighted, clamped to >= 0; a uniform value c becomes c·xyz_to_srgb(1,1,1)
+    Unbounded,   ///< unweighted, clamped to >= 0 (eta, k, alpha)
+};
+
+/// A spectrum as written in a scene: a uniform value or (wavelength nm, value) pairs.
+struct SpectrumData {
+    bool uniform = true;
+    double value = 0.0;              ///< when uniform
+    std::vector<double> wavelengths; ///< ascending, nm
+    std::vector<double> values;
+
+    static SpectrumData constant(double v) { return SpectrumData{true, v, {}, {}}; }
+    /// Linear interpolation of the pairs; zero outside their range.
+    double eval(double lambda) const;
+    std::string to_string() const;
+};
+
+/// Parse "400:0.5, 500:0.7" or a single number; throws facet::Error on bad input.
+SpectrumData parse_spectrum_pairs(const std::string &text);
+/// Read a .spd file ("wavelength value" per line, '#' comments).
+SpectrumData read_spd_file(const std::string &path);
+
+/// Integrate against the CIE 1931 curves (1000 steps over 360-830 nm) and convert to linear sRGB.
+Color3f spectrum_to_rgb(const SpectrumData &s, SpectrumKind kind);
+/// CIE XYZ -> linear Rec.709 RGB and back.
+Color3f xyz_to_srgb(const Color3f &xyz);
+Color3f srgb_to_xyz(const Color3f &rgb);
+/// CIE 1931 colour matching functions at `lambda` nm (linear interpolation of the 5 nm table).
+Color3f cie1931_xyz(double lambda);
+/// D65 relative power at `lambda` nm, normalised so that a white reflectance maps to luminance 1.
+double cie_d65(double lambda);
+
+} // namespace facet

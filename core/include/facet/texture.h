@@ -1,0 +1,37 @@
+#pragma once
+
+#include <facet/color.h>
+#include <facet/interaction.h>
+#include <facet/object.h>
+
+namespace facet {
+
+/// A spatially varying quantity, evaluated at a surface interaction (usually by its uv).
+class Texture : public Object {
+public:
+    ObjectType type() const override { return ObjectType::Texture; }
+    virtual Color3f eval(const SurfaceInteraction &si) const = 0;
+    /// Scalar value (the mean of the channels unless the texture knows better).
+    virtual float eval_1(const SurfaceInteraction &si) const { return eval(si).mean(); }
+    /// Average over the texture's domain.
+    virtual Color3f mean() const = 0;
+    virtual float max() const { return mean().max(); }
+    virtual bool is_spatially_varying() const { return true; }
+};
+
+/// The texture behind a plain number, rgb or spectrum parameter.
+class ConstantTexture final : public Texture {
+public:
+    explicit ConstantTexture(const Color3f &value) : m_value(value) {}
+    Color3f eval(const SurfaceInteraction &) const override { return m_value; }
+    float eval_1(const SurfaceInteraction &) const override { return m_value.mean(); }
+    Color3f mean() const override { return m_value; }
+    float max() const override { return m_value.max(); }
+    bool is_spatially_varying() const override { return false; }
+    std::string to_string() const override;
+
+private:
+    Color3f m_value;
+};
+
+} // namespace facet

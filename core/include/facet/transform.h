@@ -1,0 +1,55 @@
+#pragma once
+
+#include <facet/vector.h>
+
+#include <string>
+
+namespace facet {
+
+/// Row-major 4x4 matrix.
+struct Matrix4f {
+    float m[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+
+    static Matrix4f identity() { return Matrix4f(); }
+    static Matrix4f from_rows(const float (&v)[16]);
+    Matrix4f operator*(const Matrix4f &o) const;
+    bool operator==(const Matrix4f &o) const;
+    Matrix4f transpose() const;
+    /// Inverse by cofactors; a singular matrix gives a matrix of NaNs.
+    Matrix4f inverse() const;
+    bool is_identity() const { return *this == Matrix4f(); }
+};
+
+/// Affine or projective transform with its inverse.
+struct Transform {
+    Matrix4f matrix, inverse_matrix;
+
+    Transform() = default;
+    explicit Transform(const Matrix4f &m) : matrix(m), inverse_matrix(m.inverse()) {}
+    Transform(const Matrix4f &m, const Matrix4f &inv) : matrix(m), inverse_matrix(inv) {}
+
+    Transform operator*(const Transform &o) const {
+        return Transform(matrix * o.matrix, o.inverse_matrix * inverse_matrix);
+    }
+    Transform inverse() const { return Transform(inverse_matrix, matrix); }
+    bool is_identity() const { return matrix.is_identity(); }
+    bool operator==(const Transform &o) const { return matrix == o.matrix; }
+
+    Point3f apply_point(const Point3f &p) const;
+    Vector3f apply_vector(const Vector3f &v) const;
+    /// Normals transform with the inverse transpose.
+    Normal3f apply_normal(const Normal3f &n) const;
+
+    static Transform translate(const Vector3f &v);
+    static Transform scale(const Vector3f &v);
+    /// Counter-clockwise rotation by `angle_deg` degrees about `axis`.
+    static Transform rotate(const Vector3f &axis, float angle_deg);
+    /// Camera-to-world: columns [left, up', dir, origin] as in Mitsuba (camera looks down +Z).
+    static Transform look_at(const Point3f &origin, const Point3f &target, const Vector3f &up);
+    /// Perspective projection (fov in degrees) mapping camera space to [-1,1]² × [0,1].
+    static Transform perspective(float fov_deg, float near_clip, float far_clip);
+
+    std::string to_string() const;
+};
+
+} // namespace facet
