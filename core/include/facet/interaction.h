@@ -1,6 +1,7 @@
 #pragma once
 
 #include <facet/frame.h>
+#include <facet/fwd.h>
 #include <facet/ray.h>
 
 namespace facet {

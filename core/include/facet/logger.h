@@ -51,10 +51,10 @@ public:
 
 } // namespace facet
 
-#define FACET_LOG(level, ...)                                                                      \
+#define FACET_LOG(lvl, ...)                                                                        \
     do {                                                                                           \
-        if (::facet::LogLevel::level >= ::facet::Logger::level())                                  \
-            ::facet::Logger::log(::facet::LogLevel::level, fmt::format(__VA_ARGS__));              \
+        if (::facet::LogLevel::lvl >= ::facet::Logger::level())                                    \
+            ::facet::Logger::log(::facet::LogLevel::lvl, fmt::format(__VA_ARGS__));                \
     } while (0)
 
 /// Throw a facet::Error with a formatted message.

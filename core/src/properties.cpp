@@ -1,0 +1,272 @@
+#include <facet/properties.h>
+#include <facet/texture.h>
+
+namespace facet {
+
+namespace {
+
+std::string value_to_string(const Properties::Value &v) {
+    struct Visitor {
+        std::string operator()(bool b) const { return b ? "true" : "false"; }
+        std::string operator()(int64_t i) const { return fmt::format("{}", i); }
+        std::string operator()(double d) const { return fmt::format("{}", d); }
+        std::string operator()(const std::string &s) const { return fmt::format("\"{}\"", s); }
+        std::string operator()(const Vector3f &v) const {
+            return fmt::format("[{}, {}, {}]", v.x, v.y, v.z);
+        }
+        std::string operator()(const Color3f &c) const {
+            return fmt::format("[{}, {}, {}]", c.r, c.g, c.b);
+        }
+        std::string operator()(const SpectrumData &s) const { return s.to_string(); }
+        std::string operator()(const Transform &t) const { return t.to_string(); }
+        std::string operator()(const std::shared_ptr<Object> &o) const {
+            return o ? o->to_string() : std::string("null");
+        }
+    };
+    return std::visit(Visitor{}, v);
+}
+
+/// Name of the entry's type as written in a scene file ("float", "rgb", "bsdf", ...).
+std::string entry_type_name(const Properties::Value &v) {
+    if (auto obj = std::get_if<std::shared_ptr<Object>>(&v))
+        return *obj ? object_type_name((*obj)->type()) : "object";
+    return Properties::type_name(Properties::Type(v.index()));
+}
+
+} // namespace
+
+const char *Properties::type_name(Type t) {
+    switch (t) {
+    case Type::Bool: return "boolean";
+    case Type::Integer: return "integer";
+    case Type::Float: return "float";
+    case Type::String: return "string";
+    case Type::Vector: return "vector";
+    case Type::Color: return "rgb";
+    case Type::Spectrum: return "spectrum";
+    case Type::Transform: return "transform";
+    case Type::Object: return "object";
+    }
+    return "unknown";
+}
+
+void Properties::set(const std::string &name, Value value, const Location &loc, bool overwrite) {
+    for (auto &e : m_entries) {
+        if (e.name != name) continue;
+        if (!overwrite)
+            FACET_THROW_AT(loc.valid() ? loc : m_location,
+                           "property \"{}\" was specified multiple times", name);
+        e.value = std::move(value);
+        e.location = loc;
+        e.queried = false;
+        return;
+    }
+    m_entries.push_back(Entry{name, std::move(value), loc, false});
+}
+
+bool Properties::remove(const std::string &name) {
+    for (auto it = m_entries.begin(); it != m_entries.end(); ++it) {
+        if (it->name == name) {
+            m_entries.erase(it);
+            return true;
+        }
+    }
+    return false;
+}
+
+const Properties::Entry *Properties::find(const std::string &name) const {
+    for (const auto &e : m_entries)
+        if (e.name == name) return &e;
+    return nullptr;
+}
+
+void Properties::note_request(const std::string &name) const {
+    if (std::find(m_requested.begin(), m_requested.end(), name) == m_requested.end())
+        m_requested.push_back(name);
+}
+
+const Properties::Entry &Properties::require(const std::string &name) const {
+    note_request(name);
+    const Entry *e = find(name);
+    if (!e) {
+        if (m_plugin_name.empty())
+            FACET_THROW_AT(m_location, "missing required parameter \"{}\"", name);
+        FACET_THROW_AT(m_location, "missing required parameter \"{}\" of plugin \"{}\"", name,
+                       m_plugin_name);
+    }
+    e->queried = true;
+    return *e;
+}
+
+void Properties::type_error(const std::string &name, const char *expected) const {
+    const Entry *e = find(name);
+    std::string found = e ? entry_type_name(e->value) : std::string("nothing");
+    FACET_THROW_AT(e && e->location.valid() ? e->location : m_location,
+                   "parameter \"{}\" has type {}, but {} was expected", name, found, expected);
+}
+
+bool Properties::has(const std::string &name) const {
+    note_request(name);
+    return find(name) != nullptr;
+}
+
+Properties::Type Properties::type(const std::string &name) const {
+    return Type(require(name).value.index());
+}
+
+const Location &Properties::location(const std::string &name) const {
+    const Entry *e = find(name);
+    return e ? e->location : m_location;
+}
+
+bool Properties::get_bool(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<bool>(&e.value)) return *v;
+    type_error(name, "boolean");
+}
+
+bool Properties::get_bool(const std::string &name, bool def) const {
+    return has(name) ? get_bool(name) : def;
+}
+
+int64_t Properties::get_int(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<int64_t>(&e.value)) return *v;
+    type_error(name, "integer");
+}
+
+int64_t Properties::get_int(const std::string &name, int64_t def) const {
+    return has(name) ? get_int(name) : def;
+}
+
+double Properties::get_float(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<double>(&e.value)) return *v;
+    if (auto v = std::get_if<int64_t>(&e.value)) return double(*v);
+    type_error(name, "float");
+}
+
+double Properties::get_float(const std::string &name, double def) const {
+    return has(name) ? get_float(name) : def;
+}
+
+std::string Properties::get_string(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<std::string>(&e.value)) return *v;
+    type_error(name, "string");
+}
+
+std::string Properties::get_string(const std::string &name, const std::string &def) const {
+    return has(name) ? get_string(name) : def;
+}
+
+Vector3f Properties::get_vector(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<Vector3f>(&e.value)) return *v;
+    type_error(name, "vector");
+}
+
+Vector3f Properties::get_vector(const std::string &name, const Vector3f &def) const {
+    return has(name) ? get_vector(name) : def;
+}
+
+Transform Properties::get_transform(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<Transform>(&e.value)) return *v;
+    type_error(name, "transform");
+}
+
+Transform Properties::get_transform(const std::string &name, const Transform &def) const {
+    return has(name) ? get_transform(name) : def;
+}
+
+Color3f Properties::get_color(const std::string &name, SpectrumKind kind) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<Color3f>(&e.value)) return *v;
+    if (auto v = std::get_if<double>(&e.value)) return Color3f(float(*v));
+    if (auto v = std::get_if<int64_t>(&e.value)) return Color3f(float(*v));
+    if (auto v = std::get_if<Vector3f>(&e.value)) return Color3f(v->x, v->y, v->z);
+    if (auto v = std::get_if<SpectrumData>(&e.value)) {
+        try {
+            return spectrum_to_rgb(*v, kind);
+        } catch (const Error &err) {
+            FACET_THROW_AT(e.location.valid() ? e.location : m_location, "parameter \"{}\": {}", name,
+                           err.message());
+        }
+    }
+    type_error(name, "rgb, spectrum or float");
+}
+
+Color3f Properties::get_color(const std::string &name, const Color3f &def, SpectrumKind kind) const {
+    return has(name) ? get_color(name, kind) : def;
+}
+
+std::shared_ptr<Object> Properties::object_entry(const std::string &name) const {
+    const Entry &e = require(name);
+    if (auto v = std::get_if<std::shared_ptr<Object>>(&e.value)) return *v;
+    type_error(name, "object");
+}
+
+std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKind kind) const {
+    const Entry &e = require(name);
+    if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) {
+        if (auto tex = std::dynamic_pointer_cast<Texture>(*obj)) return tex;
+        type_error(name, "texture, rgb, spectrum or float");
+    }
+    switch (Type(e.value.index())) {
+    case Type::Float:
+    case Type::Integer:
+    case Type::Color:
+    case Type::Spectrum: return std::make_shared<ConstantTexture>(get_color(name, kind));
+    default: type_error(name, "texture, rgb, spectrum or float");
+    }
+}
+
+std::shared_ptr<Texture> Properties::texture(const std::string &name, float def,
+                                             SpectrumKind kind) const {
+    if (!has(name)) return std::make_shared<ConstantTexture>(Color3f(def));
+    return texture(name, kind);
+}
+
+std::shared_ptr<Texture> Properties::texture(const std::string &name, const Color3f &def,
+                                             SpectrumKind kind) const {
+    if (!has(name)) return std::make_shared<ConstantTexture>(def);
+    return texture(name, kind);
+}
+
+std::vector<std::pair<std::string, std::shared_ptr<Object>>> Properties::objects() const {
+    std::vector<std::pair<std::string, std::shared_ptr<Object>>> result;
+    for (const auto &e : m_entries)
+        if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) result.emplace_back(e.name, *obj);
+    return result;
+}
+
+std::vector<std::string> Properties::names() const {
+    std::vector<std::string> result;
+    for (const auto &e : m_entries) result.push_back(e.name);
+    return result;
+}
+
+void Properties::mark_queried(const std::string &name) const {
+    if (const Entry *e = find(name)) e->queried = true;
+}
+
+bool Properties::was_queried(const std::string &name) const {
+    const Entry *e = find(name);
+    return e && e->queried;
+}
+
+std::vector<std::string> Properties::unqueried() const {
+    std::vector<std::string> result;
+    for (const auto &e : m_entries)
+        if (!e.queried) result.push_back(e.name);
+    return result;
+}
+
+std::string Properties::entry_to_string(const std::string &name) const {
+    const Entry *e = find(name);
+    if (!e) return fmt::format("\"{}\": (absent)", name);
+    return fmt::format("{} \"{}\": {}", entry_type_name(e->value), name, value_to_string(e->value));
+}
+
+} // namespace facet
