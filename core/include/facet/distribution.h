@@ -1,0 +1,86 @@
+#pragma once
+
+#include <facet/vector.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace facet {
+
+/// Discrete distribution over n entries from non-negative weights, sampled by inverting the CDF.
+class DiscreteDistribution {
+public:
+    DiscreteDistribution() = default;
+    explicit DiscreteDistribution(const std::vector<float> &weights) { build(weights.data(), weights.size()); }
+    DiscreteDistribution(const float *weights, size_t n) { build(weights, n); }
+
+    void build(const float *weights, size_t n) {
+        m_cdf.assign(n + 1, 0.0);
+        for (size_t i = 0; i < n; ++i) m_cdf[i + 1] = m_cdf[i] + double(std::max(weights[i], 0.f));
+        m_sum = m_cdf[n];
+        if (m_sum > 0.0)
+            for (double &c : m_cdf) c /= m_sum;
+    }
+
+    size_t size() const { return m_cdf.empty() ? 0 : m_cdf.size() - 1; }
+    /// Sum of the weights before normalisation.
+    double sum() const { return m_sum; }
+    float pmf(size_t i) const { return float(m_cdf[i + 1] - m_cdf[i]); }
+
+    /// Index for u in [0,1); `u` is rescaled to a fresh uniform variate within the entry.
+    size_t sample_reuse(float &u) const {
+        size_t n = size();
+        auto it = std::upper_bound(m_cdf.begin() + 1, m_cdf.end(), double(u));
+        size_t i = std::min(size_t(it - m_cdf.begin()) - 1, n - 1);
+        // Skip zero-probability entries that upper_bound may land on at the boundaries.
+        while (i + 1 < n && pmf(i) == 0.f) ++i;
+        double lo = m_cdf[i], w = m_cdf[i + 1] - m_cdf[i];
+        u = w > 0.0 ? std::min(float((double(u) - lo) / w), OneMinusEpsilon) : 0.f;
+        return i;
+    }
+
+private:
+    std::vector<double> m_cdf;
+    double m_sum = 0.0;
+};
+
+/// Piecewise-constant density on [0,1]² over a width × height grid of cells, sampled by the
+/// marginal in y and then the conditional in x.
+class Distribution2D {
+public:
+    Distribution2D() = default;
+    Distribution2D(const std::vector<float> &weights, int width, int height) : m_width(width), m_height(height) {
+        m_conditional.resize(size_t(height));
+        std::vector<float> row_sums(static_cast<size_t>(height));
+        for (int y = 0; y < height; ++y) {
+            m_conditional[size_t(y)].build(weights.data() + size_t(y) * width, size_t(width));
+            row_sums[size_t(y)] = float(m_conditional[size_t(y)].sum());
+        }
+        m_marginal.build(row_sums.data(), row_sums.size());
+    }
+
+    bool valid() const { return m_marginal.sum() > 0.0; }
+
+    /// Point in [0,1]² and its density with respect to area on the unit square.
+    Point2f sample(const Point2f &u, float &pdf) const {
+        float uy = u.y, ux = u.x;
+        size_t y = m_marginal.sample_reuse(uy);
+        size_t x = m_conditional[y].sample_reuse(ux);
+        pdf = m_marginal.pmf(y) * m_conditional[y].pmf(x) * float(m_width) * float(m_height);
+        return {(float(x) + ux) / float(m_width), (float(y) + uy) / float(m_height)};
+    }
+
+    float pdf(const Point2f &p) const {
+        int x = std::clamp(int(p.x * float(m_width)), 0, m_width - 1);
+        int y = std::clamp(int(p.y * float(m_height)), 0, m_height - 1);
+        return m_marginal.pmf(size_t(y)) * m_conditional[size_t(y)].pmf(size_t(x)) * float(m_width) *
+               float(m_height);
+    }
+
+private:
+    int m_width = 0, m_height = 0;
+    std::vector<DiscreteDistribution> m_conditional;
+    DiscreteDistribution m_marginal;
+};
+
+} // namespace facet
