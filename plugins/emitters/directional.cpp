@@ -1,0 +1,81 @@
+static const char *DOC = R"DOC(
+# directional: distant directional light
+
+Light arriving from one direction everywhere in the scene, like sunlight. The direction is
+given by `direction` or as the +Z axis of `to_world` (not both). `irradiance` is the power per
+unit area on a surface perpendicular to the direction.
+
+| Parameter  | Type             | Default | Description                                         |
+|------------|------------------|---------|-----------------------------------------------------|
+| irradiance | spectrum or rgb  | 1       | Irradiance on a surface facing the light (W/m²)     |
+| direction  | vector           | —       | Direction the light travels in (world space)        |
+| to_world   | transform        | —       | Alternatively: the light travels along local +Z     |
+
+```xml
+<emitter type="directional">
+    <vector name="direction" value="0, -1, -1"/>
+    <rgb name="irradiance" value="3"/>
+</emitter>
+```
+)DOC";
+
+#include <facet/emitter.h>
+#include <facet/plugin.h>
+#include <facet/scene.h>
+
+namespace facet {
+
+class DirectionalEmitter final : public Emitter {
+public:
+    explicit DirectionalEmitter(const Properties &props) {
+        m_irradiance = props.get_color("irradiance", Color3f(1.f), SpectrumKind::Emission);
+        bool has_dir = props.has("direction"), has_xf = props.has("to_world");
+        if (has_dir && has_xf)
+            FACET_THROW_AT(props.location(), "directional: give either \"direction\" or \"to_world\", not both");
+        Vector3f d(0.f, 0.f, 1.f);
+        if (has_dir)
+            d = props.get_vector("direction");
+        else if (has_xf)
+            d = props.get_transform("to_world").apply_vector(Vector3f(0.f, 0.f, 1.f));
+        if (!(norm(d) > 0.f) || !is_finite(d))
+            FACET_THROW_AT(props.location(), "directional: the direction must be a non-zero vector");
+        m_direction = normalize(d);
+        m_flags = EmitterFlags::DeltaDirection | EmitterFlags::Infinite;
+    }
+
+    void set_scene(const Scene &scene) override {
+        m_radius = std::max(scene.bbox().bounding_sphere_radius(), 1e-3f);
+    }
+
+    std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                         const Point2f &) const override {
+        DirectionSample ds;
+        ds.d = -m_direction;
+        ds.dist = Infinity;
+        ds.p = ref.p + ds.d * (2.f * m_radius);
+        ds.n = m_direction;
+        ds.pdf = 1.f;
+        ds.delta = true;
+        ds.emitter = this;
+        return {ds, m_irradiance};
+    }
+
+    float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
+    Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
+
+    std::string to_string() const override {
+        return fmt::format("DirectionalEmitter[direction=[{}, {}, {}], irradiance=[{}, {}, {}]]",
+                           m_direction.x, m_direction.y, m_direction.z, m_irradiance.r,
+                           m_irradiance.g, m_irradiance.b);
+    }
+
+private:
+    Color3f m_irradiance;
+    Vector3f m_direction;
+    float m_radius = 1.f;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::DirectionalEmitter, Emitter, "directional",
+                    "Distant light from a single direction (sun-like)", DOC)

@@ -1,0 +1,107 @@
+static const char *DOC = R"DOC(
+# spot: spot light
+
+A point light at the origin of `to_world` that shines along its local +Z axis into a cone.
+Inside `beam_width` the intensity is full; between `beam_width` and `cutoff_angle` it falls
+off linearly in angle to zero. An optional `texture` is projected through the cone (uv spans
+the cone's cross-section at the cutoff angle) and multiplies the intensity.
+
+| Parameter    | Type            | Default              | Description                              |
+|--------------|-----------------|----------------------|------------------------------------------|
+| intensity    | spectrum or rgb | 1                    | Radiant intensity on the axis (W/sr)     |
+| cutoff_angle | float           | 20                   | Half-angle of the cone, degrees          |
+| beam_width   | float           | 3/4 · cutoff_angle   | Half-angle of full intensity, degrees    |
+| texture      | texture         | —                    | Pattern projected through the cone       |
+| to_world     | transform       | identity             | Position and orientation (looks along +Z)|
+
+```xml
+<emitter type="spot">
+    <transform name="to_world">
+        <lookat origin="0, 5, 0" target="0, 0, 0" up="0, 0, 1"/>
+    </transform>
+    <rgb name="intensity" value="20"/>
+    <float name="cutoff_angle" value="30"/>
+</emitter>
+```
+)DOC";
+
+#include <facet/emitter.h>
+#include <facet/plugin.h>
+#include <facet/texture.h>
+#include <facet/transform.h>
+
+namespace facet {
+
+class SpotEmitter final : public Emitter {
+public:
+    explicit SpotEmitter(const Properties &props) {
+        m_intensity = props.get_color("intensity", Color3f(1.f), SpectrumKind::Emission);
+        m_texture = props.has("texture") ? props.texture("texture") : nullptr;
+        m_to_world = props.get_transform("to_world", Transform());
+        float cutoff = float(props.get_float("cutoff_angle", 20.0));
+        float beam = float(props.get_float("beam_width", cutoff * 0.75));
+        if (!(cutoff > 0.f && cutoff < 90.f))
+            FACET_THROW_AT(props.location(), "spot: cutoff_angle must be in (0, 90) degrees, got {}", cutoff);
+        if (!(beam >= 0.f && beam <= cutoff))
+            FACET_THROW_AT(props.location(), "spot: beam_width must be in [0, cutoff_angle], got {}", beam);
+        m_cutoff = deg_to_rad(cutoff);
+        m_beam = deg_to_rad(beam);
+        m_cos_cutoff = std::cos(m_cutoff);
+        m_cos_beam = std::cos(m_beam);
+        m_uv_factor = std::tan(m_cutoff);
+        m_position = m_to_world.apply_point(Point3f(0.f));
+        m_flags = EmitterFlags::DeltaPosition;
+        if (m_texture && m_texture->is_spatially_varying()) m_flags = m_flags | EmitterFlags::SpatiallyVarying;
+    }
+
+    /// Intensity towards the local direction d (unit vector).
+    Color3f intensity(const Vector3f &d) const {
+        float cos_theta = d.z;
+        if (cos_theta <= m_cos_cutoff) return Color3f(0.f);
+        float falloff = 1.f;
+        if (cos_theta < m_cos_beam && m_cutoff > m_beam)
+            falloff = (m_cutoff - safe_acos(cos_theta)) / (m_cutoff - m_beam);
+        Color3f result = m_intensity * falloff;
+        if (m_texture) {
+            SurfaceInteraction si;
+            si.uv = Point2f(0.5f + 0.5f * d.x / (d.z * m_uv_factor), 0.5f + 0.5f * d.y / (d.z * m_uv_factor));
+            result *= m_texture->eval(si);
+        }
+        return result;
+    }
+
+    std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                         const Point2f &) const override {
+        DirectionSample ds;
+        ds.p = m_position;
+        Vector3f to_light = m_position - ref.p;
+        float dist2 = squared_norm(to_light);
+        ds.dist = std::sqrt(dist2);
+        ds.d = to_light / ds.dist;
+        ds.n = -ds.d;
+        ds.pdf = 1.f;
+        ds.delta = true;
+        ds.emitter = this;
+        Vector3f local = normalize(m_to_world.inverse().apply_vector(-ds.d));
+        return {ds, intensity(local) / dist2};
+    }
+
+    float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
+    Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
+
+    std::string to_string() const override {
+        return fmt::format("SpotEmitter[position=[{}, {}, {}], cutoff={}°, beam={}°]", m_position.x,
+                           m_position.y, m_position.z, rad_to_deg(m_cutoff), rad_to_deg(m_beam));
+    }
+
+private:
+    Color3f m_intensity;
+    std::shared_ptr<Texture> m_texture;
+    Transform m_to_world;
+    Point3f m_position;
+    float m_cutoff, m_beam, m_cos_cutoff, m_cos_beam, m_uv_factor;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::SpotEmitter, Emitter, "spot", "Spot light with a linear angular falloff", DOC)

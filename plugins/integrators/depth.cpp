@@ -1,0 +1,37 @@
+static const char *DOC = R"DOC(
+# depth: distance to the first surface
+
+Writes the distance along each camera ray to the first surface it hits (0 where the ray
+escapes) into all three channels. Useful for debugging scenes and as a depth pass.
+
+This plugin has no parameters.
+
+```xml
+<integrator type="depth"/>
+```
+)DOC";
+
+#include <facet/integrator.h>
+#include <facet/plugin.h>
+#include <facet/scene.h>
+
+namespace facet {
+
+class DepthIntegrator final : public SamplingIntegrator {
+public:
+    explicit DepthIntegrator(const Properties &) {}
+
+    Color3f sample(const Scene &scene, Sampler &, const Ray &ray, float *) const override {
+        SurfaceInteraction si;
+        if (!scene.ray_intersect(ray, si)) return Color3f(0.f);
+        // Rays from the sensor have unit directions, so t is the distance.
+        return Color3f(si.t * norm(ray.d));
+    }
+
+    std::string to_string() const override { return "DepthIntegrator[]"; }
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::DepthIntegrator, Integrator, "depth",
+                    "Distance from the sensor to the first surface", DOC)
