@@ -22,8 +22,17 @@ public:
     virtual float surface_area() const = 0;
 
     /// Creates and commits this shape's Embree geometry on `device`. The scene attaches it and
-    /// keeps the mapping from geometry id back to the shape.
+    /// keeps the mapping from geometry id back to the shape. nullptr: nothing to attach (a
+    /// shapegroup, which is only visible through its instances).
     virtual RTCGeometry embree_geometry(RTCDevice device) const = 0;
+
+    /// For instances: fills `si` for a hit on geometry `geom_id` of the instanced group (Embree's
+    /// hit.geomID when hit.instID[0] is this shape's geometry). Other shapes throw.
+    virtual void compute_instance_interaction(const Ray &ray, float t, uint32_t geom_id,
+                                              uint32_t prim_index, const Point2f &uv,
+                                              SurfaceInteraction &si) const {
+        FACET_THROW("shape {} is not an instance", to_string());
+    }
 
     /// Fills `si` for a hit at distance t on primitive `prim_index`; `uv` is what Embree
     /// reported (barycentrics for triangles, whatever the user geometry stored otherwise).
@@ -49,6 +58,9 @@ public:
     std::string to_string() const override;
 
 protected:
+    /// For shapes that interpret their nested objects themselves (shapegroup, instance).
+    Shape() = default;
+
     std::shared_ptr<BSDF> m_bsdf;
     std::shared_ptr<Emitter> m_emitter;
 };

@@ -1,0 +1,39 @@
+#pragma once
+
+#include <facet/shape.h>
+
+#include <mutex>
+#include <vector>
+
+namespace facet {
+
+/// A group of shapes with its own Embree scene, placed in the world by `instance` shapes.
+/// Declared in core so that the instance plugin can use it without including another plugin.
+class ShapeGroup : public Shape {
+public:
+    explicit ShapeGroup(const Properties &props);
+    ~ShapeGroup() override;
+
+    BoundingBox3f bbox() const override { return m_bbox; }
+    float surface_area() const override { return m_area; }
+    /// Not attached to the scene by itself.
+    RTCGeometry embree_geometry(RTCDevice) const override { return nullptr; }
+    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index, const Point2f &uv,
+                                     SurfaceInteraction &si) const override;
+    PositionSample sample_position(const Point2f &u) const override;
+    std::string to_string() const override;
+
+    /// The group's committed Embree scene (built on first use; geometry id i = shape i).
+    RTCScene group_scene(RTCDevice device) const;
+    const Shape &shape(uint32_t geom_id) const { return *m_shapes[geom_id]; }
+    const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
+
+private:
+    std::vector<std::shared_ptr<Shape>> m_shapes;
+    BoundingBox3f m_bbox;
+    float m_area = 0.f;
+    mutable std::mutex m_mutex;
+    mutable RTCScene m_scene = nullptr;
+};
+
+} // namespace facet

@@ -1,0 +1,58 @@
+#include <facet/logger.h>
+#include <facet/shapegroup.h>
+
+namespace facet {
+
+ShapeGroup::ShapeGroup(const Properties &props) {
+    for (const auto &[name, obj] : props.objects()) {
+        auto shape = std::dynamic_pointer_cast<Shape>(obj);
+        if (!shape)
+            FACET_THROW_AT(props.location(name), "shapegroup: only shapes can be nested (\"{}\" is a {})",
+                           name, object_type_name(obj->type()));
+        if (dynamic_cast<const ShapeGroup *>(shape.get()))
+            FACET_THROW_AT(props.location(name), "shapegroup: shape groups cannot be nested");
+        if (shape->emitter())
+            FACET_THROW_AT(props.location(name), "shapegroup: emitters inside a shape group are not supported");
+        props.mark_queried(name);
+        m_bbox.expand(shape->bbox());
+        m_area += shape->surface_area();
+        m_shapes.push_back(std::move(shape));
+    }
+    if (m_shapes.empty()) FACET_THROW_AT(props.location(), "shapegroup: the group is empty");
+}
+
+ShapeGroup::~ShapeGroup() {
+    if (m_scene) rtcReleaseScene(m_scene);
+}
+
+RTCScene ShapeGroup::group_scene(RTCDevice device) const {
+    std::lock_guard<std::mutex> lock(m_mutex); // scene construction only, not a hot path
+    if (m_scene) return m_scene;
+    m_scene = rtcNewScene(device);
+    rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(m_scene, RTC_BUILD_QUALITY_HIGH);
+    for (size_t i = 0; i < m_shapes.size(); ++i) {
+        RTCGeometry geom = m_shapes[i]->embree_geometry(device);
+        if (!geom) continue;
+        rtcAttachGeometryByID(m_scene, geom, unsigned(i));
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(m_scene);
+    return m_scene;
+}
+
+void ShapeGroup::compute_surface_interaction(const Ray &, float, uint32_t, const Point2f &,
+                                             SurfaceInteraction &) const {
+    FACET_THROW("shapegroup: a shape group is only visible through instances");
+}
+
+PositionSample ShapeGroup::sample_position(const Point2f &) const {
+    FACET_THROW("shapegroup: sampling positions on a shape group is not supported");
+}
+
+std::string ShapeGroup::to_string() const {
+    return fmt::format("ShapeGroup[{} shapes]", m_shapes.size());
+}
+
+} // namespace facet
+
