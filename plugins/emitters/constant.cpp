@@ -1,0 +1,93 @@
+static const char *DOC = R"DOC(
+# constant: constant environment light
+
+An environment that surrounds the scene and sends the same `radiance` from every direction.
+Directions are sampled uniformly over the sphere (pdf 1/4π); the sampled point lies beyond the
+scene's bounding sphere, so shadow rays towards it cross the whole scene.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| radiance | spectrum or texture | 1 | Emitted radiance (a number, `rgb`, `spectrum` or texture) |
+
+```xml
+<emitter type="constant">
+    <rgb name="radiance" value="1.0"/>
+</emitter>
+```
+)DOC";
+
+#include <facet/emitter.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/scene.h>
+#include <facet/texture.h>
+#include <facet/warp.h>
+
+#include <fmt/format.h>
+
+namespace facet {
+
+class ConstantLight final : public Emitter {
+public:
+    explicit ConstantLight(const Properties &props) {
+        m_radiance = props.texture("radiance", 1.f, SpectrumKind::Emission);
+        m_flags = EmitterFlags::Infinite;
+        if (m_radiance->is_spatially_varying()) m_flags = m_flags | EmitterFlags::SpatiallyVarying;
+    }
+
+    void set_scene(const Scene &scene) override {
+        const BoundingBox3f &bbox = scene.bbox();
+        float radius = bbox.bounding_sphere_radius();
+        if (bbox.valid() && std::isfinite(radius) && radius > 0.f) {
+            m_center = bbox.center();
+            // Slightly larger than the bounding sphere, so the sampled points lie outside it.
+            m_radius = radius * (1.f + RayEpsilon);
+        } else {
+            m_center = Point3f(0.f);
+            m_radius = 1.f;
+        }
+    }
+
+    std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                         const Point2f &u) const override {
+        DirectionSample ds;
+        ds.d = warp::square_to_uniform_sphere(u);
+        // A point at distance 2r: beyond the bounding sphere for every reference point inside it.
+        ds.dist = 2.f * m_radius;
+        ds.p = ref.p + ds.d * ds.dist;
+        ds.n = -ds.d;
+        ds.uv = u;
+        ds.pdf = InvFourPi;
+        ds.delta = false;
+        ds.emitter = this;
+        return {ds, radiance_along(ds.d) * (4.f * Pi)};
+    }
+
+    float pdf_direction(const Interaction &, const DirectionSample &) const override {
+        return InvFourPi;
+    }
+
+    Color3f eval(const SurfaceInteraction &si) const override { return m_radiance->eval(si); }
+
+    std::string to_string() const override {
+        return fmt::format("ConstantLight[radiance = {}, bounding sphere = ({}, {}, {}) r {}]",
+                           m_radiance->to_string(), m_center.x, m_center.y, m_center.z, m_radius);
+    }
+
+private:
+    /// Radiance arriving from direction d (a miss record, as Scene passes to eval()).
+    Color3f radiance_along(const Vector3f &d) const {
+        if (!m_radiance->is_spatially_varying()) return m_radiance->mean();
+        SurfaceInteraction si;
+        si.wi = -d;
+        return m_radiance->eval(si);
+    }
+
+    std::shared_ptr<Texture> m_radiance;
+    Point3f m_center{0.f, 0.f, 0.f};
+    float m_radius = 1.f;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::ConstantLight, Emitter, "constant", "Constant environment light", DOC)

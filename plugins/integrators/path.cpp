@@ -1,0 +1,205 @@
+static const char *DOC = R"DOC(
+# path: unidirectional path tracer
+
+Traces paths from the camera. At every non-specular vertex it samples an emitter (next event
+estimation) and the BSDF, and weights both with multiple importance sampling (power heuristic).
+Emitters found by BSDF sampling after a specular bounce get full weight. After `rr_depth`
+bounces, Russian roulette ends paths whose throughput has become small.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| max_depth | integer | -1 | Longest path, in segments: -1 is unbounded, 1 shows only directly visible emitters, 2 adds direct illumination, 3 one indirect bounce, ... |
+| rr_depth | integer | 5 | Depth from which Russian roulette may end a path (at least 1) |
+| hide_emitters | boolean | false | Hide emitters (area lights and the environment) seen directly by the camera |
+
+```xml
+<integrator type="path">
+    <integer name="max_depth" value="8"/>
+</integrator>
+```
+)DOC";
+
+#include <facet/bsdf.h>
+#include <facet/emitter.h>
+#include <facet/integrator.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+
+#include <fmt/format.h>
+
+#include <limits>
+
+namespace facet {
+
+namespace {
+
+/// Power heuristic (β = 2) for the strategy with density `a` against one with density `b`.
+inline float mis_weight(float a, float b) {
+    a *= a;
+    b *= b;
+    float w = a / (a + b);
+    return std::isfinite(w) ? w : 0.f;
+}
+
+/// Record of the emitter point `si` as seen from `ref`, for Scene::pdf_emitter_direction.
+inline DirectionSample direction_to(const SurfaceInteraction &si, const Interaction &ref) {
+    DirectionSample ds;
+    ds.p = si.p;
+    ds.n = si.n;
+    ds.uv = si.uv;
+    Vector3f d = si.p - ref.p;
+    ds.dist = norm(d);
+    ds.d = ds.dist > 0.f ? d / ds.dist : Vector3f(0.f);
+    ds.emitter = si.emitter();
+    return ds;
+}
+
+} // namespace
+
+class PathIntegrator final : public SamplingIntegrator {
+public:
+    explicit PathIntegrator(const Properties &props) {
+        int64_t max_depth = props.get_int("max_depth", -1);
+        if (max_depth < -1)
+            FACET_THROW_AT(props.location("max_depth"),
+                           "path: max_depth must be -1 (unbounded) or a value >= 0, got {}",
+                           max_depth);
+        m_max_depth = max_depth == -1 ? std::numeric_limits<uint32_t>::max()
+                                      : uint32_t(std::min<int64_t>(max_depth, 0xfffffffe));
+        int64_t rr_depth = props.get_int("rr_depth", 5);
+        if (rr_depth <= 0)
+            FACET_THROW_AT(props.location("rr_depth"),
+                           "path: rr_depth must be a value greater than zero, got {}", rr_depth);
+        m_rr_depth = uint32_t(std::min<int64_t>(rr_depth, 0xffffffff));
+        m_hide_emitters = props.get_bool("hide_emitters", false);
+    }
+
+    Color3f sample(const Scene &scene, Sampler &sampler, const Ray &camera_ray,
+                   float * /*aovs*/) const override {
+        if (m_max_depth == 0) return Color3f(0.f);
+
+        const BSDFContext ctx;
+        Ray ray = camera_ray;
+        Color3f result(0.f), throughput(1.f);
+        float eta = 1.f;
+        uint32_t depth = 0;
+        SurfaceInteraction si, prev_si;
+        // The camera ray behaves like a delta bounce: whatever it hits is counted in full.
+        float prev_bsdf_pdf = 1.f;
+        bool prev_bsdf_delta = true;
+
+        for (;;) {
+            bool hit = scene.ray_intersect(ray, si);
+            bool count_emission = !(m_hide_emitters && depth == 0);
+
+            // ---- Emission found by the previous BSDF sample (or by the camera ray) ----
+            if (!hit) {
+                if (count_emission)
+                    result += throughput * environment(scene, ray, prev_si, prev_bsdf_pdf,
+                                                       prev_bsdf_delta);
+                break;
+            }
+            if (count_emission) {
+                if (const Emitter *emitter = si.emitter()) {
+                    Color3f L = emitter->eval(si);
+                    if (!L.is_black()) {
+                        float w = 1.f;
+                        if (!prev_bsdf_delta) {
+                            float em_pdf = scene.pdf_emitter_direction(prev_si, direction_to(si, prev_si));
+                            w = mis_weight(prev_bsdf_pdf, em_pdf);
+                        }
+                        result += throughput * L * w;
+                    }
+                }
+            }
+
+            if (depth + 1 >= m_max_depth) break;
+            const BSDF *bsdf = si.bsdf();
+
+            // ---- Emitter sampling (pointless for purely specular BSDFs) ----
+            if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), true);
+                if (ds.pdf != 0.f && !em_weight.is_black()) {
+                    Vector3f wo = si.to_local(ds.d);
+                    auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
+                    if (!f.is_black()) {
+                        float w = ds.delta ? 1.f : mis_weight(ds.pdf, bsdf_pdf);
+                        result += throughput * f * em_weight * w;
+                    }
+                }
+            }
+
+            // ---- BSDF sampling: the next segment of the path ----
+            float sample1 = sampler.next_1d();
+            Point2f sample2 = sampler.next_2d();
+            auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);
+            if (bsdf_weight.is_black()) break;
+
+            throughput *= bsdf_weight;
+            eta *= bs.eta;
+            prev_si = si;
+            prev_bsdf_pdf = bs.pdf;
+            prev_bsdf_delta = has_flag(bs.sampled_type, BSDFFlags::Delta);
+            ray = si.spawn_ray(si.to_world(bs.wo));
+            ++depth;
+
+            // ---- Russian roulette; eta² undoes the radiance scaling of refraction ----
+            float throughput_max = throughput.max();
+            if (!(throughput_max > 0.f) || !std::isfinite(throughput_max)) break;
+            if (depth >= m_rr_depth) {
+                float q = std::min(throughput_max * eta * eta, 0.95f);
+                if (!(sampler.next_1d() < q)) break;
+                throughput /= q;
+            }
+        }
+        return result;
+    }
+
+    std::string to_string() const override {
+        return fmt::format("PathIntegrator[max_depth = {}, rr_depth = {}, hide_emitters = {}]",
+                           m_max_depth == std::numeric_limits<uint32_t>::max()
+                               ? std::string("-1")
+                               : std::to_string(m_max_depth),
+                           m_rr_depth, m_hide_emitters);
+    }
+
+private:
+    /// Radiance of the environment along a ray that left the scene. With MIS, each infinite
+    /// emitter is weighted against the density with which emitter sampling picks it and this
+    /// direction, since an emitter sample only ever carries the radiance of its own emitter.
+    static Color3f environment(const Scene &scene, const Ray &ray, const Interaction &prev,
+                               float prev_bsdf_pdf, bool prev_bsdf_delta) {
+        const auto &emitters = scene.environment_emitters();
+        if (emitters.empty()) return Color3f(0.f);
+        SurfaceInteraction miss; // t = Infinity, identity shading frame
+        miss.wi = -ray.d;
+        DirectionSample ds;
+        ds.d = ray.d;
+        ds.dist = Infinity;
+        ds.p = prev.p + ray.d;
+        ds.n = -ray.d;
+        Color3f result(0.f);
+        for (const auto &emitter : emitters) {
+            Color3f L = emitter->eval(miss);
+            if (L.is_black()) continue;
+            float w = 1.f;
+            if (!prev_bsdf_delta) {
+                ds.emitter = emitter.get();
+                w = mis_weight(prev_bsdf_pdf, scene.pdf_emitter_direction(prev, ds));
+            }
+            result += L * w;
+        }
+        return result;
+    }
+
+    uint32_t m_max_depth;
+    uint32_t m_rr_depth;
+    bool m_hide_emitters;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::PathIntegrator, Integrator, "path",
+                    "Path tracer with next event estimation and multiple importance sampling", DOC)
