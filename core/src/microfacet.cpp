@@ -1,0 +1,181 @@
+#include <facet/logger.h>
+#include <facet/microfacet.h>
+#include <facet/properties.h>
+
+#include <fmt/format.h>
+
+namespace facet {
+
+const char *microfacet_type_name(MicrofacetType type) {
+    return type == MicrofacetType::Beckmann ? "beckmann" : "ggx";
+}
+
+MicrofacetDistribution::MicrofacetDistribution(const Properties &props, float default_alpha)
+    : MicrofacetDistribution(MicrofacetType::Beckmann, default_alpha) {
+    MicrofacetParameters params = read_microfacet(props, default_alpha, false);
+    *this = MicrofacetDistribution(params.type(), params.alpha_u()->mean().mean(),
+                                   params.alpha_v()->mean().mean(), params.sample_visible());
+}
+
+std::pair<Vector3f, float> MicrofacetDistribution::sample(const Vector3f &wi, const Point2f &u) const {
+    return m_sample_visible ? sample_visible_normals(wi, u) : sample_all(u);
+}
+
+std::pair<Vector3f, float> MicrofacetDistribution::sample_all(const Point2f &u) const {
+    // Azimuth: uniform when isotropic; otherwise inverted from the marginal of D·cos θ, which
+    // gives tan φ = (αv/αu)·tan(2π u.y), with the quadrant taken from u.y.
+    float phi, alpha_2;
+    if (m_alpha_u == m_alpha_v) {
+        phi = 2.f * Pi * u.y;
+        alpha_2 = m_alpha_u * m_alpha_u;
+    } else {
+        phi = std::atan(m_alpha_v / m_alpha_u * std::tan(2.f * Pi * u.y));
+        if (std::abs(u.y - 0.5f) < 0.25f) phi += Pi;
+        float c = std::cos(phi), s = std::sin(phi);
+        alpha_2 = 1.f / (sqr(c / m_alpha_u) + sqr(s / m_alpha_v));
+    }
+    float cos_phi = std::cos(phi), sin_phi = std::sin(phi);
+
+    // Elevation: inverse of the radial CDF of D·cos θ for the effective α of this azimuth.
+    float tan_theta_2 = m_type == MicrofacetType::Beckmann
+                            ? -alpha_2 * std::log1p(-u.x)
+                            : alpha_2 * u.x / (1.f - u.x);
+    float cos_theta = 1.f / std::sqrt(1.f + tan_theta_2);
+    float sin_theta = safe_sqrt(1.f - cos_theta * cos_theta);
+
+    Vector3f m(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
+    // The density is recomputed from m, so sample() and pdf() agree to the last bit.
+    float pdf = eval(m) * cos_theta;
+    if (!std::isfinite(pdf)) pdf = 0.f;
+    return {m, pdf};
+}
+
+std::pair<Vector3f, float> MicrofacetDistribution::sample_visible_normals(const Vector3f &wi,
+                                                                          const Point2f &u) const {
+    if (Frame::cos_theta(wi) <= 0.f) return {Vector3f(0.f, 0.f, 1.f), 0.f};
+    // 1. Stretch wi into the configuration of an α = 1 distribution.
+    Vector3f wi_s = normalize(Vector3f(m_alpha_u * wi.x, m_alpha_v * wi.y, wi.z));
+    // 2. Sample a visible slope of the α = 1 distribution for the azimuth φ = 0.
+    Point2f slope = sample_visible_11(Frame::cos_theta(wi_s), u);
+    // 3. Rotate to the azimuth of wi and unstretch.
+    float cos_phi = Frame::cos_phi(wi_s), sin_phi = Frame::sin_phi(wi_s);
+    slope = Point2f(cos_phi * slope.x - sin_phi * slope.y, sin_phi * slope.x + cos_phi * slope.y);
+    slope.x *= m_alpha_u;
+    slope.y *= m_alpha_v;
+    // 4. The normal of the slope.
+    Vector3f m = normalize(Vector3f(-slope.x, -slope.y, 1.f));
+    if (!is_finite(m)) return {Vector3f(0.f, 0.f, 1.f), 0.f};
+    return {m, pdf(wi, m)};
+}
+
+Point2f MicrofacetDistribution::sample_visible_11(float cos_theta_i, const Point2f &u_in) const {
+    if (m_type == MicrofacetType::GGX) {
+        // Heitz 2018: a uniform point on the projected hemisphere of visible normals, which is a
+        // half disk plus a half ellipse; warp y to the ellipse's half.
+        Point2f p = warp::square_to_uniform_disk_concentric(u_in);
+        float s = 0.5f * (1.f + cos_theta_i);
+        p.y = lerp(s, safe_sqrt(1.f - p.x * p.x), p.y);
+        float x = p.x, y = p.y, z = safe_sqrt(1.f - x * x - y * y);
+        float sin_theta_i = safe_sqrt(1.f - cos_theta_i * cos_theta_i);
+        // The normal (s·z − c·y, x, s·y + c·z) in the frame of wi, as a slope.
+        float inv_nz = 1.f / (sin_theta_i * y + cos_theta_i * z);
+        return Point2f((cos_theta_i * y - sin_theta_i * z) * inv_nz, x * inv_nz);
+    }
+
+    // Beckmann (Heitz & d'Eon 2014, Jakob 2014). The visible slopes of the α = 1 distribution
+    // seen at elevation θ have density ∝ exp(−x̃² − ỹ²)·(cos θ − x̃ sin θ) for x̃ < cot θ: ỹ is a
+    // plain Gaussian, x̃ is found by inverting its CDF numerically. In the variable X = erf(x̃) the
+    // CDF is, up to normalisation, C(X) = 1 + X + tanθ/√π·exp(−x̃²), with C'(X) = 1 − x̃·tanθ.
+    const float InvSqrtPi = 0.56418958354775628f;
+    Point2f u(clamp(u_in.x, 1e-6f, 1.f - 1e-6f), clamp(u_in.y, 1e-6f, 1.f - 1e-6f));
+    float sin_theta_i = safe_sqrt(1.f - cos_theta_i * cos_theta_i);
+    float tan_theta_i = sin_theta_i / cos_theta_i;
+    if (!(tan_theta_i > 1e-4f)) // near normal incidence every normal is visible alike
+        return Point2f(erfinv(2.f * u.x - 1.f), erfinv(2.f * u.y - 1.f));
+
+    float cot_theta_i = cos_theta_i / sin_theta_i;
+    float x_max = std::min(std::erf(cot_theta_i), 1.f - 1e-6f); // C is defined on [−1, x_max]
+    float target = u.x * (1.f + x_max + InvSqrtPi * tan_theta_i * std::exp(-sqr(cot_theta_i)));
+
+    // Initial guess: the exact inverse for θ = π/2 (C ∝ exp(−x̃²)), mapped onto [−1, x_max].
+    float X = x_max - (1.f + x_max) * std::erf(std::sqrt(-std::log(u.x)));
+    for (int i = 0; i < 3; ++i) { // Newton steps
+        float slope = erfinv(X);
+        float value = 1.f + X + InvSqrtPi * tan_theta_i * std::exp(-slope * slope) - target;
+        float derivative = 1.f - slope * tan_theta_i;
+        X = clamp(X - value / derivative, -1.f + 1e-6f, x_max);
+    }
+    return Point2f(erfinv(X), erfinv(2.f * u.y - 1.f));
+}
+
+std::string MicrofacetDistribution::to_string() const {
+    return fmt::format("MicrofacetDistribution[type = {}, alpha_u = {}, alpha_v = {}, "
+                       "sample_visible = {}]",
+                       microfacet_type_name(m_type), m_alpha_u, m_alpha_v, m_sample_visible);
+}
+
+MicrofacetParameters::MicrofacetParameters(MicrofacetType type, std::shared_ptr<Texture> alpha_u,
+                                           std::shared_ptr<Texture> alpha_v, bool sample_visible)
+    : m_type(type), m_alpha_u(std::move(alpha_u)), m_alpha_v(std::move(alpha_v)),
+      m_sample_visible(sample_visible) {
+    m_constant = !m_alpha_u->is_spatially_varying() && !m_alpha_v->is_spatially_varying();
+    if (m_constant) {
+        m_const_u = m_alpha_u->mean().mean();
+        m_const_v = m_alpha_v->mean().mean();
+    }
+    m_anisotropic = m_alpha_u != m_alpha_v && !(m_constant && m_const_u == m_const_v);
+}
+
+std::string MicrofacetParameters::to_string() const {
+    return fmt::format("distribution = {}, alpha_u = {}, alpha_v = {}, sample_visible = {}",
+                       microfacet_type_name(m_type), m_alpha_u->to_string(),
+                       m_alpha_v->to_string(), m_sample_visible);
+}
+
+MicrofacetParameters read_microfacet(const Properties &props, float default_alpha,
+                                     bool allow_textures) {
+    std::string name = props.get_string("distribution", "beckmann");
+    MicrofacetType type;
+    if (name == "beckmann")
+        type = MicrofacetType::Beckmann;
+    else if (name == "ggx")
+        type = MicrofacetType::GGX;
+    else
+        FACET_THROW_AT(props.has("distribution") ? props.location("distribution") : props.location(),
+                       "distribution must be beckmann or ggx, found \"{}\"", name);
+
+    bool has_alpha = props.has("alpha"), has_u = props.has("alpha_u"), has_v = props.has("alpha_v");
+    if (has_alpha && (has_u || has_v))
+        FACET_THROW_AT(props.location(), "give either alpha or both alpha_u and alpha_v, not both");
+    if (has_u != has_v)
+        FACET_THROW_AT(props.location(), "alpha_u and alpha_v must be given together (found only {})",
+                       has_u ? "alpha_u" : "alpha_v");
+
+    auto read = [&](const char *param) {
+        if (!allow_textures && props.has(param) && props.type(param) == Properties::Type::Object)
+            FACET_THROW_AT(props.location(param), "{} must be a number here, not a texture", param);
+        std::shared_ptr<Texture> tex = props.texture(param, default_alpha, SpectrumKind::Unbounded);
+        if (!tex->is_spatially_varying()) {
+            float value = tex->mean().mean();
+            const Location &loc = props.has(param) ? props.location(param) : props.location();
+            if (!(value >= 0.f) || !std::isfinite(value))
+                FACET_THROW_AT(loc, "{} must be a roughness >= 0, found {}", param, value);
+            if (value == 0.f)
+                FACET_LOG(Warn, "{}{} = 0 is clamped to {}; a smooth plugin (conductor, dielectric) "
+                          "renders this case exactly", loc.valid() ? loc.to_string() + ": " : "",
+                          param, MicrofacetDistribution::MinAlpha);
+        }
+        return tex;
+    };
+    std::shared_ptr<Texture> alpha_u, alpha_v;
+    if (has_u) {
+        alpha_u = read("alpha_u");
+        alpha_v = read("alpha_v");
+    } else {
+        alpha_u = alpha_v = read("alpha");
+    }
+    bool sample_visible = props.get_bool("sample_visible", true);
+    return MicrofacetParameters(type, alpha_u, alpha_v, sample_visible);
+}
+
+} // namespace facet
