@@ -99,10 +99,10 @@ SpectrumData parse_spectrum_pairs(const std::string &text) {
     }
     SpectrumData s;
     s.uniform = false;
-    std::stringstream ss(t);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        item = trim(item);
+    for (size_t start = 0; start <= t.size();) {
+        size_t end = std::min(t.find(',', start), t.size());
+        std::string item = trim(t.substr(start, end - start));
+        start = end + 1;
         size_t colon = item.find(':');
         if (item.empty() || colon == std::string::npos || item.find(':', colon + 1) != std::string::npos)
             FACET_THROW("spectrum \"{}\": \"{}\" is not a wavelength:value pair", text, item);

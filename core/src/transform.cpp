@@ -1,3 +1,4 @@
+#include <facet/frame.h>
 #include <facet/transform.h>
 
 #include <fmt/format.h>
@@ -129,15 +130,6 @@ Transform Transform::rotate(const Vector3f &axis, float angle_deg) {
     return Transform(m, m.transpose());
 }
 
-namespace {
-/// Any unit vector perpendicular to the unit vector n (Duff et al. 2017 orthonormal basis).
-Vector3d perpendicular(const Vector3d &n) {
-    double s = n.z >= 0.0 ? 1.0 : -1.0;
-    double a = -1.0 / (s + n.z), b = n.x * n.y * a;
-    return {1.0 + s * n.x * n.x * a, s * b, -s * n.x};
-}
-} // namespace
-
 Transform Transform::look_at(const Point3f &origin, const Point3f &target, const Vector3f &up) {
     Vector3d o(origin), dir = normalize(Vector3d(target) - o);
     Vector3d up_d(up);
@@ -145,7 +137,9 @@ Transform Transform::look_at(const Point3f &origin, const Point3f &target, const
     double len = norm(left);
     if (!(len > 1e-9 * std::max(1.0, norm(up_d)))) {
         // Up missing or parallel to the view direction: pick one perpendicular to dir.
-        up_d = perpendicular(dir);
+        Vector3f s, t;
+        coordinate_system(Vector3f(dir), s, t);
+        up_d = Vector3d(s);
         left = cross(up_d, dir);
         len = norm(left);
     }
