@@ -1,0 +1,127 @@
+// Convergence of every sampler on smooth integrals: the RMS error over many pixels must fall at
+// the rate the sampler promises (N^-1/2 for independent sampling, about N^-1 or better for the
+// stratified and low-discrepancy ones on a smooth 2D integrand).
+#include <facet/plugin.h>
+#include <facet/sampler.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+using namespace facet;
+
+namespace {
+
+std::shared_ptr<Sampler> make_sampler(const std::string &type, int spp) {
+    Properties props(type);
+    props.set_int("sample_count", spp);
+    return PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler, props);
+}
+
+/// Smooth integrand on [0,1]²: x·e^x · (1 + cos(2πy)/2) with integral 1.
+double f2(const Point2f &p) { return p.x * std::exp(p.x) * (1.0 + 0.5 * std::cos(2.0 * M_PI * p.y)); }
+
+/// RMS error of the N-sample estimate over `pixels` independent pixels. `dim` 2D draws are skipped
+/// first, so dimensions other than the first are exercised too.
+double rms_error_2d(const std::string &type, int spp, int pixels, int dim) {
+    auto base = make_sampler(type, spp);
+    auto sampler = base->clone();
+    int n = int(sampler->sample_count());
+    double sum_sq = 0.0;
+    for (int px = 0; px < pixels; ++px) {
+        sampler->seed(uint64_t(px) * 7919u + 13u);
+        double est = 0.0;
+        for (int s = 0; s < n; ++s) {
+            for (int d = 0; d < dim; ++d) sampler->next_2d();
+            est += f2(sampler->next_2d());
+            sampler->advance();
+        }
+        est /= n;
+        sum_sq += (est - 1.0) * (est - 1.0);
+    }
+    return std::sqrt(sum_sq / pixels);
+}
+
+/// Least-squares slope of log(rmse) against log(N).
+double convergence_slope(const std::string &type, int dim) {
+    std::vector<int> counts = {16, 64, 256, 1024};
+    std::vector<double> xs, ys;
+    for (int n : counts) {
+        xs.push_back(std::log(double(n)));
+        ys.push_back(std::log(rms_error_2d(type, n, 256, dim)));
+    }
+    double mx = 0, my = 0;
+    for (size_t i = 0; i < xs.size(); ++i) { mx += xs[i]; my += ys[i]; }
+    mx /= xs.size(); my /= ys.size();
+    double num = 0, den = 0;
+    for (size_t i = 0; i < xs.size(); ++i) { num += (xs[i] - mx) * (ys[i] - my); den += sqr(xs[i] - mx); }
+    return num / den;
+}
+
+} // namespace
+
+TEST(SamplerConvergence, IndependentIsMonteCarloRate) {
+    double slope = convergence_slope("independent", 0);
+    EXPECT_NEAR(slope, -0.5, 0.1);
+}
+
+TEST(SamplerConvergence, StratifiedBeatsMonteCarlo) {
+    EXPECT_LT(convergence_slope("stratified", 0), -0.85);
+    EXPECT_LT(convergence_slope("stratified", 3), -0.85);
+}
+
+TEST(SamplerConvergence, MultijitterBeatsMonteCarlo) {
+    EXPECT_LT(convergence_slope("multijitter", 0), -0.85);
+    EXPECT_LT(convergence_slope("multijitter", 3), -0.85);
+}
+
+TEST(SamplerConvergence, LowDiscrepancyBeatsMonteCarlo) {
+    EXPECT_LT(convergence_slope("ldsampler", 0), -0.85);
+    EXPECT_LT(convergence_slope("ldsampler", 3), -0.85);
+}
+
+TEST(Samplers, DeterministicPerSeedAndInUnitInterval) {
+    for (const char *type : {"independent", "stratified", "multijitter", "ldsampler"}) {
+        auto a = make_sampler(type, 64)->clone(), b = make_sampler(type, 64)->clone();
+        a->seed(42);
+        b->seed(42);
+        bool differs_from_other_pixel = false;
+        auto c = make_sampler(type, 64)->clone();
+        c->seed(43);
+        for (int s = 0; s < 64; ++s) {
+            for (int d = 0; d < 4; ++d) {
+                Point2f pa = a->next_2d(), pb = b->next_2d(), pc = c->next_2d();
+                float fa = a->next_1d(), fb = b->next_1d();
+                c->next_1d();
+                ASSERT_EQ(pa, pb) << type;
+                ASSERT_EQ(fa, fb) << type;
+                for (float v : {pa.x, pa.y, fa}) {
+                    ASSERT_GE(v, 0.f) << type;
+                    ASSERT_LT(v, 1.f) << type;
+                }
+                differs_from_other_pixel |= pa != pc;
+            }
+            a->advance(); b->advance(); c->advance();
+        }
+        EXPECT_TRUE(differs_from_other_pixel) << type;
+    }
+}
+
+TEST(Samplers, StratifiedCoversEveryStratumOnce) {
+    auto s = make_sampler("stratified", 16)->clone();
+    s->seed(7);
+    std::vector<int> hits(16, 0);
+    for (int i = 0; i < 16; ++i) {
+        Point2f p = s->next_2d();
+        hits[size_t(int(p.y * 4) * 4 + int(p.x * 4))]++;
+        s->advance();
+    }
+    for (int h : hits) EXPECT_EQ(h, 1);
+}
+
+TEST(Samplers, SampleCountRounding) {
+    EXPECT_EQ(make_sampler("stratified", 10)->sample_count(), 16u);
+    EXPECT_EQ(make_sampler("ldsampler", 10)->sample_count(), 16u);
+    EXPECT_EQ(make_sampler("multijitter", 10)->sample_count(), 10u);
+}
