@@ -1,0 +1,55 @@
+#pragma once
+
+#include <facet/xml.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+/// Entry points of the `facet` subcommands. Each takes the arguments that follow the subcommand
+/// name (argv[0] is the subcommand itself), returns the process exit code and lets facet::Error
+/// and std::exception escape: main() turns them into one "facet: error: ..." line.
+int render_main(int argc, char **argv);
+int plugins_main(int argc, char **argv);
+int bench_main(int argc, char **argv);
+int compare_main(int argc, char **argv);
+
+/// Implemented in chi2_cmd.cpp and new_plugin_cmd.cpp. Weak, so that `facet` still links (and
+/// says "not available") in a tree without them.
+int chi2_main(int argc, char **argv) __attribute__((weak));
+int new_plugin_main(int argc, char **argv) __attribute__((weak));
+
+namespace facet::cli {
+
+/// Parses with CLI11. Returns -1 when the command should run; otherwise the exit code to return
+/// (0 after --help). Parse errors are thrown as facet::Error, so they print as one line.
+int parse(CLI::App &app, int argc, char **argv);
+
+/// The options `render` and `bench` share: the scene and how to load it.
+struct SceneOptions {
+    std::string scene;
+    std::vector<std::string> defines;     ///< -D key=value
+    std::vector<std::string> plugin_dirs; ///< -a (';' separates several folders in one value)
+    int threads = 0;                      ///< -t; 0 = all cores
+    bool threads_given = false;           ///< -t was on the command line (values < 1 become 1)
+    int sensor = 0;                       ///< -s
+    int verbose = 0;                      ///< number of -v
+    bool quiet = false;                   ///< -q
+    bool lenient = false;                 ///< --lenient
+};
+
+/// Adds -D, -a, -t, -s, -v, -q, --lenient and the scene argument to `app`.
+void add_scene_options(CLI::App &app, SceneOptions &opts);
+
+/// Applies -v/-q to the logger, -a to the plugin registry, fixes the thread count (warning for
+/// -t < 1) and the Embree device, then loads the scene with the -D values.
+std::shared_ptr<Scene> load_scene(SceneOptions &opts);
+
+/// Threads a render will use: `threads`, or every core when it is 0.
+int effective_threads(int threads);
+
+} // namespace facet::cli

@@ -1,0 +1,123 @@
+// The `facet` command: picks the subcommand and turns every error into one line on stderr.
+
+#include "commands.h"
+
+#include <facet/logger.h>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+namespace {
+
+const char *USAGE = R"(facet: a physically based renderer for Mitsuba 3 scenes
+
+Usage:
+  facet render <scene.xml> [options]   render a scene (see `facet render --help`)
+  facet <scene.xml> [options]          the same
+  facet plugins [kind|name]            list the plugins, or print one plugin's parameters
+  facet bench <scene.xml> [options]    path tracer samples/s and rays/s against plain Embree
+  facet compare ours.exr ref_mean.exr ref_var_xyz.exr --spp N
+                                       statistical comparison with a reference render
+  facet chi2 ...                       chi-square test of a BSDF or emitter plugin
+  facet new-plugin ...                 start a plugin of your own from the template
+
+Run `facet <command> --help` for the options of a command.
+)";
+
+struct Command {
+    const char *name;
+    int (*run)(int, char **);
+};
+
+/// One line: a multi-line message (a list of unused properties, say) is joined with "; ".
+std::string one_line(const std::string &msg) {
+    std::string out;
+    bool pending_separator = false;
+    for (size_t i = 0; i < msg.size(); ++i) {
+        char c = msg[i];
+        if (c == '\n' || c == '\r') {
+            pending_separator = !out.empty();
+            continue;
+        }
+        if (pending_separator) {
+            if (c == ' ' || c == '\t') continue;
+            out += "; ";
+            pending_separator = false;
+        }
+        out += c;
+    }
+    return out;
+}
+
+int run(int argc, char **argv) {
+    if (argc < 2) {
+        std::fputs(USAGE, stderr);
+        return 2;
+    }
+    std::string first = argv[1];
+    if (first == "-h" || first == "--help" || first == "help") {
+        std::fputs(USAGE, stdout);
+        return 0;
+    }
+
+    const Command commands[] = {
+        {"render", render_main},   {"plugins", plugins_main},       {"bench", bench_main},
+        {"compare", compare_main}, {"chi2", chi2_main},             {"new-plugin", new_plugin_main},
+    };
+    for (const Command &cmd : commands) {
+        if (first != cmd.name) continue;
+        if (!cmd.run)
+            throw facet::Error(fmt::format("the '{}' command is not available in this build", first));
+        return cmd.run(argc - 1, argv + 1);
+    }
+
+    // `facet scene.xml ...` and `facet -D spp=4 scene.xml` are short for `facet render ...`.
+    bool looks_like_scene = first.size() > 4 && first.compare(first.size() - 4, 4, ".xml") == 0;
+    if (looks_like_scene || first[0] == '-') {
+        argv[0] = const_cast<char *>("render");
+        return render_main(argc, argv);
+    }
+    throw facet::Error(fmt::format("unknown command '{}' (expected render, plugins, bench, "
+                                   "compare, chi2, new-plugin or a scene file; see facet --help)",
+                                   first));
+}
+
+} // namespace
+
+namespace facet::cli {
+
+int parse(CLI::App &app, int argc, char **argv) {
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp &) {
+        std::fputs(app.help().c_str(), stdout);
+        return 0;
+    } catch (const CLI::CallForAllHelp &) {
+        std::fputs(app.help("", CLI::AppFormatMode::All).c_str(), stdout);
+        return 0;
+    } catch (const CLI::ParseError &e) {
+        throw facet::Error(fmt::format("{} (see {} --help)", e.what(), app.get_name()));
+    }
+    return -1;
+}
+
+} // namespace facet::cli
+
+int main(int argc, char **argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception &e) {
+        // facet::Error derives from std::exception; its what() carries the scene location.
+        std::fflush(stdout);
+        std::fprintf(stderr, "facet: error: %s\n", one_line(e.what()).c_str());
+        return 1;
+    } catch (...) {
+        std::fprintf(stderr, "facet: error: unknown exception\n");
+        return 1;
+    }
+}
