@@ -1,0 +1,226 @@
+#pragma once
+
+#include <facet/bsdf.h>
+#include <facet/color.h>
+#include <facet/emitter.h>
+#include <facet/vector.h>
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+/**
+ * Chi-square goodness-of-fit test of a sampling routine over the sphere of directions.
+ *
+ * The domain is parameterised by (φ, cos θ) ∈ [-π, π] × [-1, 1]; this map preserves area
+ * (dω = dφ dcos θ), so the expected count of a cell is N times the pdf integrated over the cell in
+ * these coordinates, with no Jacobian. `res` cells split cos θ and 2·res cells split φ.
+ *
+ * One run draws N samples (sample i uses a PCG32 seeded from tea_hash(i, seed), so any failure
+ * reproduces), bins the directions, integrates the pdf over every cell (a fixed composite Simpson
+ * rule on ires × ires points, or adaptive Simpson), pools cells expecting fewer than
+ * `min_expected` samples, and compares Pearson's statistic with the chi-square distribution.
+ * The significance level is Šidák-corrected for the number of tests run together.
+ *
+ * Outright failures, whatever the statistic says: a sample in a cell whose expected count is
+ * zero, a non-finite or negative pdf, a non-finite weight, a sampled direction that is not a unit
+ * vector. On the same samples the test also checks that each smooth sample's weight equals
+ * eval/pdf and that its reported pdf equals pdf() (relative 1e-3), that the pdf integrates to at
+ * most one and to the fraction of samples that produced a smooth direction, and (for BSDFs) that
+ * the mean weight does not exceed one beyond its statistical noise.
+ */
+namespace facet {
+
+/// One draw of the routine under test, as the test sees it.
+struct Chi2Sample {
+    enum class Kind {
+        Failed, ///< no direction (zero weight)
+        Smooth, ///< a direction with a density: goes into the histogram
+        Delta,  ///< a direction of a delta lobe: only its weight is checked
+    };
+    Kind kind = Kind::Failed;
+    Vector3f d;                ///< sampled unit direction
+    bool has_weight = false;   ///< `weight` is meaningful (checked for finiteness, summed)
+    bool has_value = false;    ///< `value` is meaningful: check weight == value / pdf
+    Color3f weight;            ///< what the routine returned
+    /// Factor that turns `weight` into the fraction of energy carried (η² for radiance-mode
+    /// refraction, whose weight carries the 1/η² radiance scaling).
+    float energy_scale = 1.f;
+    Color3f value;             ///< eval(d), for the weight == value / pdf check (Smooth)
+    float sampled_pdf = std::numeric_limits<float>::quiet_NaN(); ///< density the routine reported
+    float pdf = std::numeric_limits<float>::quiet_NaN();         ///< pdf(d) from the pdf function
+    /// Set by an adapter that found its routine inconsistent (e.g. eval_pdf != (eval, pdf)).
+    std::string problem;
+};
+
+/// What the test drives: a sampler of directions and the density of what it samples.
+class Chi2Adapter {
+public:
+    virtual ~Chi2Adapter() = default;
+    /// Uniform numbers one sample consumes (at most 8).
+    virtual int sample_dim() const = 0;
+    /// Draws one sample from the uniform numbers u[0 .. sample_dim()).
+    virtual Chi2Sample sample(const float *u) const = 0;
+    /// Solid-angle density of sample() at the unit direction d (zero for delta lobes).
+    virtual double pdf(const Vector3f &d) const = 0;
+    /// True when the mean of the weights may not exceed one (BSDFs: energy conservation).
+    virtual bool bounded_weights() const { return false; }
+    virtual std::string to_string() const = 0;
+};
+
+struct Chi2Options {
+    int res = 32;                  ///< cos θ cells (made even); φ gets 2·res cells
+    uint64_t samples = 1000000;    ///< N
+    uint32_t seed = 0;
+    bool adaptive = false;         ///< adaptive Simpson instead of the fixed rule
+    int ires = 7;                  ///< points per axis and cell of the fixed rule (made odd)
+    double tolerance = 1e-5;       ///< relative tolerance of the adaptive rule
+    int max_depth = 8;             ///< bisections per axis of the adaptive rule
+    double min_expected = 5.0;     ///< cells expecting less are pooled
+    double significance = 0.01;    ///< before the Šidák correction
+    uint32_t test_count = 1;       ///< number of tests of the family (Šidák)
+    double weight_tolerance = 1e-3; ///< relative, weight vs eval/pdf and sampled vs pdf()
+};
+
+struct Chi2Result {
+    bool passed = false;
+    double statistic = 0.0;
+    int dof = 0;
+    double p_value = 0.0;
+    double significance = 0.0;     ///< after the Šidák correction
+    /// Why the test failed (empty when it passed) and notes worth reading either way.
+    std::vector<std::string> failures, notes;
+
+    int phi_res = 0, cos_res = 0;
+    /// Counts per cell, row-major: index = cos_bin · phi_res + phi_bin, cos θ = -1 in row 0.
+    std::vector<double> observed, expected;
+
+    uint64_t samples = 0, smooth = 0, delta = 0, failed = 0;
+    double pdf_integral = 0.0;     ///< ∫ pdf over the sphere
+    Color3f mean_weight;           ///< energy-scaled, over all samples (failures count as 0)
+    Color3f weight_stddev;
+    uint64_t weight_mismatches = 0, pdf_mismatches = 0;
+    std::string description;       ///< the adapter's to_string()
+
+    /// Several lines: what was tested, the statistic, dof, p-value and the verdict.
+    std::string summary() const;
+};
+
+/// Runs the whole test.
+Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts = {});
+
+/// Writes observed | expected | difference side by side as a PNG (difference = (o - e)/√e, red
+/// above and blue below expectation; cells with samples but zero expectation are green).
+void write_chi2_heatmap(const std::string &path, const Chi2Result &result);
+/// Writes the observed and expected tables as text (one line per cell).
+void write_chi2_tables(const std::string &path, const Chi2Result &result);
+
+// -- The statistics, exposed for tests ------------------------------------------------------------
+
+/// Regularised lower incomplete gamma function P(a, x) (series or continued fraction).
+double regularized_gamma_p(double a, double x);
+/// Q(a, x) = 1 - P(a, x), computed without cancellation.
+double regularized_gamma_q(double a, double x);
+/// P(X ≥ x) for X chi-square distributed with `dof` degrees of freedom.
+double chi2_survival(double x, double dof);
+/// Per-test level that keeps the family-wise level at `alpha` over `test_count` tests.
+double sidak_correction(double alpha, uint32_t test_count);
+
+struct PearsonResult {
+    double statistic = 0.0;
+    int dof = 0;                ///< number of terms - 1
+    int pooled_cells = 0;       ///< cells that went into pools
+    bool zero_expected_hit = false; ///< a cell expecting nothing received samples
+    size_t zero_expected_cell = 0;
+};
+/// Pearson's statistic after sorting cells by expected count and pooling those expecting less
+/// than `min_expected`: a pool becomes one term once it reaches min_expected, and a last pool that
+/// never does joins the smallest cell above the threshold (or is a term of its own when there is
+/// none). Cells expecting zero are skipped; samples in them set `zero_expected_hit`.
+PearsonResult pearson_chi2(const std::vector<double> &observed, const std::vector<double> &expected,
+                           double min_expected = 5.0);
+
+// -- Adapters -------------------------------------------------------------------------------------
+
+/// XML text of one object: `<kind version="3.0.0" type="plugin"> entries children </kind>`.
+/// Each entry is `key=value` with the type inferred (a number: float, true/false: boolean,
+/// "r,g,b": rgb, anything else: string) or `type:key=value` with the tag given
+/// (float, integer, boolean, string, rgb, spectrum, vector, point).
+std::string chi2_object_xml(ObjectType kind, const std::string &plugin,
+                            const std::vector<std::string> &entries,
+                            const std::string &children = "", bool with_version = true);
+
+/// A BSDF seen from the incident direction wi (local frame), in context ctx.
+class BSDFAdapter : public Chi2Adapter {
+public:
+    BSDFAdapter(std::shared_ptr<BSDF> bsdf, const Vector3f &wi, const BSDFContext &ctx = {});
+    /// Creates the plugin from properties through the registry.
+    BSDFAdapter(const Properties &props, const Vector3f &wi, const BSDFContext &ctx = {});
+    /// Loads `<bsdf version="3.0.0" type="...">...</bsdf>` with load_string.
+    BSDFAdapter(const std::string &xml, const Vector3f &wi, const BSDFContext &ctx = {});
+
+    int sample_dim() const override { return 3; }
+    Chi2Sample sample(const float *u) const override;
+    double pdf(const Vector3f &d) const override;
+    bool bounded_weights() const override { return true; }
+    std::string to_string() const override;
+    const BSDF &bsdf() const { return *m_bsdf; }
+
+private:
+    void init();
+    std::shared_ptr<BSDF> m_bsdf;
+    BSDFContext m_ctx;
+    SurfaceInteraction m_si;
+};
+
+/// An emitter's direction sampling seen from a reference point. The emitter lives in a small
+/// scene (so infinite emitters know the scene bounds and area emitters have their shape);
+/// pdf() of a direction traces a ray in that scene to find the point it reaches.
+class EmitterAdapter : public Chi2Adapter {
+public:
+    /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it.
+    EmitterAdapter(const std::string &scene_xml, const Point3f &ref, size_t index = 0);
+    EmitterAdapter(std::shared_ptr<Scene> scene, std::shared_ptr<Emitter> emitter, const Point3f &ref);
+    ~EmitterAdapter() override;
+
+    /// The scene for plugin `plugin` with `entries` (see chi2_object_xml): an `area` emitter is
+    /// put on a shape of type `shape` (a 2×2 rectangle at z = 0 facing +z by default).
+    static std::string scene_xml(const std::string &plugin, const std::vector<std::string> &entries,
+                                 const std::string &shape = "rectangle");
+
+    int sample_dim() const override { return 2; }
+    Chi2Sample sample(const float *u) const override;
+    double pdf(const Vector3f &d) const override;
+    std::string to_string() const override;
+
+private:
+    void init();
+    std::shared_ptr<Scene> m_scene;
+    std::shared_ptr<Emitter> m_emitter;
+    Interaction m_ref;
+};
+
+/// A microfacet distribution's normal sampling (facet/microfacet.h) for incident direction wi.
+class MicrofacetAdapter : public Chi2Adapter {
+public:
+    /// `type` is "beckmann" or "ggx".
+    MicrofacetAdapter(const std::string &type, float alpha_u, float alpha_v, bool sample_visible,
+                      const Vector3f &wi);
+    ~MicrofacetAdapter() override;
+
+    int sample_dim() const override { return 2; }
+    Chi2Sample sample(const float *u) const override;
+    double pdf(const Vector3f &d) const override;
+    std::string to_string() const override;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+/// Direction at polar angle θ and azimuth φ (degrees) in the local frame.
+Vector3f direction_from_angles(float theta_deg, float phi_deg);
+
+} // namespace facet
