@@ -1,0 +1,87 @@
+static const char *DOC = R"DOC(
+# thinlens: perspective camera with a thin lens (depth of field)
+
+A perspective camera whose rays start on a circular aperture of radius `aperture_radius` and
+converge on the plane at `focus_distance`: objects on that plane are sharp, others blur. The
+frame and field of view are those of `perspective` (looks down local +Z, +X is left).
+
+| Parameter       | Type      | Default            | Description                                               |
+|-----------------|-----------|--------------------|-----------------------------------------------------------|
+| to_world        | transform | identity           | Camera-to-world transform (usually a `<lookat>`)          |
+| aperture_radius | float     | —                  | Radius of the lens aperture in scene units (required, ≥ 0)|
+| focus_distance  | float     | —                  | Distance of the plane in focus (required, > 0)            |
+| fov             | float     | (from focal_length)| Field of view in degrees along `fov_axis`                 |
+| fov_axis        | string    | x                  | x, y, diagonal, smaller or larger                         |
+| focal_length    | string    | 50mm               | 35 mm equivalent focal length; not with `fov`             |
+| near_clip       | float     | 0.01               | Near clipping distance                                    |
+| far_clip        | float     | 10000              | Far clipping distance                                     |
+| (film)          | film      | hdrfilm            | Nested film                                               |
+| (sampler)       | sampler   | independent        | Nested sampler                                            |
+
+```xml
+<sensor type="thinlens">
+    <float name="aperture_radius" value="0.1"/>
+    <float name="focus_distance" value="5"/>
+    <float name="fov" value="40"/>
+</sensor>
+```
+)DOC";
+
+#include <facet/fov.h>
+#include <facet/plugin.h>
+#include <facet/sensor.h>
+#include <facet/warp.h>
+
+namespace facet {
+
+class ThinLensCamera final : public Sensor {
+public:
+    explicit ThinLensCamera(const Properties &props) : Sensor(props) {
+        const Point2i size = m_film->size();
+        const double aspect = double(size.x) / double(size.y);
+        double x_fov = perspective_x_fov(props, aspect);
+        m_tan_x = float(std::tan(0.5 * x_fov * (Pi / 180.0)));
+        m_tan_y = float(double(m_tan_x) / aspect);
+        m_aperture_radius = float(props.get_float("aperture_radius"));
+        m_focus_distance = float(props.get_float("focus_distance"));
+        m_near_clip = float(props.get_float("near_clip", 1e-2));
+        m_far_clip = float(props.get_float("far_clip", 1e4));
+        if (!(m_aperture_radius >= 0.f))
+            FACET_THROW_AT(props.location("aperture_radius"), "aperture_radius must be >= 0, got {}", m_aperture_radius);
+        if (!(m_focus_distance > 0.f))
+            FACET_THROW_AT(props.location("focus_distance"), "focus_distance must be positive, got {}", m_focus_distance);
+        if (!(m_near_clip > 0.f) || !(m_far_clip > m_near_clip))
+            FACET_THROW_AT(props.location(), "the clipping planes must satisfy 0 < near_clip < far_clip");
+    }
+
+    bool needs_aperture_sample() const override { return true; }
+
+    std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
+                                       const Point2f &aperture_sample) const override {
+        // Point on the plane in focus that the pinhole ray through film_pos would reach.
+        Vector3f pinhole((1.f - 2.f * film_pos.x) * m_tan_x, (1.f - 2.f * film_pos.y) * m_tan_y, 1.f);
+        Point3f focus = pinhole * m_focus_distance;
+        Point2f lens = warp::square_to_uniform_disk_concentric(aperture_sample) * m_aperture_radius;
+        Point3f origin(lens.x, lens.y, 0.f);
+        Vector3f d = normalize(focus - origin);
+        float inv_z = 1.f / d.z;
+        Ray ray(m_to_world.apply_point(origin), normalize(m_to_world.apply_vector(d)), m_near_clip * inv_z,
+                m_far_clip * inv_z);
+        ray.time = time;
+        return {ray, Color3f(1.f)};
+    }
+
+    std::string to_string() const override {
+        return fmt::format("ThinLensCamera[aperture_radius={}, focus_distance={}, film={}, sampler={}]",
+                           m_aperture_radius, m_focus_distance, m_film->to_string(), m_sampler->to_string());
+    }
+
+private:
+    float m_tan_x = 1.f, m_tan_y = 1.f;
+    float m_aperture_radius = 0.f, m_focus_distance = 1.f;
+    float m_near_clip = 1e-2f, m_far_clip = 1e4f;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::ThinLensCamera, Sensor, "thinlens", "Perspective camera with a thin lens (depth of field)", DOC)
