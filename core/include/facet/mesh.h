@@ -41,6 +41,10 @@ protected:
     /// `to_world` (normals by its inverse transpose), drops vertex normals when `face_normals`,
     /// flips normals when `flip_normals`, and builds the area table for sampling.
     void initialize(const Transform &to_world, bool face_normals, bool flip_normals);
+    /// Smooth vertex normals from the faces around each vertex (angle-weighted), for loaders
+    /// whose file has none and `face_normals` is off (Mitsuba does the same). Call it after
+    /// initialize() so the weights are those of the world-space triangles.
+    void recompute_vertex_normals();
 
     std::string m_name; ///< file name or plugin name, for messages
     std::vector<float> m_positions; ///< 3 per vertex (+1 padding float for Embree after initialize)

@@ -1,0 +1,244 @@
+#include <facet/bsdf.h>
+#include <facet/emitter.h>
+#include <facet/logger.h>
+#include <facet/mesh.h>
+#include <facet/warp.h>
+
+#include <algorithm>
+
+namespace facet {
+
+Mesh::Mesh(const Properties &props) : Shape(props) {
+    m_name = props.id().empty() ? props.plugin_name() : props.id();
+}
+
+void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_normals) {
+    m_flip_normals = flip_normals;
+    if (m_positions.size() % 3 != 0)
+        FACET_THROW("{}: position array of {} floats is not a list of 3D points", m_name,
+                    m_positions.size());
+    size_t nv = m_positions.size() / 3;
+    if (m_faces.empty())
+        FACET_THROW("{}: the mesh has no triangles", m_name);
+    if (m_faces.size() % 3 != 0)
+        FACET_THROW("{}: index array of {} entries is not a list of triangles", m_name,
+                    m_faces.size());
+    if (nv >= size_t(std::numeric_limits<uint32_t>::max()))
+        FACET_THROW("{}: too many vertices ({})", m_name, nv);
+    if (!m_normals.empty() && m_normals.size() != 3 * nv)
+        FACET_THROW("{}: {} normal floats for {} vertices", m_name, m_normals.size(), nv);
+    if (!m_uvs.empty() && m_uvs.size() != 2 * nv)
+        FACET_THROW("{}: {} texture coordinate floats for {} vertices", m_name, m_uvs.size(), nv);
+    if (!m_colors.empty() && m_colors.size() != 3 * nv)
+        FACET_THROW("{}: {} colour floats for {} vertices", m_name, m_colors.size(), nv);
+    for (size_t i = 0; i < m_faces.size(); ++i)
+        if (m_faces[i] >= nv)
+            FACET_THROW("{}: triangle {} uses vertex {}, but the mesh has only {} vertices",
+                        m_name, i / 3, m_faces[i], nv);
+    for (size_t i = 0; i < nv; ++i)
+        if (!is_finite(vertex_position(i)))
+            FACET_THROW("{}: vertex {} has a non-finite position", m_name, i);
+
+    if (!to_world.is_identity()) {
+        for (size_t i = 0; i < nv; ++i) {
+            Point3f p = to_world.apply_point(vertex_position(i));
+            m_positions[3 * i] = p.x;
+            m_positions[3 * i + 1] = p.y;
+            m_positions[3 * i + 2] = p.z;
+        }
+    }
+    if (face_normals) {
+        m_normals.clear();
+        m_normals.shrink_to_fit();
+    }
+    for (size_t i = 0; i < m_normals.size(); i += 3) {
+        Normal3f n(m_normals[i], m_normals[i + 1], m_normals[i + 2]);
+        if (!to_world.is_identity())
+            n = to_world.apply_normal(n);
+        float len = norm(n);
+        // A zero or broken normal stays zero: shading then falls back to the face normal.
+        n = (len > 0.f && std::isfinite(len)) ? n / len : Normal3f(0.f);
+        m_normals[i] = n.x;
+        m_normals[i + 1] = n.y;
+        m_normals[i + 2] = n.z;
+    }
+
+    m_bbox = BoundingBox3f();
+    for (size_t i = 0; i < nv; ++i)
+        m_bbox.expand(vertex_position(i));
+
+    size_t nf = face_count();
+    m_area_cdf.resize(nf);
+    double total = 0.0;
+    for (size_t f = 0; f < nf; ++f) {
+        Point3f p0 = vertex_position(m_faces[3 * f]), p1 = vertex_position(m_faces[3 * f + 1]),
+                p2 = vertex_position(m_faces[3 * f + 2]);
+        total += 0.5 * double(norm(cross(p1 - p0, p2 - p0)));
+        m_area_cdf[f] = float(total);
+    }
+    m_area = float(total);
+    if (total > 0.0) {
+        for (float &c : m_area_cdf)
+            c = float(double(c) / total);
+        m_area_cdf.back() = 1.f;
+    } else {
+        FACET_LOG(Warn, "{}: all {} triangles are degenerate (zero area)", m_name, nf);
+    }
+
+    // Embree reads vertices with 16-byte loads: keep one float of padding after the last one.
+    m_positions.push_back(0.f);
+}
+
+void Mesh::recompute_vertex_normals() {
+    size_t nv = vertex_count();
+    m_normals.assign(3 * nv, 0.f);
+    std::vector<Vector3d> acc(nv, Vector3d(0.0));
+    for (size_t f = 0; f < face_count(); ++f) {
+        uint32_t idx[3] = {m_faces[3 * f], m_faces[3 * f + 1], m_faces[3 * f + 2]};
+        Vector3d p[3];
+        for (int k = 0; k < 3; ++k)
+            p[k] = Vector3d(vertex_position(idx[k]));
+        Vector3d n = cross(p[1] - p[0], p[2] - p[0]);
+        double len = norm(n);
+        if (!(len > 0.0))
+            continue;
+        n /= len;
+        // Each face contributes its normal weighted by its angle at the vertex
+        // (Thürmer and Wüthrich 1998), which makes the result independent of the tessellation.
+        for (int k = 0; k < 3; ++k) {
+            Vector3d e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
+            double l1 = norm(e1), l2 = norm(e2);
+            if (!(l1 > 0.0 && l2 > 0.0))
+                continue;
+            double angle = std::acos(clamp(dot(e1, e2) / (l1 * l2), -1.0, 1.0));
+            acc[idx[k]] += n * angle;
+        }
+    }
+    for (size_t i = 0; i < nv; ++i) {
+        double len = norm(acc[i]);
+        if (len > 0.0) {
+            Vector3d n = acc[i] / len;
+            m_normals[3 * i] = float(n.x);
+            m_normals[3 * i + 1] = float(n.y);
+            m_normals[3 * i + 2] = float(n.z);
+        }
+    }
+}
+
+RTCGeometry Mesh::embree_geometry(RTCDevice device) const {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m_positions.data(),
+                               0, 3 * sizeof(float), vertex_count());
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m_faces.data(), 0,
+                               3 * sizeof(uint32_t), face_count());
+    rtcCommitGeometry(geom);
+    return geom;
+}
+
+void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
+                                       const Point2f &uv, SurfaceInteraction &si) const {
+    const uint32_t i0 = m_faces[3 * prim_index], i1 = m_faces[3 * prim_index + 1],
+                   i2 = m_faces[3 * prim_index + 2];
+    const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
+    // Embree's (u, v) weight vertices 1 and 2.
+    const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
+
+    si.t = t;
+    si.shape = this;
+    si.prim_index = prim_index;
+    // Interpolating the vertices is more accurate than ray(t) far from the ray origin.
+    si.p = p0 * b0 + p1 * b1 + p2 * b2;
+
+    const Vector3f dp0 = p1 - p0, dp1 = p2 - p0;
+    Normal3f n = cross(dp0, dp1);
+    float n_len = norm(n);
+    n = n_len > 0.f ? n / n_len : -ray.d;
+    if (m_flip_normals)
+        n = -n;
+    si.n = n;
+
+    bool have_dp = false;
+    if (has_uvs()) {
+        const Point2f uv0(m_uvs[2 * i0], m_uvs[2 * i0 + 1]), uv1(m_uvs[2 * i1], m_uvs[2 * i1 + 1]),
+            uv2(m_uvs[2 * i2], m_uvs[2 * i2 + 1]);
+        si.uv = uv0 * b0 + uv1 * b1 + uv2 * b2;
+        const Vector2f duv0 = uv1 - uv0, duv1 = uv2 - uv0;
+        float det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if (det != 0.f) {
+            float inv = 1.f / det;
+            si.dp_du = (dp0 * duv1.y - dp1 * duv0.y) * inv;
+            si.dp_dv = (dp1 * duv0.x - dp0 * duv1.x) * inv;
+            have_dp = is_finite(si.dp_du) && is_finite(si.dp_dv);
+        }
+        if (!have_dp)
+            coordinate_system(n, si.dp_du, si.dp_dv);
+    } else {
+        // Without texture coordinates the barycentrics serve as (u, v).
+        si.uv = Point2f(b1, b2);
+        si.dp_du = dp0;
+        si.dp_dv = dp1;
+    }
+
+    Normal3f ns = n;
+    if (has_vertex_normals()) {
+        auto vn = [&](uint32_t i) {
+            return Normal3f(m_normals[3 * i], m_normals[3 * i + 1], m_normals[3 * i + 2]);
+        };
+        Normal3f interp = vn(i0) * b0 + vn(i1) * b1 + vn(i2) * b2;
+        float len = norm(interp);
+        if (len > 0.f && std::isfinite(len))
+            ns = m_flip_normals ? -interp / len : interp / len;
+    }
+
+    // Shading frame: the shading normal and dp_du made orthogonal to it (Gram-Schmidt).
+    Vector3f s = si.dp_du - ns * dot(ns, si.dp_du);
+    float s_len = norm(s);
+    if (s_len > 1e-6f * norm(si.dp_du) && std::isfinite(s_len)) {
+        s /= s_len;
+        si.sh_frame = Frame(s, cross(ns, s), ns);
+    } else {
+        si.sh_frame = Frame(ns);
+    }
+    si.wi = si.to_local(-ray.d);
+}
+
+PositionSample Mesh::sample_position(const Point2f &u_) const {
+    PositionSample ps;
+    if (m_area_cdf.empty() || !(m_area > 0.f))
+        return ps;
+    Point2f u = u_;
+    // Pick a triangle in proportion to its area and reuse the sample within its interval.
+    size_t f = size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) -
+                      m_area_cdf.begin());
+    f = std::min(f, m_area_cdf.size() - 1);
+    float lo = f > 0 ? m_area_cdf[f - 1] : 0.f, hi = m_area_cdf[f];
+    u.x = hi > lo ? clamp((u.x - lo) / (hi - lo), 0.f, OneMinusEpsilon) : 0.f;
+
+    const uint32_t i0 = m_faces[3 * f], i1 = m_faces[3 * f + 1], i2 = m_faces[3 * f + 2];
+    const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
+    Point2f b = warp::square_to_uniform_triangle(u);
+    float b0 = 1.f - b.x - b.y;
+    ps.p = p0 * b0 + p1 * b.x + p2 * b.y;
+    Normal3f n = normalize(cross(p1 - p0, p2 - p0));
+    ps.n = m_flip_normals ? -n : n;
+    if (has_uvs())
+        ps.uv = Point2f(m_uvs[2 * i0], m_uvs[2 * i0 + 1]) * b0 +
+                Point2f(m_uvs[2 * i1], m_uvs[2 * i1 + 1]) * b.x +
+                Point2f(m_uvs[2 * i2], m_uvs[2 * i2 + 1]) * b.y;
+    else
+        ps.uv = b;
+    ps.pdf = 1.f / m_area;
+    ps.delta = false;
+    return ps;
+}
+
+std::string Mesh::to_string() const {
+    return fmt::format("Mesh[name=\"{}\", vertices={}, triangles={}, normals={}, uvs={}, "
+                       "colors={}, area={}, flip_normals={}, bsdf={}, emitter={}]",
+                       m_name, vertex_count(), face_count(), has_vertex_normals(), has_uvs(),
+                       has_vertex_colors(), m_area, m_flip_normals,
+                       m_bsdf ? m_bsdf->to_string() : "none",
+                       m_emitter ? m_emitter->to_string() : "none");
+}
+
+} // namespace facet

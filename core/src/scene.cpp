@@ -1,0 +1,288 @@
+#include <facet/bsdf.h>
+#include <facet/emitter.h>
+#include <facet/integrator.h>
+#include <facet/logger.h>
+#include <facet/plugin.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/shape.h>
+#include <facet/shapegroup.h>
+
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+
+#include <mutex>
+
+namespace facet {
+
+namespace {
+
+const char *embree_error_name(RTCError code) {
+    switch (code) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_UNKNOWN: return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    }
+    return "unknown error";
+}
+
+void embree_error_callback(void *, RTCError code, const char *str) {
+    FACET_LOG(Error, "Embree: {}: {}", embree_error_name(code), str ? str : "");
+}
+
+std::string object_label(const Object &obj) {
+    return obj.id().empty() ? obj.to_string() : "\"" + obj.id() + "\"";
+}
+
+} // namespace
+
+RTCDevice embree_device(int threads) {
+    static RTCDevice device = nullptr;
+    static std::once_flag once;
+    std::call_once(once, [threads] {
+        std::string config = threads > 0 ? fmt::format("threads={}", threads) : std::string();
+        device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+        if (!device)
+            FACET_THROW("could not create the Embree device: {}",
+                        embree_error_name(rtcGetDeviceError(nullptr)));
+        rtcSetDeviceErrorFunction(device, embree_error_callback, nullptr);
+    });
+    if (!device)
+        FACET_THROW("the Embree device is not available");
+    return device;
+}
+
+Scene::Scene(const Properties &props) {
+    // Embree asks every thread that builds or traces to flush denormals.
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+
+    for (const auto &[name, obj] : props.objects()) {
+        if (!obj)
+            continue;
+        const Location &loc = props.location(name);
+        switch (obj->type()) {
+        case ObjectType::Shape: {
+            auto shape = std::static_pointer_cast<Shape>(obj);
+            m_shapes.push_back(shape);
+            if (auto emitter = shape->emitter_ptr())
+                m_emitters.push_back(emitter);
+            break;
+        }
+        case ObjectType::Emitter: {
+            auto emitter = std::static_pointer_cast<Emitter>(obj);
+            if (emitter->shape())
+                break; // an area emitter referenced by a shape: the shape brings it in
+            if (has_flag(emitter->flags(), EmitterFlags::Surface))
+                FACET_THROW_AT(loc, "area emitter {} is not attached to any shape: nest it in a "
+                                    "<shape> (or reference it from one)",
+                               object_label(*emitter));
+            m_emitters.push_back(emitter);
+            break;
+        }
+        case ObjectType::Sensor:
+            m_sensors.push_back(std::static_pointer_cast<Sensor>(obj));
+            break;
+        case ObjectType::Integrator:
+            if (m_integrator)
+                FACET_THROW_AT(loc, "the scene has more than one integrator ({} and {})",
+                               object_label(*m_integrator), object_label(*obj));
+            m_integrator = std::static_pointer_cast<Integrator>(obj);
+            break;
+        case ObjectType::BSDF:
+        case ObjectType::Texture:
+            break; // declared at the top level to be referenced elsewhere
+        default:
+            FACET_THROW_AT(loc, "a scene cannot hold a top-level {} ({})",
+                           object_type_name(obj->type()), object_label(*obj));
+        }
+        props.mark_queried(name);
+    }
+
+    auto &registry = PluginRegistry::instance();
+    if (!m_integrator)
+        m_integrator = registry.create_as<Integrator>(ObjectType::Integrator, Properties("path"));
+    if (m_sensors.empty())
+        m_sensors.push_back(registry.create_as<Sensor>(ObjectType::Sensor, Properties("perspective")));
+    // Shapes without a BSDF (those inside shape groups included) share one default diffuse.
+    std::shared_ptr<BSDF> default_bsdf;
+    auto give_default_bsdf = [&](Shape &shape) {
+        if (shape.bsdf())
+            return;
+        if (!default_bsdf)
+            default_bsdf = registry.create_as<BSDF>(ObjectType::BSDF, Properties("diffuse"));
+        shape.set_bsdf(default_bsdf);
+    };
+    for (auto &shape : m_shapes) {
+        if (auto group = dynamic_cast<const ShapeGroup *>(shape.get())) {
+            for (auto &member : group->shapes())
+                give_default_bsdf(*member);
+            continue;
+        }
+        give_default_bsdf(*shape);
+    }
+    for (auto &emitter : m_emitters)
+        if (emitter->is_infinite())
+            m_environment.push_back(emitter);
+
+    m_device = embree_device();
+    rtcRetainDevice(m_device);
+    m_rtc_scene = rtcNewScene(m_device);
+    rtcSetSceneFlags(m_rtc_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
+    for (auto &shape : m_shapes) {
+        RTCGeometry geom = shape->embree_geometry(m_device);
+        if (!geom)
+            continue; // a shape group: only visible through its instances
+        unsigned id = rtcAttachGeometry(m_rtc_scene, geom);
+        rtcReleaseGeometry(geom); // the scene holds it now
+        if (id >= m_geometry_shapes.size())
+            m_geometry_shapes.resize(id + 1, nullptr);
+        m_geometry_shapes[id] = shape.get();
+        m_bbox.expand(shape->bbox());
+    }
+    rtcCommitScene(m_rtc_scene);
+    RTCError err = rtcGetDeviceError(m_device);
+    if (err != RTC_ERROR_NONE)
+        FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));
+
+    for (auto &emitter : m_emitters)
+        emitter->set_scene(*this);
+}
+
+Scene::~Scene() {
+    if (m_rtc_scene)
+        rtcReleaseScene(m_rtc_scene);
+    if (m_device)
+        rtcReleaseDevice(m_device);
+}
+
+bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray.org_x = ray.o.x;
+    rh.ray.org_y = ray.o.y;
+    rh.ray.org_z = ray.o.z;
+    rh.ray.tnear = ray.mint;
+    rh.ray.dir_x = ray.d.x;
+    rh.ray.dir_y = ray.d.y;
+    rh.ray.dir_z = ray.d.z;
+    rh.ray.time = 0.f;
+    rh.ray.tfar = ray.maxt;
+    rh.ray.mask = 0xFFFFFFFFu; // the Debian build has ray masks on: any other value can miss
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(m_rtc_scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        si.t = Infinity;
+        si.shape = nullptr;
+        return false;
+    }
+    const Point2f uv(rh.hit.u, rh.hit.v);
+    if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
+        // A hit inside an instanced group: geomID is the member of the group.
+        m_geometry_shapes[rh.hit.instID[0]]->compute_instance_interaction(
+            ray, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, uv, si);
+    } else {
+        m_geometry_shapes[rh.hit.geomID]->compute_surface_interaction(ray, rh.ray.tfar,
+                                                                      rh.hit.primID, uv, si);
+    }
+    return true;
+}
+
+bool Scene::ray_test(const Ray &ray) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay r;
+    r.org_x = ray.o.x;
+    r.org_y = ray.o.y;
+    r.org_z = ray.o.z;
+    r.tnear = ray.mint;
+    r.dir_x = ray.d.x;
+    r.dir_y = ray.d.y;
+    r.dir_z = ray.d.z;
+    r.time = 0.f;
+    r.tfar = ray.maxt;
+    r.mask = 0xFFFFFFFFu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(m_rtc_scene, &context, &r);
+    // Embree sets tfar to -inf when something was hit.
+    return r.tfar == -Infinity;
+}
+
+std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Interaction &ref,
+                                                                   Point2f u,
+                                                                   bool test_visibility) const {
+    const size_t count = m_emitters.size();
+    if (count == 0)
+        return {DirectionSample(), Color3f(0.f)};
+    // Uniform emitter selection; the sample is stretched back to [0, 1) for the emitter.
+    float scaled = u.x * float(count);
+    size_t index = std::min(size_t(scaled), count - 1);
+    u.x = std::min(scaled - float(index), OneMinusEpsilon);
+    const Emitter *emitter = m_emitters[index].get();
+
+    auto [ds, weight] = emitter->sample_direction(ref, u);
+    ds.emitter = emitter;
+    if (!(ds.pdf > 0.f) || weight.is_black())
+        return {ds, Color3f(0.f)};
+    // Delta emitters report pdf 1 (not a density): it is left as returned, as in
+    // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
+    if (!ds.delta)
+        ds.pdf /= float(count);
+    weight *= float(count);
+
+    if (test_visibility) {
+        Ray shadow = std::isfinite(ds.dist) ? ref.spawn_ray_to(ds.p) : ref.spawn_ray(ds.d);
+        if (ray_test(shadow))
+            weight = Color3f(0.f);
+    }
+    return {ds, weight};
+}
+
+float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {
+    if (!ds.emitter || m_emitters.empty())
+        return 0.f;
+    return ds.emitter->pdf_direction(ref, ds) / float(m_emitters.size());
+}
+
+Color3f Scene::eval_environment(const Ray &ray) const {
+    Color3f result(0.f);
+    if (m_environment.empty())
+        return result;
+    SurfaceInteraction si;
+    si.p = ray.o;
+    si.t = Infinity;
+    si.sh_frame = Frame();
+    si.wi = -ray.d;
+    for (const auto &emitter : m_environment)
+        result += emitter->eval(si);
+    return result;
+}
+
+std::string Scene::to_string() const {
+    std::string s = fmt::format("Scene[\n  bbox=[{}, {}, {}]-[{}, {}, {}],\n  shapes=[\n",
+                                m_bbox.min.x, m_bbox.min.y, m_bbox.min.z, m_bbox.max.x,
+                                m_bbox.max.y, m_bbox.max.z);
+    for (const auto &shape : m_shapes)
+        s += "    " + shape->to_string() + ",\n";
+    s += "  ],\n  emitters=[\n";
+    for (const auto &emitter : m_emitters)
+        s += "    " + emitter->to_string() + ",\n";
+    s += "  ],\n  sensors=[\n";
+    for (const auto &sensor : m_sensors)
+        s += "    " + sensor->to_string() + ",\n";
+    s += "  ],\n  integrator=" + (m_integrator ? m_integrator->to_string() : "none") + "\n]";
+    return s;
+}
+
+} // namespace facet

@@ -1,0 +1,75 @@
+#include <facet/bsdf.h>
+#include <facet/emitter.h>
+#include <facet/logger.h>
+#include <facet/shape.h>
+
+namespace facet {
+
+Shape::Shape(const Properties &props) {
+    for (const auto &[name, obj] : props.objects()) {
+        if (!obj)
+            continue;
+        const Location &loc = props.location(name);
+        switch (obj->type()) {
+        case ObjectType::BSDF:
+            if (m_bsdf)
+                FACET_THROW_AT(loc, "shape \"{}\" has more than one bsdf (\"{}\" is the second)",
+                               props.plugin_name(), name);
+            m_bsdf = std::static_pointer_cast<BSDF>(obj);
+            break;
+        case ObjectType::Emitter: {
+            if (m_emitter)
+                FACET_THROW_AT(loc, "shape \"{}\" has more than one emitter (\"{}\" is the second)",
+                               props.plugin_name(), name);
+            auto emitter = std::static_pointer_cast<Emitter>(obj);
+            if (emitter->shape() && emitter->shape() != this)
+                FACET_THROW_AT(loc, "emitter {}is already attached to another shape",
+                               emitter->id().empty() ? "" : "\"" + emitter->id() + "\" ");
+            m_emitter = std::move(emitter);
+            m_emitter->set_shape(this);
+            break;
+        }
+        default:
+            FACET_THROW_AT(loc,
+                           "shape \"{}\" cannot hold a nested {} (\"{}\"): only a bsdf and an "
+                           "emitter are accepted",
+                           props.plugin_name(), object_type_name(obj->type()), name);
+        }
+        props.mark_queried(name);
+    }
+}
+
+DirectionSample Shape::sample_direction(const Interaction &ref, const Point2f &u) const {
+    PositionSample ps = sample_position(u);
+    DirectionSample ds;
+    static_cast<PositionSample &>(ds) = ps;
+    ds.emitter = m_emitter.get();
+    ds.d = ps.p - ref.p;
+    float dist2 = squared_norm(ds.d);
+    ds.dist = std::sqrt(dist2);
+    if (!(ds.dist > 0.f)) {
+        ds.pdf = 0.f;
+        return ds;
+    }
+    ds.d /= ds.dist;
+    // Area density to solid angle: dA = r² / |cos θ| dω.
+    float cos_theta = absdot(ps.n, ds.d);
+    ds.pdf = cos_theta > 0.f ? ps.pdf * dist2 / cos_theta : 0.f;
+    return ds;
+}
+
+float Shape::pdf_direction(const Interaction &ref, const DirectionSample &ds) const {
+    float cos_theta = absdot(ds.n, ds.d);
+    if (!(cos_theta > 0.f))
+        return 0.f;
+    return pdf_position(ds) * ds.dist * ds.dist / cos_theta;
+}
+
+std::string Shape::to_string() const {
+    return fmt::format("Shape[bbox=[{}, {}, {}]-[{}, {}, {}], area={}, bsdf={}, emitter={}]",
+                       bbox().min.x, bbox().min.y, bbox().min.z, bbox().max.x, bbox().max.y,
+                       bbox().max.z, surface_area(), m_bsdf ? m_bsdf->to_string() : "none",
+                       m_emitter ? m_emitter->to_string() : "none");
+}
+
+} // namespace facet
