@@ -1,0 +1,138 @@
+static const char *DOC = R"DOC(
+# roughconductor: rough conductor (brushed or frosted metal)
+
+A metal surface made of tiny mirror facets whose normals follow a Beckmann or GGX distribution
+(Walter et al. 2007, "Microfacet models for refraction through rough surfaces"):
+f = F(wi·h)·D(h)·G(wi, wo, h) / (4·cos θi·cos θo). The roughness α is the RMS slope of the facets
+(0.01 is nearly smooth, 0.1 is glossy, 0.3 and above is rough); separate `alpha_u`/`alpha_v`
+give anisotropic highlights stretched along the tangent directions. Only the front side
+reflects (wrap the BSDF in `twosided` for two-sided surfaces).
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| distribution | string | beckmann | Microfacet distribution: beckmann or ggx |
+| alpha | float or texture | 0.1 | Isotropic roughness (not together with alpha_u/alpha_v) |
+| alpha_u | float or texture | 0.1 | Roughness along the tangent (anisotropic; requires alpha_v) |
+| alpha_v | float or texture | 0.1 | Roughness along the bitangent (anisotropic; requires alpha_u) |
+| sample_visible | boolean | true | Sample only the normals visible from wi (Heitz & d'Eon 2014), which lowers variance |
+| material | string | none | Measured material (Ag, Al, Au, Cr, Cu, ..., as for `conductor`); none = ideal mirror |
+| eta | spectrum or texture | 0.0 | Real part of the IOR (only without material; unbounded spectrum) |
+| k | spectrum or texture | 1.0 | Imaginary part of the IOR (only without material; unbounded spectrum) |
+| specular_reflectance | spectrum or texture | 1.0 | Tint of the reflection (for artistic control only) |
+
+```xml
+<bsdf type="roughconductor">
+    <string name="material" value="Al"/>
+    <string name="distribution" value="ggx"/>
+    <float name="alpha_u" value="0.05"/>
+    <float name="alpha_v" value="0.3"/>
+</bsdf>
+```
+)DOC";
+
+#include <facet/bsdf.h>
+#include <facet/conductor_data.h>
+#include <facet/fresnel.h>
+#include <facet/microfacet.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/texture.h>
+
+#include <fmt/format.h>
+
+namespace facet {
+
+class RoughConductor final : public BSDF {
+public:
+    explicit RoughConductor(const Properties &props) {
+        m_microfacet = read_microfacet(props);
+        ConductorIOR ior = read_conductor_ior(props);
+        m_material = ior.material;
+        m_eta = ior.eta;
+        m_k = ior.k;
+        m_specular_reflectance = props.texture("specular_reflectance", 1.f);
+
+        BSDFFlags flags = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide;
+        if (m_microfacet.is_anisotropic()) flags |= BSDFFlags::Anisotropic;
+        set_components({flags});
+    }
+
+    std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                          float /*sample1*/, const Point2f &sample2) const override {
+        BSDFSample bs;
+        float cos_i = Frame::cos_theta(si.wi);
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f) return {bs, Color3f(0.f)};
+
+        MicrofacetDistribution distr = m_microfacet.at(si);
+        auto [m, pdf_m] = distr.sample(si.wi, sample2);
+        float wi_dot_m = dot(si.wi, m);
+        if (!(pdf_m > 0.f) || wi_dot_m <= 0.f) return {bs, Color3f(0.f)};
+
+        bs.wo = facet::reflect(si.wi, m);
+        bs.eta = 1.f;
+        bs.sampled_type = BSDFFlags::GlossyReflection;
+        bs.sampled_component = 0;
+        if (Frame::cos_theta(bs.wo) <= 0.f) return {bs, Color3f(0.f)};
+        // Jacobian of the half-vector map for reflection, dωm/dωo = 1/(4 wo·m) (Walter eq. 14).
+        bs.pdf = pdf_m / (4.f * wi_dot_m);
+
+        // weight = f·cos θo / pdf with f·cos θo = F·D·G/(4 cos θi):
+        //   visible normals (pdf_m = D·G1(wi)·(wi·m)/cos θi): F·G1(wo, m);
+        //   all normals (pdf_m = D·cos θm): F·G·(wi·m)/(cos θi·cos θm).
+        float weight = distr.sample_visible()
+                           ? distr.smith_g1(bs.wo, m)
+                           : distr.G(si.wi, bs.wo, m) * wi_dot_m / (cos_i * Frame::cos_theta(m));
+        if (!(weight > 0.f)) return {bs, Color3f(0.f)};
+        Color3f F = fresnel_conductor(wi_dot_m, m_eta->eval(si), m_k->eval(si));
+        return {bs, F * m_specular_reflectance->eval(si) * weight};
+    }
+
+    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
+                 const Vector3f &wo) const override {
+        return eval_pdf(ctx, si, wo).first;
+    }
+
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+              const Vector3f &wo) const override {
+        float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f || cos_o <= 0.f)
+            return 0.f;
+        Vector3f h = normalize(si.wi + wo);
+        return m_microfacet.at(si).pdf(si.wi, h) / (4.f * dot(wo, h));
+    }
+
+    std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                       const Vector3f &wo) const override {
+        float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f || cos_o <= 0.f)
+            return {Color3f(0.f), 0.f};
+
+        MicrofacetDistribution distr = m_microfacet.at(si);
+        Vector3f h = normalize(si.wi + wo);
+        float D = distr.eval(h);
+        if (D == 0.f) return {Color3f(0.f), 0.f};
+        float wi_dot_h = dot(si.wi, h);
+        // f·cos θo = F·D·G / (4 cos θi).
+        float value = D * distr.G(si.wi, wo, h) / (4.f * cos_i);
+        Color3f F = fresnel_conductor(wi_dot_h, m_eta->eval(si), m_k->eval(si));
+        float pdf = distr.pdf(si.wi, h) / (4.f * dot(wo, h));
+        return {F * m_specular_reflectance->eval(si) * value, pdf};
+    }
+
+    std::string to_string() const override {
+        return fmt::format("RoughConductor[{}, material = {}, eta = {}, k = {}, "
+                           "specular_reflectance = {}]",
+                           m_microfacet.to_string(), m_material, m_eta->to_string(),
+                           m_k->to_string(), m_specular_reflectance->to_string());
+    }
+
+private:
+    MicrofacetParameters m_microfacet;
+    std::string m_material;
+    std::shared_ptr<Texture> m_eta, m_k, m_specular_reflectance;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::RoughConductor, BSDF, "roughconductor",
+                    "Rough conductor with a Beckmann or GGX microfacet distribution", DOC)
