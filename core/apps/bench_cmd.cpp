@@ -1,7 +1,7 @@
 // `facet bench`: how fast the scene's integrator renders, and how that compares with Embree
 // tracing the same number of rays with no shading at all.
 //
-// Rays of the render are counted exactly: ray_count() sums per-thread counts of every
+// Rays of the render are counted exactly: Scene::ray_count() sums per-thread counts of every
 // ray_intersect() and ray_test() call (plain thread-local increments, no locks or atomics in the
 // hot path). The plain Embree loop then traces that many incoherent rays through the same RTCScene
 // on the same number of threads: origins at the primary hit points of a pixel grid, directions
@@ -118,9 +118,6 @@ EmbreeLoop embree_loop(const Scene &scene, const std::vector<Hit> &hits, uint64_
     return result;
 }
 
-// TODO(cli): Scene::ray_count() once scene.cpp has landed.
-uint64_t ray_count() { return 0; }
-
 std::string mega(double v) { return fmt::format("{:.3f} M", v * 1e-6); }
 
 } // namespace
@@ -157,9 +154,9 @@ int bench_main(int argc, char **argv) {
     std::fflush(stdout);
 
     install_interrupt_handler(&cancel);
-    uint64_t rays_before = ray_count();
+    uint64_t rays_before = Scene::ray_count();
     RenderResult result = render(*scene, sensor, ropts);
-    uint64_t rays = ray_count() - rays_before;
+    uint64_t rays = Scene::ray_count() - rays_before;
     uninstall_interrupt_handler();
     if (result.cancelled) FACET_THROW("interrupted");
 

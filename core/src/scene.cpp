@@ -11,11 +11,36 @@
 #include <xmmintrin.h>
 #include <pmmintrin.h>
 
+#include <algorithm>
+#include <atomic>
 #include <mutex>
+#include <vector>
 
 namespace facet {
 
 namespace {
+
+/// Per-thread count of ray_intersect() and ray_test() calls, summed by Scene::ray_count() for
+/// `facet bench`. The hot path only does a relaxed load and store on its own thread's counter
+/// (plain moves: no lock, no read-modify-write). Each counter registers once per thread and folds
+/// its count into the retired total when its thread ends.
+struct RayCounter {
+    std::atomic<uint64_t> count{0};
+    static std::mutex &mutex() { static std::mutex m; return m; }
+    static std::vector<RayCounter *> &all() { static std::vector<RayCounter *> v; return v; }
+    static uint64_t &retired() { static uint64_t r = 0; return r; }
+    RayCounter() {
+        std::lock_guard<std::mutex> lock(mutex());
+        all().push_back(this);
+    }
+    ~RayCounter() {
+        std::lock_guard<std::mutex> lock(mutex());
+        retired() += count.load(std::memory_order_relaxed);
+        all().erase(std::find(all().begin(), all().end(), this));
+    }
+    void add() { count.store(count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
+};
+thread_local RayCounter t_ray_counter;
 
 const char *embree_error_name(RTCError code) {
     switch (code) {
@@ -161,7 +186,15 @@ Scene::~Scene() {
         rtcReleaseDevice(m_device);
 }
 
+uint64_t Scene::ray_count() {
+    std::lock_guard<std::mutex> lock(RayCounter::mutex());
+    uint64_t total = RayCounter::retired();
+    for (const RayCounter *c : RayCounter::all()) total += c->count.load(std::memory_order_relaxed);
+    return total;
+}
+
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
+    t_ray_counter.add();
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
@@ -199,6 +232,7 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
 }
 
 bool Scene::ray_test(const Ray &ray) const {
+    t_ray_counter.add();
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay r;

@@ -28,6 +28,9 @@ public:
     bool ray_intersect(const Ray &ray, SurfaceInteraction &si) const;
     /// Any hit in [ray.mint, ray.maxt] (rtcOccluded1).
     bool ray_test(const Ray &ray) const;
+    /// Number of ray_intersect() and ray_test() calls so far, all threads and scenes together
+    /// (`facet bench` takes the difference around a render).
+    static uint64_t ray_count();
 
     /// Picks an emitter uniformly and samples a direction to it from ref. The weight includes the
     /// selection probability; with `test_visibility` an occluded sample gets weight zero.
