@@ -9,27 +9,43 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace facet {
 
 /// Accumulates filtered samples for a rectangle of pixels (a render block plus the filter border).
-/// Each pixel stores Σ w·L and Σ w.
+/// Each pixel stores Σ w·L, Σ w·aov for every extra channel, and Σ w.
 class ImageBlock {
 public:
     ImageBlock() = default;
-    /// `offset`/`size` are the block's pixels in film coordinates; `border` extra pixels each side.
-    void reset(const Point2i &offset, const Point2i &size, int border);
+    /// `offset`/`size` are the block's pixels in film coordinates; `border` extra pixels each side;
+    /// `aov_count` extra channels after r, g, b. Reuses the existing memory when it is big enough.
+    void reset(const Point2i &offset, const Point2i &size, int border, int aov_count = 0);
     /// Adds radiance L at continuous film position `pos` (pixel centres at .5) with the filter.
-    void put(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter);
+    /// Extra channels receive zero.
+    void put(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter) {
+        put(pos, L, nullptr, filter);
+    }
+    /// The same with `aov_count()` extra values (`aovs` may be null when there are none).
+    void put(const Point2f &pos, const Color3f &L, const float *aovs, const ReconstructionFilter &filter);
     const Point2i &offset() const { return m_offset; }
     const Point2i &size() const { return m_size; }
     int border() const { return m_border; }
-    /// 4 floats per pixel (r, g, b, weight), rows of size.x + 2·border.
+    int aov_count() const { return m_aov_count; }
+    /// Floats per pixel: r, g, b, the AOVs, weight (4 without AOVs).
+    int channel_count() const { return m_aov_count + 4; }
+    /// Pixels per row/column of data(): size + 2·border.
+    Point2i storage_size() const { return {m_size.x + 2 * m_border, m_size.y + 2 * m_border}; }
+    /// channel_count() floats per pixel, rows of size.x + 2·border; pixel (0, 0) of the data is
+    /// film pixel offset - border.
     const std::vector<float> &data() const { return m_data; }
+
+    /// Border (in pixels) that a block needs around it for `filter`: floor(radius + 0.5).
+    static int border_for(const ReconstructionFilter &filter);
 
 private:
     Point2i m_offset, m_size;
-    int m_border = 0;
+    int m_border = 0, m_aov_count = 0;
     std::vector<float> m_data;
     std::vector<float> m_wx, m_wy; ///< scratch filter weights, reused
 };
@@ -48,23 +64,32 @@ public:
     Point2i crop_size() const { return m_crop_size; }
     const ReconstructionFilter &rfilter() const { return *m_filter; }
 
-    /// Clears the storage for a new render.
-    void prepare();
-    /// Adds a finished block (the render loop calls this in a fixed order).
+    /// Clears the storage for a new render without extra channels.
+    void prepare() { prepare({}); }
+    /// Clears the storage for a new render with extra (AOV) channels named `aov_names`.
+    void prepare(const std::vector<std::string> &aov_names);
+    /// Names of the extra channels of the current render.
+    const std::vector<std::string> &aov_names() const { return m_aov_names; }
+    /// Adds a finished block (the render loop calls this in a fixed order). Pixels outside the
+    /// crop window (parts of the filter border) are dropped.
     void put_block(const ImageBlock &block);
-    /// Normalised linear RGB (plus alpha when the pixel format asks) of the crop window.
+    /// Normalised linear RGB (plus alpha when the pixel format asks) of the crop window, followed
+    /// by the AOV channels. Pixels without any sample weight are 0 (and alpha 0).
     virtual Image develop() const;
     /// Extension the film writes by default (".exr").
     virtual std::string default_extension() const { return ".exr"; }
     /// Writes `image` to `path` through image I/O (atomically), float16 or float32 as configured.
     virtual void write(const Image &image, const std::string &path, const ImageWriteOptions &opts) const;
 
+    bool half() const { return m_half; }
+    bool has_alpha() const { return m_alpha; }
     std::string to_string() const override;
 
 protected:
     Point2i m_size, m_crop_offset, m_crop_size;
     std::shared_ptr<ReconstructionFilter> m_filter;
-    std::vector<double> m_storage; ///< Σ w·L (3) and Σ w per crop pixel
+    std::vector<double> m_storage; ///< Σ w·L (3), Σ w·aov (per AOV) and Σ w per crop pixel
+    std::vector<std::string> m_aov_names;
     bool m_half = true;            ///< component_format float16
     bool m_alpha = false;          ///< pixel_format rgba
 };

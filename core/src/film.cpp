@@ -1,0 +1,180 @@
+#include <facet/film.h>
+#include <facet/plugin.h>
+
+#include <cmath>
+
+namespace facet {
+
+// ---------------------------------------------------------------------------------------------
+// ImageBlock
+
+int ImageBlock::border_for(const ReconstructionFilter &filter) {
+    return int(std::floor(filter.radius() + 0.5f));
+}
+
+void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, int aov_count) {
+    if (size.x < 0 || size.y < 0 || border < 0 || aov_count < 0)
+        FACET_THROW("ImageBlock::reset: invalid size {}x{}, border {} or AOV count {}", size.x, size.y,
+                    border, aov_count);
+    m_offset = offset;
+    m_size = size;
+    m_border = border;
+    m_aov_count = aov_count;
+    Point2i s = storage_size();
+    // assign() keeps the capacity, so a block reused for equally sized tiles allocates nothing.
+    m_data.assign(size_t(s.x) * size_t(s.y) * size_t(channel_count()), 0.f);
+}
+
+void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
+                     const ReconstructionFilter &filter) {
+    if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return;
+    const float radius = filter.radius();
+    const Point2i s = storage_size();
+    // Continuous position in the block's storage, with pixel centres at integers.
+    const float px = pos.x - 0.5f - float(m_offset.x - m_border);
+    const float py = pos.y - 0.5f - float(m_offset.y - m_border);
+    const int x0 = std::max(0, int(std::ceil(px - radius)));
+    const int x1 = std::min(s.x - 1, int(std::floor(px + radius)));
+    const int y0 = std::max(0, int(std::ceil(py - radius)));
+    const int y1 = std::min(s.y - 1, int(std::floor(py + radius)));
+    if (x0 > x1 || y0 > y1) return;
+
+    const size_t nx = size_t(x1 - x0 + 1), ny = size_t(y1 - y0 + 1);
+    // Grows only the first time a block sees a filter of this size.
+    if (m_wx.size() < nx) m_wx.resize(nx);
+    if (m_wy.size() < ny) m_wy.resize(ny);
+    // The filter argument is the sample's offset from the pixel centre.
+    for (size_t i = 0; i < nx; ++i) m_wx[i] = filter.eval(px - float(x0 + int(i)));
+    for (size_t j = 0; j < ny; ++j) m_wy[j] = filter.eval(py - float(y0 + int(j)));
+
+    const int nc = channel_count();
+    for (size_t j = 0; j < ny; ++j) {
+        const float wy = m_wy[j];
+        if (wy == 0.f) continue;
+        float *row = m_data.data() + (size_t(y0) + j) * size_t(s.x) * nc;
+        for (size_t i = 0; i < nx; ++i) {
+            const float w = m_wx[i] * wy;
+            if (w == 0.f) continue;
+            float *p = row + (size_t(x0) + i) * nc;
+            p[0] += w * L.r;
+            p[1] += w * L.g;
+            p[2] += w * L.b;
+            if (aovs)
+                for (int k = 0; k < m_aov_count; ++k) p[3 + k] += w * aovs[k];
+            p[nc - 1] += w;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Film
+
+namespace {
+
+int read_positive(const Properties &props, const char *name, int64_t def) {
+    int64_t v = props.get_int(name, def);
+    if (v <= 0 || v > (1 << 20))
+        FACET_THROW_AT(props.location(name), "{} must be a positive number of pixels (at most {}), got {}",
+                       name, 1 << 20, v);
+    return int(v);
+}
+
+} // namespace
+
+Film::Film(const Properties &props) {
+    m_size = {read_positive(props, "width", 768), read_positive(props, "height", 576)};
+
+    int64_t ox = props.get_int("crop_offset_x", 0), oy = props.get_int("crop_offset_y", 0);
+    if (ox < 0 || oy < 0 || ox >= m_size.x || oy >= m_size.y)
+        FACET_THROW_AT(props.location(), "the crop offset ({}, {}) must lie inside the {}x{} film", ox, oy,
+                       m_size.x, m_size.y);
+    m_crop_offset = {int(ox), int(oy)};
+    int64_t cw = props.get_int("crop_width", m_size.x - ox);
+    int64_t ch = props.get_int("crop_height", m_size.y - oy);
+    if (cw <= 0 || ch <= 0 || ox + cw > m_size.x || oy + ch > m_size.y)
+        FACET_THROW_AT(props.location(),
+                       "the crop window (offset ({}, {}), size {}x{}) must be non-empty and lie inside the "
+                       "{}x{} film",
+                       ox, oy, cw, ch, m_size.x, m_size.y);
+    m_crop_size = {int(cw), int(ch)};
+
+    for (const auto &[name, obj] : props.objects()) {
+        if (!obj || obj->type() != ObjectType::ReconstructionFilter) continue;
+        if (m_filter)
+            FACET_THROW_AT(props.location(name), "a film takes only one reconstruction filter");
+        m_filter = std::static_pointer_cast<ReconstructionFilter>(obj);
+        props.mark_queried(name);
+    }
+    if (!m_filter)
+        m_filter = PluginRegistry::instance().create_as<ReconstructionFilter>(
+            ObjectType::ReconstructionFilter, Properties("gaussian"));
+}
+
+void Film::prepare(const std::vector<std::string> &aov_names) {
+    m_aov_names = aov_names;
+    size_t channels = 4 + aov_names.size();
+    m_storage.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * channels, 0.0);
+}
+
+void Film::put_block(const ImageBlock &block) {
+    const int nc = block.channel_count();
+    if (size_t(nc) != 4 + m_aov_names.size())
+        FACET_THROW("Film::put_block: the block has {} AOV channels, the film expects {}",
+                    block.aov_count(), m_aov_names.size());
+    if (m_storage.empty()) prepare(m_aov_names);
+    const Point2i s = block.storage_size();
+    const float *data = block.data().data();
+    // Block storage pixel (0, 0) is film pixel offset - border; map it to the crop window.
+    const int bx = block.offset().x - block.border() - m_crop_offset.x;
+    const int by = block.offset().y - block.border() - m_crop_offset.y;
+    for (int y = 0; y < s.y; ++y) {
+        int cy = by + y;
+        if (cy < 0 || cy >= m_crop_size.y) continue;
+        for (int x = 0; x < s.x; ++x) {
+            int cx = bx + x;
+            if (cx < 0 || cx >= m_crop_size.x) continue;
+            const float *src = data + (size_t(y) * s.x + x) * nc;
+            double *dst = m_storage.data() + (size_t(cy) * m_crop_size.x + cx) * nc;
+            for (int c = 0; c < nc; ++c) dst[c] += double(src[c]);
+        }
+    }
+}
+
+Image Film::develop() const {
+    const int naov = int(m_aov_names.size());
+    const int nc = 4 + naov;
+    const int out_c = 3 + (m_alpha ? 1 : 0) + naov;
+    Image img(m_crop_size.x, m_crop_size.y, out_c);
+    img.channel_names = {"R", "G", "B"};
+    if (m_alpha) img.channel_names.push_back("A");
+    for (const auto &n : m_aov_names) img.channel_names.push_back(n);
+    if (m_storage.empty()) return img;
+
+    for (size_t i = 0, n = size_t(m_crop_size.x) * m_crop_size.y; i < n; ++i) {
+        const double *src = m_storage.data() + i * nc;
+        float *dst = img.data.data() + i * out_c;
+        const double w = src[nc - 1];
+        // Filters with negative lobes could give a negative sum; treat it like no sample at all.
+        const double inv = w > 0.0 ? 1.0 / w : 0.0;
+        int o = 0;
+        for (int c = 0; c < 3; ++c) dst[o++] = float(src[c] * inv);
+        if (m_alpha) dst[o++] = w > 0.0 ? 1.f : 0.f;
+        for (int k = 0; k < naov; ++k) dst[o++] = float(src[3 + k] * inv);
+    }
+    return img;
+}
+
+void Film::write(const Image &image, const std::string &path, const ImageWriteOptions &opts) const {
+    ImageWriteOptions o = opts;
+    o.half = m_half;
+    write_image(path, image, o);
+}
+
+std::string Film::to_string() const {
+    return fmt::format("Film[size={}x{}, crop_offset=({}, {}), crop_size={}x{}, component_format={}, "
+                       "alpha={}, rfilter={}]",
+                       m_size.x, m_size.y, m_crop_offset.x, m_crop_offset.y, m_crop_size.x, m_crop_size.y,
+                       m_half ? "float16" : "float32", m_alpha, m_filter ? m_filter->to_string() : "none");
+}
+
+} // namespace facet

@@ -1,0 +1,306 @@
+#include <facet/film.h>
+#include <facet/integrator.h>
+#include <facet/logger.h>
+#include <facet/random.h>
+#include <facet/render.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <pmmintrin.h>
+#include <signal.h>
+#include <unistd.h>
+#include <xmmintrin.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <mutex>
+
+namespace facet {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Seed of one pixel's sample stream, from the render seed and the pixel's index in the full film.
+uint64_t pixel_seed(uint64_t seed, uint64_t pixel_index) {
+    uint64_t h = tea_hash(uint32_t(pixel_index), uint32_t(seed) ^ uint32_t(pixel_index >> 32));
+    return h ^ (uint64_t(uint32_t(seed >> 32)) << 32);
+}
+
+/// Sets flush-to-zero / denormals-are-zero for the lifetime of the object (Embree wants both).
+class ScopedFlushToZero {
+public:
+    ScopedFlushToZero() : m_csr(_mm_getcsr()) {
+        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    }
+    ~ScopedFlushToZero() { _mm_setcsr(m_csr); }
+
+private:
+    unsigned int m_csr;
+};
+
+/// One line on a terminal: "Rendering [=====     ] 42% (1.2s, ETA 1.6s)".
+class ProgressLine {
+public:
+    explicit ProgressLine(bool enabled) : m_enabled(enabled && ::isatty(2)) {}
+    bool enabled() const { return m_enabled; }
+
+    /// Redraws at most every 500 ms unless `force`.
+    void update(size_t done, size_t total, double elapsed, bool force = false) {
+        if (!m_enabled || total == 0) return;
+        if (!force && elapsed - m_last < 0.5) return;
+        m_last = elapsed;
+        const double frac = double(done) / double(total);
+        constexpr int width = 40;
+        const int filled = int(frac * width + 0.5);
+        std::string bar(size_t(filled), '=');
+        bar.append(size_t(width - filled), ' ');
+        std::string eta = done > 0 ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac) : "";
+        std::string line = fmt::format("\rRendering [{}] {:3d}% ({:.1f}s{})", bar, int(frac * 100.0), elapsed, eta);
+        // Pad to clear what a longer earlier line left behind.
+        if (line.size() < m_width) line.append(m_width - line.size(), ' ');
+        m_width = line.size();
+        std::fputs(line.c_str(), stderr);
+        std::fflush(stderr);
+        m_drawn = true;
+    }
+    void finish() {
+        if (m_enabled && m_drawn) std::fputs("\n", stderr);
+    }
+
+private:
+    bool m_enabled;
+    bool m_drawn = false;
+    double m_last = -1.0;
+    size_t m_width = 0;
+};
+
+/// Blocks that finished, merged into the film strictly in block-index order so that the result
+/// does not depend on which thread finished first. Also recycles block memory.
+class BlockMerger {
+public:
+    explicit BlockMerger(Film &film) : m_film(film) {}
+
+    std::unique_ptr<ImageBlock> acquire() {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        if (m_free.empty()) return std::make_unique<ImageBlock>();
+        auto b = std::move(m_free.back());
+        m_free.pop_back();
+        return b;
+    }
+
+    /// Hands in block `index`; merges every block that is now next in order. Returns the number
+    /// of blocks finished so far.
+    size_t submit(size_t index, std::unique_ptr<ImageBlock> block) {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        m_pending.emplace(index, std::move(block));
+        ++m_finished;
+        for (auto it = m_pending.begin(); it != m_pending.end() && it->first == m_next; it = m_pending.begin()) {
+            m_film.put_block(*it->second);
+            m_free.push_back(std::move(it->second));
+            m_pending.erase(it);
+            ++m_next;
+        }
+        return m_finished;
+    }
+
+    /// After a cancelled render: merges what is left, still in index order (gaps are skipped).
+    void flush() {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        for (auto &[index, block] : m_pending) m_film.put_block(*block);
+        m_pending.clear();
+    }
+
+    size_t finished() {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        return m_finished;
+    }
+
+private:
+    Film &m_film;
+    std::mutex m_mutex;
+    std::map<size_t, std::unique_ptr<ImageBlock>> m_pending;
+    std::vector<std::unique_ptr<ImageBlock>> m_free;
+    size_t m_next = 0, m_finished = 0;
+};
+
+} // namespace
+
+RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts) {
+    const auto start = Clock::now();
+    auto integrator = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator());
+    if (!integrator)
+        FACET_THROW("cannot render with the integrator {}: facet's render loop needs a sampling integrator "
+                    "(path, direct, ...)",
+                    scene.integrator() ? scene.integrator()->to_string() : "(none)");
+    if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
+    if (opts.block_size <= 0) FACET_THROW("the block size must be positive, got {}", opts.block_size);
+    if (opts.threads < 0) FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
+
+    Film &film = sensor.film();
+    const Sampler &proto_sampler = sensor.sampler();
+    // The per-thread samplers are clones of this one. Samplers may round the count (stratified
+    // ones to a square); seeding once lets them do so before the count is read back.
+    std::unique_ptr<Sampler> base_sampler = proto_sampler.clone();
+    if (opts.spp > 0) base_sampler->set_sample_count(uint32_t(opts.spp));
+    base_sampler->seed(0);
+    const uint32_t spp = base_sampler->sample_count();
+    if (opts.spp > 0 && spp != uint32_t(opts.spp))
+        FACET_LOG(Info, "The sampler takes {} samples per pixel instead of {}", spp, opts.spp);
+    const uint64_t seed = opts.seed + proto_sampler.base_seed();
+    const std::vector<std::string> aov_names = integrator->aov_names();
+    const int aov_count = int(aov_names.size());
+    film.prepare(aov_names);
+
+    const Point2i film_size = film.size(), crop_offset = film.crop_offset(), crop_size = film.crop_size();
+    const int bs = opts.block_size;
+    const int blocks_x = (crop_size.x + bs - 1) / bs, blocks_y = (crop_size.y + bs - 1) / bs;
+    const size_t total = size_t(blocks_x) * size_t(blocks_y);
+    const int border = ImageBlock::border_for(film.rfilter());
+    const ReconstructionFilter &filter = film.rfilter();
+    const bool needs_aperture = sensor.needs_aperture_sample();
+    const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
+
+    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
+    const int workers = arena.max_concurrency();
+    FACET_LOG(Info, "Starting render job ({}x{}, {} samples, {} threads)", crop_size.x, crop_size.y, spp, workers);
+
+    BlockMerger merger(film);
+    ProgressLine progress(opts.progress);
+    std::atomic<size_t> next_block{0};
+    std::atomic<uint64_t> samples_taken{0}, invalid_samples{0};
+    std::atomic<uint64_t> first_invalid_pixel{UINT64_MAX};
+    std::atomic<bool> cancelled{false};
+    std::mutex progress_mutex;
+
+    // Each worker takes the next block in scanline order until none is left, so blocks finish
+    // roughly in order and few wait to be merged. The image does not depend on who took which.
+    auto worker = [&](int) {
+        ScopedFlushToZero ftz;
+        std::unique_ptr<Sampler> sampler = base_sampler->clone();
+        std::vector<float> aovs(size_t(aov_count) + 1, 0.f);
+        for (;;) {
+            if (opts.cancel && opts.cancel->load(std::memory_order_relaxed)) {
+                cancelled = true;
+                return;
+            }
+            const size_t index = next_block.fetch_add(1);
+            if (index >= total) return;
+            const int bx = int(index % size_t(blocks_x)), by = int(index / size_t(blocks_x));
+            const Point2i offset(crop_offset.x + bx * bs, crop_offset.y + by * bs);
+            const Point2i size(std::min(bs, crop_offset.x + crop_size.x - offset.x),
+                               std::min(bs, crop_offset.y + crop_size.y - offset.y));
+            std::unique_ptr<ImageBlock> block = merger.acquire();
+            block->reset(offset, size, border, aov_count);
+
+            uint64_t invalid = 0;
+            for (int y = offset.y; y < offset.y + size.y; ++y) {
+                for (int x = offset.x; x < offset.x + size.x; ++x) {
+                    const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
+                    sampler->seed(pixel_seed(seed, pixel_index));
+                    for (uint32_t s = 0; s < spp; ++s) {
+                        if (s > 0) sampler->advance();
+                        const Point2f u = sampler->next_2d();
+                        const Point2f pos(float(x) + u.x, float(y) + u.y);
+                        const Point2f aperture = needs_aperture ? sampler->next_2d() : Point2f(0.5f, 0.5f);
+                        auto [ray, weight] = sensor.sample_ray(0.f, pos * inv_film_size, aperture);
+                        Color3f L = integrator->sample(scene, *sampler, ray, aovs.data()) * weight;
+                        bool valid = L.is_finite();
+                        for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
+                        if (!valid) {
+                            // One bad sample must not turn the whole pixel into NaN: drop it.
+                            if (invalid++ == 0) {
+                                uint64_t cur = first_invalid_pixel.load();
+                                while (pixel_index < cur && !first_invalid_pixel.compare_exchange_weak(cur, pixel_index)) {}
+                            }
+                            continue;
+                        }
+                        block->put(pos, L, aovs.data(), filter);
+                    }
+                }
+            }
+            samples_taken += uint64_t(size.x) * uint64_t(size.y) * spp;
+            invalid_samples += invalid;
+            const size_t done = merger.submit(index, std::move(block));
+            if (progress.enabled()) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                progress.update(done, total, seconds_since(start));
+            }
+        }
+    };
+    arena.execute([&] { tbb::parallel_for(0, workers, worker, tbb::simple_partitioner()); });
+    merger.flush();
+
+    RenderResult result;
+    result.blocks_total = total;
+    result.blocks_done = merger.finished();
+    result.cancelled = cancelled && result.blocks_done < total;
+    result.samples = samples_taken.load();
+    result.seconds = seconds_since(start);
+    progress.update(result.blocks_done, total, result.seconds, true);
+    progress.finish();
+    if (result.cancelled)
+        FACET_LOG(Warn, "Rendering cancelled after {} of {} blocks", result.blocks_done, total);
+    if (invalid_samples > 0) {
+        uint64_t p = first_invalid_pixel.load();
+        FACET_LOG(Warn, "{} samples had NaN or infinite radiance and were dropped (the first at pixel ({}, {}))",
+                  invalid_samples.load(), p % uint64_t(film_size.x), p / uint64_t(film_size.x));
+    }
+    result.image = film.develop();
+    return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Interrupt handling
+
+namespace {
+
+std::atomic<bool> *g_interrupt_flag = nullptr;
+struct sigaction g_old_sigint, g_old_sighup;
+bool g_handler_installed = false;
+
+extern "C" void facet_interrupt_handler(int sig) {
+    if (g_interrupt_flag) g_interrupt_flag->store(true);
+    // A second signal of the same kind takes the default action, so the user can force quit.
+    struct sigaction dfl;
+    std::memset(&dfl, 0, sizeof(dfl));
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, nullptr);
+}
+
+} // namespace
+
+void install_interrupt_handler(std::atomic<bool> *flag) {
+    if (g_handler_installed) uninstall_interrupt_handler();
+    g_interrupt_flag = flag;
+    struct sigaction sa;
+    std::memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = facet_interrupt_handler;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGINT, &sa, &g_old_sigint);
+    sigaction(SIGHUP, &sa, &g_old_sighup);
+    g_handler_installed = true;
+}
+
+void uninstall_interrupt_handler() {
+    if (!g_handler_installed) return;
+    sigaction(SIGINT, &g_old_sigint, nullptr);
+    sigaction(SIGHUP, &g_old_sighup, nullptr);
+    g_interrupt_flag = nullptr;
+    g_handler_installed = false;
+}
+
+} // namespace facet

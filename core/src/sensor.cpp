@@ -1,0 +1,33 @@
+#include <facet/plugin.h>
+#include <facet/sensor.h>
+
+namespace facet {
+
+Sensor::Sensor(const Properties &props) {
+    m_to_world = props.get_transform("to_world", Transform());
+
+    // Mitsuba's sensors take a shutter interval; facet renders still scenes, so only check it.
+    double open = props.get_float("shutter_open", 0.0);
+    double close = props.get_float("shutter_close", 0.0);
+    if (close < open)
+        FACET_THROW_AT(props.location("shutter_close"),
+                       "shutter_close ({}) must not be earlier than shutter_open ({})", close, open);
+
+    for (const auto &[name, obj] : props.objects()) {
+        if (!obj) continue;
+        if (obj->type() == ObjectType::Film) {
+            if (m_film) FACET_THROW_AT(props.location(name), "a sensor takes only one film");
+            m_film = std::static_pointer_cast<Film>(obj);
+            props.mark_queried(name);
+        } else if (obj->type() == ObjectType::Sampler) {
+            if (m_sampler) FACET_THROW_AT(props.location(name), "a sensor takes only one sampler");
+            m_sampler = std::static_pointer_cast<Sampler>(obj);
+            props.mark_queried(name);
+        }
+    }
+    auto &registry = PluginRegistry::instance();
+    if (!m_film) m_film = registry.create_as<Film>(ObjectType::Film, Properties("hdrfilm"));
+    if (!m_sampler) m_sampler = registry.create_as<Sampler>(ObjectType::Sampler, Properties("independent"));
+}
+
+} // namespace facet

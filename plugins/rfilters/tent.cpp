@@ -1,0 +1,44 @@
+static const char *DOC = R"DOC(
+# tent
+
+Tent (triangle, bilinear) reconstruction filter: the weight falls linearly from 1 at the pixel
+centre to 0 at `radius`.
+
+| Parameter | Type | Default | Description |
+|---|---|---|---|
+| radius | float | 1.0 | Radius of the filter in pixels (must be > 0) |
+
+```xml
+<rfilter type="tent">
+    <float name="radius" value="1.5"/>
+</rfilter>
+```
+)DOC";
+
+#include <facet/plugin.h>
+#include <facet/rfilter.h>
+
+namespace facet {
+
+class TentFilter final : public ReconstructionFilter {
+public:
+    explicit TentFilter(const Properties &props) {
+        double radius = props.get_float("radius", 1.0);
+        if (!(radius > 0.0) || !std::isfinite(radius))
+            FACET_THROW_AT(props.location("radius"), "radius must be a positive number of pixels, got {}",
+                           radius);
+        m_radius = float(radius);
+        m_inv_radius = 1.f / m_radius;
+    }
+
+    float eval(float x) const override { return std::max(0.f, 1.f - std::abs(x) * m_inv_radius); }
+
+    std::string to_string() const override { return fmt::format("TentFilter[radius={}]", m_radius); }
+
+private:
+    float m_inv_radius = 1.f;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::TentFilter, ReconstructionFilter, "tent", "Tent (triangle) pixel filter", DOC)

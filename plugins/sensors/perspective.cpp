@@ -1,0 +1,101 @@
+static const char *DOC = R"DOC(
+# perspective
+
+Pinhole perspective camera. It looks down +Z of its local frame with +X to the left and +Y up,
+which is the frame `<lookat>` builds; image x grows to the right and y downwards. The field of
+view is given either by `fov` (with `fov_axis`) or by a 35 mm equivalent `focal_length`; without
+either, the camera has a 50 mm lens on a 36x24 mm film, measured along the diagonal.
+
+| Parameter | Type | Default | Description |
+|---|---|---|---|
+| to_world | transform | identity | Camera-to-world transform (usually a `<lookat>`) |
+| fov | float | (from focal_length) | Field of view in degrees, 0 < fov < 180, along `fov_axis` |
+| fov_axis | string | x | Axis of `fov`: x, y, diagonal, smaller or larger (read only with `fov`) |
+| focal_length | string | 50mm | 35 mm equivalent focal length ("<f>mm", or a bare number in mm); not with `fov` |
+| near_clip | float | 0.01 | Distance of the near clipping plane (> 0) |
+| far_clip | float | 10000 | Distance of the far clipping plane (> near_clip) |
+| principal_point_offset_x | float | 0 | Shift of the image centre, in units of the film width |
+| principal_point_offset_y | float | 0 | Shift of the image centre, in units of the film height |
+| focus_distance | float | (none) | Accepted for Mitsuba scenes that give it; a pinhole is always in focus |
+| shutter_open | float | 0 | Accepted for compatibility; facet renders still images |
+| shutter_close | float | 0 | Accepted for compatibility (must be >= shutter_open) |
+| (film) | film | hdrfilm | Nested film |
+| (sampler) | sampler | independent | Nested sampler |
+
+```xml
+<sensor type="perspective">
+    <float name="fov" value="39.3"/>
+    <transform name="to_world">
+        <lookat origin="0, 1, 6.8" target="0, 1, 0" up="0, 1, 0"/>
+    </transform>
+    <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="512"/><integer name="height" value="512"/></film>
+</sensor>
+```
+)DOC";
+
+#include <facet/fov.h>
+#include <facet/plugin.h>
+#include <facet/sensor.h>
+
+#include <cmath>
+
+namespace facet {
+
+class PerspectiveCamera final : public Sensor {
+public:
+    explicit PerspectiveCamera(const Properties &props) : Sensor(props) {
+        const Point2i size = m_film->size();
+        const double aspect = double(size.x) / double(size.y);
+        m_x_fov = perspective_x_fov(props, aspect);
+
+        m_near_clip = float(props.get_float("near_clip", 1e-2));
+        m_far_clip = float(props.get_float("far_clip", 1e4));
+        if (!(m_near_clip > 0.f) || !(m_far_clip > m_near_clip) || !std::isfinite(m_far_clip))
+            FACET_THROW_AT(props.location(),
+                           "the clipping planes must satisfy 0 < near_clip < far_clip (finite), got "
+                           "near_clip = {}, far_clip = {}",
+                           m_near_clip, m_far_clip);
+        m_principal_offset = Point2f(float(props.get_float("principal_point_offset_x", 0.0)),
+                                     float(props.get_float("principal_point_offset_y", 0.0)));
+        if (props.has("focus_distance")) {
+            double fd = props.get_float("focus_distance");
+            if (!(fd > 0.0))
+                FACET_THROW_AT(props.location("focus_distance"), "focus_distance must be positive, got {}",
+                               fd);
+        }
+
+        m_tan_x = float(std::tan(0.5 * m_x_fov * 3.14159265358979323846 / 180.0));
+        m_tan_y = float(double(m_tan_x) / aspect);
+        m_origin = m_to_world.apply_point(Point3f(0.f));
+    }
+
+    std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
+                                       const Point2f &aperture_sample) const override {
+        // Film x grows to the right, which is local -X (local +X is the camera's left).
+        const float u = film_pos.x + m_principal_offset.x, v = film_pos.y + m_principal_offset.y;
+        const Vector3f local = normalize(Vector3f((1.f - 2.f * u) * m_tan_x, (1.f - 2.f * v) * m_tan_y, 1.f));
+        const float inv_z = 1.f / local.z;
+        Ray ray(m_origin, normalize(m_to_world.apply_vector(local)), m_near_clip * inv_z, m_far_clip * inv_z);
+        ray.time = time;
+        return {ray, Color3f(1.f)};
+    }
+
+    std::string to_string() const override {
+        return fmt::format("PerspectiveCamera[x_fov={:.4f}, near_clip={}, far_clip={}, origin=({}, {}, {}), "
+                           "film={}, sampler={}]",
+                           m_x_fov, m_near_clip, m_far_clip, m_origin.x, m_origin.y, m_origin.z,
+                           m_film->to_string(), m_sampler->to_string());
+    }
+
+private:
+    double m_x_fov = 0.0;
+    float m_near_clip = 1e-2f, m_far_clip = 1e4f;
+    float m_tan_x = 1.f, m_tan_y = 1.f;
+    Point2f m_principal_offset;
+    Point3f m_origin;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::PerspectiveCamera, Sensor, "perspective", "Pinhole perspective camera", DOC)
