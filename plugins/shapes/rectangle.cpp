@@ -1,0 +1,45 @@
+static const char *DOC = R"DOC(
+# rectangle
+
+The square [-1, 1]² in the z = 0 plane with its normal along +z, placed by `to_world`; two
+triangles.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| flip_normals | boolean | false | Make the normal point along -z (object space) |
+| to_world | transform | identity | Object-to-world transform |
+
+Texture coordinates run from (0, 0) at (-1, -1) to (1, 1) at (1, 1).
+
+```xml
+<shape type="rectangle">
+    <transform name="to_world">
+        <scale x="2" y="3"/>
+        <rotate x="1" angle="-90"/>
+    </transform>
+    <bsdf type="diffuse"/>
+</shape>
+```
+)DOC";
+
+#include <facet/mesh.h>
+#include <facet/plugin.h>
+
+namespace facet {
+
+class Rectangle final : public Mesh {
+public:
+    explicit Rectangle(const Properties &props) : Mesh(props) {
+        bool flip_normals = props.get_bool("flip_normals", false);
+        Transform to_world = props.get_transform("to_world", Transform());
+        m_positions = {-1.f, -1.f, 0.f, 1.f, -1.f, 0.f, 1.f, 1.f, 0.f, -1.f, 1.f, 0.f};
+        m_uvs = {0.f, 0.f, 1.f, 0.f, 1.f, 1.f, 0.f, 1.f};
+        // Counter-clockwise seen from +z, so the face normal is +z.
+        m_faces = {0, 1, 2, 2, 3, 0};
+        initialize(to_world, false, flip_normals);
+    }
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::Rectangle, Shape, "rectangle", "Square [-1, 1]² in the z = 0 plane", DOC)
