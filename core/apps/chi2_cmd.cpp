@@ -1,0 +1,242 @@
+// `facet chi2 bsdf|emitter|microfacet ...`: the chi-square test of facet/chi2.h on any plugin.
+
+#include "commands.h"
+
+#include <facet/chi2.h>
+#include <facet/logger.h>
+#include <facet/plugin.h>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using namespace facet;
+
+/// Options every subcommand shares.
+struct CommonOptions {
+    int res = 32;
+    uint64_t samples = 1000000;
+    uint32_t seed = 0;
+    uint32_t tests = 1;
+    double significance = 0.01;
+    int ires = 7;
+    bool adaptive = false;
+    std::string out;
+    std::vector<std::string> plugin_dirs;
+    bool quiet = false;
+};
+
+void add_common(CLI::App &app, CommonOptions &o) {
+    app.add_option("--res", o.res, "Cells along cos theta; phi gets twice as many (default 32)");
+    app.add_option("--samples", o.samples, "Number of samples (default 1000000)");
+    app.add_option("--seed", o.seed, "Seed; sample i uses a PCG32 seeded from tea_hash(i, seed)");
+    app.add_option("--tests", o.tests,
+                   "Number of tests run together: the level is Sidak-corrected (default 1)");
+    app.add_option("--significance", o.significance, "Family-wise significance level (default 0.01)");
+    app.add_option("--ires", o.ires, "Simpson points per axis and cell of the fixed rule (default 7)");
+    app.add_flag("--adaptive", o.adaptive, "Integrate the pdf with adaptive Simpson");
+    app.add_option("--out", o.out,
+                   "Write the heat map (PNG) and tables here, also when the test passes "
+                   "(failures always go to ./chi2-failures)");
+    app.add_option("-a", o.plugin_dirs, "Add folders to the plugin search path (';' separates several)");
+    app.add_flag("-q,--quiet", o.quiet, "Print only the verdict line");
+}
+
+std::vector<float> parse_floats(const std::string &text, size_t count, const char *what) {
+    std::vector<float> values;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            size_t used = 0;
+            values.push_back(std::stof(item, &used));
+            if (item.find_first_not_of(" \t", used) != std::string::npos) throw std::invalid_argument("");
+        } catch (const std::exception &) {
+            FACET_THROW("{} \"{}\": expected {} comma-separated numbers", what, text, count);
+        }
+    }
+    if (values.size() != count)
+        FACET_THROW("{} \"{}\": expected {} comma-separated numbers", what, text, count);
+    return values;
+}
+
+bool parse_bool(const std::string &text, const char *what) {
+    if (text == "true" || text == "1" || text == "yes") return true;
+    if (text == "false" || text == "0" || text == "no") return false;
+    FACET_THROW("{} \"{}\": expected true or false", what, text);
+}
+
+void add_plugin_dirs(const std::vector<std::string> &values) {
+    for (const std::string &value : values) {
+        size_t start = 0;
+        while (start <= value.size()) {
+            size_t end = std::min(value.find(';', start), value.size());
+            if (end > start) PluginRegistry::instance().add_search_dir(value.substr(start, end - start));
+            start = end + 1;
+        }
+    }
+}
+
+/// A file name made of the test's words: "bsdf-roughconductor-1a2b3c4d".
+std::string slug(const std::string &kind, const std::string &name, const std::string &everything) {
+    uint32_t h = 2166136261u; // FNV-1a of the whole configuration
+    for (unsigned char c : everything) h = (h ^ c) * 16777619u;
+    std::string base = kind + "-" + name;
+    for (char &c : base)
+        if (!std::isalnum((unsigned char) c) && c != '-' && c != '_') c = '_';
+    return fmt::format("{}-{:08x}", base.substr(0, 48), h);
+}
+
+/// Runs the test, prints the result and writes pictures when asked or on failure.
+int run(const Chi2Adapter &adapter, const CommonOptions &o, const std::string &file_base) {
+    Chi2Options opts;
+    opts.res = o.res;
+    opts.samples = o.samples;
+    opts.seed = o.seed;
+    opts.test_count = std::max(1u, o.tests);
+    opts.significance = o.significance;
+    opts.ires = o.ires;
+    opts.adaptive = o.adaptive;
+    if (!(o.significance > 0.0 && o.significance < 1.0))
+        FACET_THROW("--significance {} must be in (0, 1)", o.significance);
+
+    Chi2Result result = run_chi2(adapter, opts);
+    if (o.quiet)
+        fmt::print("chi2: {} ({}, p-value {:.6g})\n", result.passed ? "accepted" : "REJECTED",
+                   result.description, result.p_value);
+    else
+        fmt::print("{}", result.summary());
+
+    std::string dir = !o.out.empty() ? o.out : (result.passed ? std::string() : "chi2-failures");
+    if (!dir.empty()) {
+        fs::create_directories(dir);
+        std::string base = (fs::path(dir) / file_base).string();
+        write_chi2_heatmap(base + ".png", result);
+        write_chi2_tables(base + ".txt", result);
+        fmt::print("  wrote {}.png (observed | expected | (o-e)/sqrt(e)) and {}.txt\n", base, base);
+    }
+    std::fflush(stdout);
+    return result.passed ? 0 : 1;
+}
+
+std::string join_args(int argc, char **argv) {
+    std::string s;
+    for (int i = 0; i < argc; ++i) s += std::string(argv[i]) + "\n";
+    return s;
+}
+
+} // namespace
+
+int chi2_main(int argc, char **argv) {
+    CLI::App app("Chi-square test of a plugin's sampling routine against its pdf.\n"
+                 "Prints the statistic, dof, p-value and verdict; exits with 1 on rejection.",
+                 "facet chi2");
+    app.require_subcommand(1);
+
+    // bsdf
+    CommonOptions bo;
+    std::string bsdf_name, xml, wi_text, mode = "radiance";
+    std::vector<std::string> bsdf_params;
+    float theta = 30.f, phi = 0.f;
+    int component = -1;
+    CLI::App *bsdf = app.add_subcommand("bsdf", "Test a BSDF: facet chi2 bsdf <name> [key=value ...]");
+    bsdf->add_option("name", bsdf_name, "BSDF plugin name");
+    bsdf->add_option("params", bsdf_params,
+                     "Parameters key=value (type inferred: number -> float, true/false -> boolean, "
+                     "r,g,b -> rgb, else string) or type:key=value (e.g. integer:n=3)");
+    bsdf->add_option("--xml", xml, "The BSDF as XML text or an .xml file (instead of a name)");
+    bsdf->add_option("--wi", wi_text, "Incident direction x,y,z in the local frame (normalised)");
+    auto theta_opt = bsdf->add_option("--theta", theta, "Incident polar angle in degrees (default 30)");
+    bsdf->add_option("--phi", phi, "Incident azimuth in degrees (default 0)");
+    bsdf->add_option("--component", component, "Test only this component (lobe) index");
+    bsdf->add_option("--mode", mode, "Transport mode: radiance (default) or importance");
+    add_common(*bsdf, bo);
+
+    // emitter
+    CommonOptions eo;
+    std::string emitter_name, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
+    std::vector<std::string> emitter_params;
+    CLI::App *emitter = app.add_subcommand(
+        "emitter", "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
+    emitter->add_option("name", emitter_name, "Emitter plugin name")->required();
+    emitter->add_option("params", emitter_params, "Parameters, as for bsdf");
+    emitter->add_option("--ref", ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
+    emitter->add_option("--shape", shape,
+                        "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
+    add_common(*emitter, eo);
+
+    // microfacet
+    CommonOptions mo;
+    std::string distr_name, visible_text = "true";
+    float alpha = 0.1f, alpha_v = -1.f, m_theta = 30.f, m_phi = 0.f;
+    CLI::App *micro = app.add_subcommand(
+        "microfacet", "Test microfacet normal sampling: facet chi2 microfacet beckmann|ggx --alpha a");
+    micro->add_option("type", distr_name, "beckmann or ggx")->required();
+    micro->add_option("--alpha", alpha, "Roughness (alpha_u when --alpha-v is given; default 0.1)");
+    micro->add_option("--alpha-v", alpha_v, "Roughness along v (default: --alpha)");
+    micro->add_option("--visible", visible_text, "Sample visible normals: true (default) or false");
+    micro->add_option("--theta", m_theta, "Incident polar angle in degrees (default 30)");
+    micro->add_option("--phi", m_phi, "Incident azimuth in degrees (default 0)");
+    add_common(*micro, mo);
+
+    if (int code = cli::parse(app, argc, argv); code >= 0) return code;
+    std::string everything = join_args(argc, argv);
+
+    if (bsdf->parsed()) {
+        add_plugin_dirs(bo.plugin_dirs);
+        if (!wi_text.empty() && theta_opt->count() > 0)
+            FACET_THROW("give the incident direction either with --wi or with --theta/--phi");
+        Vector3f wi;
+        if (!wi_text.empty()) {
+            auto v = parse_floats(wi_text, 3, "--wi");
+            wi = Vector3f(v[0], v[1], v[2]);
+        } else {
+            wi = direction_from_angles(theta, phi);
+        }
+        BSDFContext ctx;
+        if (mode == "importance")
+            ctx.mode = TransportMode::Importance;
+        else if (mode != "radiance")
+            FACET_THROW("--mode \"{}\": expected radiance or importance", mode);
+        if (component >= 0) ctx.component = uint32_t(component);
+
+        std::string text;
+        if (!xml.empty() || (!bsdf_name.empty() && bsdf_name[0] == '<')) {
+            if (!bsdf_params.empty()) FACET_THROW("key=value parameters cannot be added to --xml");
+            text = xml.empty() ? bsdf_name : xml;
+            if (text[0] != '<') {
+                std::ifstream in(text);
+                if (!in) FACET_THROW("cannot read \"{}\"", text);
+                std::stringstream ss;
+                ss << in.rdbuf();
+                text = ss.str();
+            }
+            if (bsdf_name.empty() || bsdf_name[0] == '<') bsdf_name = "xml";
+        } else {
+            if (bsdf_name.empty()) FACET_THROW("name the BSDF plugin to test (or give --xml)");
+            text = chi2_object_xml(ObjectType::BSDF, bsdf_name, bsdf_params);
+        }
+        BSDFAdapter adapter(text, wi, ctx);
+        return run(adapter, bo, slug("bsdf", bsdf_name, everything));
+    }
+    if (emitter->parsed()) {
+        add_plugin_dirs(eo.plugin_dirs);
+        auto r = parse_floats(ref_text, 3, "--ref");
+        EmitterAdapter adapter(EmitterAdapter::scene_xml(emitter_name, emitter_params, shape),
+                               Point3f(r[0], r[1], r[2]));
+        return run(adapter, eo, slug("emitter", emitter_name, everything));
+    }
+    // microfacet
+    add_plugin_dirs(mo.plugin_dirs);
+    MicrofacetAdapter adapter(distr_name, alpha, alpha_v > 0.f ? alpha_v : alpha,
+                              parse_bool(visible_text, "--visible"),
+                              direction_from_angles(m_theta, m_phi));
+    return run(adapter, mo, slug("microfacet", distr_name, everything));
+}
