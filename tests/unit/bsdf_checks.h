@@ -1,0 +1,148 @@
+#pragma once
+
+// Checks shared by the BSDF unit tests (dielectric, conductor, rough*, ...): creation from
+// parameters, error messages, eval/pdf/sample consistency, energy (white furnace) and chi-square.
+
+#include <facet/bsdf.h>
+#include <facet/chi2.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/random.h>
+#include <facet/warp.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace bsdf_checks {
+
+using namespace facet;
+
+/// Parameters as (name, value) pairs; use std::string for strings (not const char*).
+using Params = std::vector<std::pair<std::string, Properties::Value>>;
+
+inline Properties make_props(const std::string &plugin, const Params &params = {}) {
+    Properties props(plugin);
+    for (const auto &[name, value] : params) props.set(name, value);
+    return props;
+}
+
+inline std::shared_ptr<BSDF> make_bsdf(const std::string &plugin, const Params &params = {}) {
+    return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, make_props(plugin, params));
+}
+
+/// Expects creating the BSDF to throw a facet::Error whose message contains `fragment`.
+inline void expect_error(const std::string &plugin, const Params &params, const std::string &fragment) {
+    try {
+        make_bsdf(plugin, params);
+        ADD_FAILURE() << plugin << ": expected an error containing \"" << fragment << "\"";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos)
+            << plugin << ": message \"" << e.what() << "\" lacks \"" << fragment << "\"";
+    }
+}
+
+inline SurfaceInteraction make_si(const Vector3f &wi) {
+    SurfaceInteraction si;
+    si.p = Point3f(0.f);
+    si.n = Normal3f(0.f, 0.f, 1.f);
+    si.t = 1.f;
+    si.uv = Point2f(0.5f, 0.5f);
+    si.dp_du = Vector3f(1.f, 0.f, 0.f);
+    si.dp_dv = Vector3f(0.f, 1.f, 0.f);
+    si.wi = wi;
+    return si;
+}
+
+/// Uniform direction on the sphere, or on the upper hemisphere; kept away from the horizon
+/// (|cos θ| >= 1e-2), where float results are legitimately fragile.
+inline Vector3f random_direction(PCG32 &rng, bool upper_only) {
+    for (;;) {
+        Vector3f v = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        if (upper_only) v.z = std::abs(v.z);
+        if (std::abs(v.z) >= 1e-2f) return v;
+    }
+}
+
+inline bool near_rel(float a, float b, float rel) {
+    return std::abs(a - b) <= rel * std::max(std::abs(a), std::abs(b)) + 1e-12f;
+}
+
+/**
+ * For `count` random incident directions (upper hemisphere unless `both_sides`): every sample
+ * with a density has weight == eval/pdf and bs.pdf == pdf() (relative `tol`), and eval_pdf()
+ * equals (eval(), pdf()) at the sampled direction and at a random one. Returns the number of
+ * smooth samples checked, so callers can make sure the check was not vacuous.
+ */
+inline int check_sample_eval_pdf(const BSDF &bsdf, const BSDFContext &ctx, bool both_sides,
+                                 int count = 2000, uint64_t seed = 1, float tol = 1e-3f) {
+    PCG32 rng(seed);
+    int checked = 0, failures = 0;
+    for (int i = 0; i < count && failures < 5; ++i) {
+        SurfaceInteraction si = make_si(random_direction(rng, !both_sides));
+        float s1 = rng.next_float();
+        Point2f s2(rng.next_float(), rng.next_float());
+        auto [bs, weight] = bsdf.sample(ctx, si, s1, s2);
+
+        Vector3f other = random_direction(rng, false);
+        auto [v_other, p_other] = bsdf.eval_pdf(ctx, si, other);
+        Color3f e_other = bsdf.eval(ctx, si, other);
+        float pdf_other = bsdf.pdf(ctx, si, other);
+        bool ok = near_rel(p_other, pdf_other, 1e-5f);
+        for (int c = 0; c < 3; ++c) ok &= near_rel(v_other[c], e_other[c], 1e-5f);
+        if (!ok) {
+            ++failures;
+            ADD_FAILURE() << "eval_pdf != (eval, pdf) at wi = " << si.wi << ", wo = " << other;
+        }
+
+        if (weight.is_black() || has_flag(bs.sampled_type, BSDFFlags::Delta)) continue;
+        EXPECT_TRUE(weight.is_finite());
+        EXPECT_NEAR(norm(bs.wo), 1.f, 1e-4f);
+        auto [value, pdf] = bsdf.eval_pdf(ctx, si, bs.wo);
+        Color3f expected = value / pdf;
+        ok = pdf > 0.f && near_rel(bs.pdf, pdf, tol);
+        for (int c = 0; c < 3; ++c) ok &= near_rel(weight[c], expected[c], tol);
+        if (!ok) {
+            ++failures;
+            ADD_FAILURE() << "wi = " << si.wi << ", wo = " << bs.wo << ": weight " << weight
+                          << " vs eval/pdf " << expected << ", sampled pdf " << bs.pdf
+                          << " vs pdf() " << pdf;
+        }
+        ++checked;
+    }
+    return checked;
+}
+
+/// Monte Carlo mean of the sample weights for incident direction wi (the albedo; failed samples
+/// count as zero). Radiance-mode refraction is compensated by η² so the result is energy.
+inline Color3f furnace(const BSDF &bsdf, const BSDFContext &ctx, const Vector3f &wi, int count,
+                       uint64_t seed = 7) {
+    PCG32 rng(seed);
+    SurfaceInteraction si = make_si(wi);
+    double sum[3] = {0, 0, 0};
+    for (int i = 0; i < count; ++i) {
+        float s1 = rng.next_float();
+        Point2f s2(rng.next_float(), rng.next_float());
+        auto [bs, weight] = bsdf.sample(ctx, si, s1, s2);
+        float scale = ctx.mode == TransportMode::Radiance ? bs.eta * bs.eta : 1.f;
+        for (int c = 0; c < 3; ++c) sum[c] += double(weight[c]) * scale;
+    }
+    return Color3f(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
+}
+
+/// Runs the project's chi-square test; on failure prints the summary and writes the observed and
+/// expected tables and a heat map next to the test binary.
+inline void expect_chi2(const Chi2Adapter &adapter, const std::string &name, Chi2Options opts = {}) {
+    Chi2Result result = run_chi2(adapter, opts);
+    EXPECT_TRUE(result.passed) << name << "\n" << result.summary();
+    if (!result.passed) {
+        write_chi2_tables(name + "_chi2.txt", result);
+        write_chi2_heatmap(name + "_chi2.png", result);
+    }
+}
+
+} // namespace bsdf_checks
