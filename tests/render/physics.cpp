@@ -1,0 +1,438 @@
+// Light transport against known answers: the white furnace, a diffuse plane under a point light,
+// and path tracing against direct illumination where both must agree.
+
+#include <facet/integrator.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/render.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/xml.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace facet;
+
+namespace {
+
+std::shared_ptr<Scene> load_scene_string(const std::string &xml,
+                                         const std::map<std::string, std::string> &params = {}) {
+    LoadOptions opts;
+    opts.params = params;
+    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml, opts));
+    if (!scene) throw std::runtime_error("not a scene");
+    return scene;
+}
+
+std::unique_ptr<Sampler> make_sampler() {
+    auto proto = PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler,
+                                                               Properties("independent"));
+    return proto->clone();
+}
+
+std::shared_ptr<SamplingIntegrator> make_integrator(const std::string &type,
+                                                    const std::vector<std::pair<std::string, int>> &ints = {},
+                                                    bool hide_emitters = false) {
+    Properties props(type);
+    for (const auto &[name, value] : ints) props.set_int(name, value);
+    if (hide_emitters) props.set_bool("hide_emitters", true);
+    return std::dynamic_pointer_cast<SamplingIntegrator>(
+        PluginRegistry::instance().create(ObjectType::Integrator, props));
+}
+
+/// Camera-less furnace scene: spheres of reflectance 1 inside constant environments.
+std::string furnace_xml(const std::string &integrator, const std::string &emitters,
+                        const std::string &shapes, int spp, int size = 64) {
+    return R"(<scene version="3.0.0">
+    )" + integrator + R"(
+    <sensor type="perspective">
+        <float name="fov" value="45"/>
+        <transform name="to_world">
+            <lookat origin="0, 0, 7" target="0, 0, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent">
+            <integer name="sample_count" value=")" + std::to_string(spp) + R"("/>
+        </sampler>
+        <film type="hdrfilm">
+            <integer name="width" value=")" + std::to_string(size) + R"("/>
+            <integer name="height" value=")" + std::to_string(size) + R"("/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    )" + emitters + shapes + R"(
+</scene>)";
+}
+
+const char *WHITE_SPHERES = R"(
+    <bsdf type="diffuse" id="white">
+        <rgb name="reflectance" value="1, 1, 1"/>
+    </bsdf>
+    <shape type="sphere">
+        <point name="center" x="-1.02" y="-0.3" z="0"/>
+        <float name="radius" value="1"/>
+        <ref id="white"/>
+    </shape>
+    <shape type="sphere">
+        <point name="center" x="1.02" y="-0.3" z="0"/>
+        <float name="radius" value="1"/>
+        <ref id="white"/>
+    </shape>
+    <shape type="sphere">
+        <point name="center" x="0" y="1.1" z="-0.6"/>
+        <float name="radius" value="0.9"/>
+        <ref id="white"/>
+    </shape>
+)";
+
+struct Stats {
+    double mean = 0, robust_sigma = 0, max_dev = 0;
+    size_t pixels = 0, noisy = 0;
+};
+
+/// Image statistics against an expected constant value: the mean, a robust per-pixel standard
+/// deviation (1.4826 · median absolute deviation over the pixels that are not exact) and the
+/// largest deviation of any pixel.
+Stats image_stats(const Image &img, float expected) {
+    Stats s;
+    std::vector<double> dev;
+    double sum = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                double v = img.at(x, y, c), d = std::abs(v - expected);
+                sum += v;
+                s.max_dev = std::max(s.max_dev, d);
+                if (d > 1e-6) dev.push_back(d);
+            }
+    s.pixels = size_t(img.width) * img.height * 3;
+    s.mean = sum / s.pixels;
+    s.noisy = dev.size();
+    if (!dev.empty()) {
+        std::nth_element(dev.begin(), dev.begin() + dev.size() / 2, dev.end());
+        s.robust_sigma = 1.4826 * dev[dev.size() / 2];
+    }
+    return s;
+}
+
+RenderResult render_scene(const Scene &scene, uint64_t seed = 0) {
+    RenderOptions opts;
+    opts.progress = false;
+    opts.seed = seed;
+    return render(scene, *scene.sensors().at(0), opts);
+}
+
+/// The white furnace: every pixel, sphere or background, must be 1.
+void check_furnace(const Image &img, double max_robust_sigma) {
+    ASSERT_GE(img.channels, 3);
+    Stats s = image_stats(img, 1.f);
+    // The spheres cover a good part of the image and are noisy; the background is exactly 1.
+    EXPECT_GT(s.noisy, s.pixels / 5);
+    EXPECT_LT(s.robust_sigma, max_robust_sigma);
+    // Standard error of the image mean: at most σ/√(noisy pixels) (pixels of a channel
+    // triple are correlated, hence the factor √3).
+    double mean_sigma = s.robust_sigma * std::sqrt(3.0 / std::max<size_t>(s.noisy, 1)) *
+                        double(s.noisy) / s.pixels;
+    EXPECT_NEAR(s.mean, 1.0, std::max(5.0 * mean_sigma, 1e-4)) << "image mean";
+    EXPECT_NEAR(s.mean, 1.0, 0.01);
+    EXPECT_LT(s.max_dev, 6.0 * s.robust_sigma + 1e-5) << "an outlier pixel";
+}
+
+} // namespace
+
+// ---- white furnace --------------------------------------------------------------------------
+
+TEST(Furnace, PathInterreflectingSpheres) {
+    auto scene = load_scene_string(furnace_xml(
+        R"(<integrator type="path"><integer name="max_depth" value="-1"/></integrator>)",
+        R"(<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>)",
+        WHITE_SPHERES, 64));
+    RenderResult r = render_scene(*scene);
+    check_furnace(r.image, 0.2);
+}
+
+TEST(Furnace, PathTwoEnvironments) {
+    // Two environment emitters: emitter sampling picks one of them, so MIS has to weigh each
+    // escaped ray against each emitter's own density.
+    auto scene = load_scene_string(furnace_xml(
+        R"(<integrator type="path"/>)",
+        R"(<emitter type="constant"><rgb name="radiance" value="0.25, 0.25, 0.25"/></emitter>
+           <emitter type="constant"><rgb name="radiance" value="0.75, 0.75, 0.75"/></emitter>)",
+        WHITE_SPHERES, 64));
+    RenderResult r = render_scene(*scene);
+    check_furnace(r.image, 0.2);
+}
+
+TEST(Furnace, DirectSingleSphere) {
+    // Light reflected once off a convex body escapes: direct illumination is the whole answer.
+    const char *sphere = R"(
+    <shape type="sphere">
+        <float name="radius" value="1.5"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="1, 1, 1"/></bsdf>
+    </shape>)";
+    for (const char *integrator :
+         {R"(<integrator type="direct"/>)",
+          R"(<integrator type="direct"><integer name="emitter_samples" value="3"/></integrator>)",
+          R"(<integrator type="path"><integer name="max_depth" value="2"/></integrator>)"}) {
+        auto scene = load_scene_string(furnace_xml(
+            integrator, R"(<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>)",
+            sphere, 32));
+        RenderResult r = render_scene(*scene);
+        SCOPED_TRACE(integrator);
+        check_furnace(r.image, 0.2);
+    }
+}
+
+// ---- point light over a diffuse plane ----------------------------------------------------------
+
+TEST(PointLight, DiffusePlaneRadiance) {
+    // Radiance leaving a diffuse plane lit by a point light of intensity I at height h:
+    // L = ρ/π · I cos θ / d² = ρ/π · I cos³θ / h². Emitter sampling of a single point light is
+    // exact, so both integrators must agree with it to float precision.
+    const float rho[3] = {0.2f, 0.5f, 0.8f}, intensity = 10.f, h = 2.f;
+    auto scene = load_scene_string(R"(<scene version="3.0.0">
+    <emitter type="point">
+        <point name="position" x="0" y="0" z="2"/>
+        <rgb name="intensity" value="10, 10, 10"/>
+    </emitter>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="20"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.5, 0.8"/></bsdf>
+    </shape>
+</scene>)");
+    auto sampler = make_sampler();
+    for (const auto &integrator :
+         {make_integrator("path"), make_integrator("path", {{"max_depth", 2}}),
+          make_integrator("direct"), make_integrator("direct", {{"emitter_samples", 4}})}) {
+        ASSERT_TRUE(integrator);
+        SCOPED_TRACE(integrator->to_string());
+        for (float x : {0.f, 0.5f, 1.f, 2.f, 3.5f, 6.f}) {
+            Ray ray(Point3f(x, 0.3f * x, 5.f), Vector3f(0.f, 0.f, -1.f));
+            float cos_theta = h / std::sqrt(sqr(x) + sqr(0.3f * x) + sqr(h));
+            sampler->seed(uint64_t(x * 100));
+            Color3f L = integrator->sample(*scene, *sampler, ray, nullptr);
+            for (int c = 0; c < 3; ++c) {
+                float expected = rho[c] * InvPi * intensity * std::pow(cos_theta, 3.f) / sqr(h);
+                EXPECT_NEAR(L[c], expected, 1e-4f * expected) << "x = " << x << ", channel " << c;
+            }
+        }
+        // The light cannot be seen and the plane's back side is black.
+        sampler->seed(1);
+        EXPECT_TRUE(integrator->sample(*scene, *sampler, Ray(Point3f(0.f, 0.f, 5.f), Vector3f(0.f, 0.f, 1.f)), nullptr).is_black());
+        EXPECT_TRUE(integrator->sample(*scene, *sampler, Ray(Point3f(0.f, 0.f, -5.f), Vector3f(0.f, 0.f, 1.f)), nullptr).is_black());
+    }
+}
+
+TEST(PointLight, RenderedPlaneRadiance) {
+    // The same through the whole render loop: a camera looking straight down at the plane; the
+    // centre pixel sees the point below the light.
+    auto scene = load_scene_string(R"(<scene version="3.0.0">
+    <integrator type="path"/>
+    <sensor type="perspective">
+        <float name="fov" value="30"/>
+        <transform name="to_world">
+            <lookat origin="0, 0, 10" target="0, 0, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="33"/>
+            <integer name="height" value="33"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="point">
+        <point name="position" x="0" y="0" z="1"/>
+        <rgb name="intensity" value="5, 5, 5"/>
+    </emitter>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="20"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.5, 0.5"/></bsdf>
+    </shape>
+</scene>)");
+    RenderResult r = render_scene(*scene);
+    const Image &img = r.image;
+    ASSERT_EQ(img.width, 33);
+    // The centre pixel spans about ±0.08 around the axis; the radiance there is within 3% of
+    // the on-axis value ρ/π · I/h² and slightly below it.
+    float expected = 0.5f * InvPi * 5.f;
+    float centre = img.at(16, 16, 1);
+    EXPECT_LT(centre, expected);
+    EXPECT_GT(centre, 0.97f * expected);
+    // Symmetry: mirrored pixels agree, and radiance falls off away from the centre.
+    EXPECT_NEAR(img.at(4, 16, 0), img.at(28, 16, 0), 3e-2f * img.at(4, 16, 0));
+    EXPECT_NEAR(img.at(16, 4, 0), img.at(16, 28, 0), 3e-2f * img.at(16, 4, 0));
+    EXPECT_LT(img.at(4, 16, 0), 0.5f * centre);
+}
+
+// ---- path vs direct ------------------------------------------------------------------------
+
+namespace {
+
+const char *CORNER_SCENE = R"(<scene version="3.0.0">
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="4"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.5, 0.3"/></bsdf>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale value="4"/>
+            <rotate x="1" angle="90"/>
+            <translate y="2" z="2"/>
+        </transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.4, 0.6, 0.5"/></bsdf>
+    </shape>
+    <shape type="sphere">
+        <point name="center" x="0.5" y="0" z="0.8"/>
+        <float name="radius" value="0.8"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.4, 0.9"/></bsdf>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale x="0.6" y="0.4" z="1"/>
+            <rotate x="1" angle="180"/>
+            <translate x="-0.5" y="0.5" z="3"/>
+        </transform>
+        <emitter type="area"><rgb name="radiance" value="12, 10, 8"/></emitter>
+    </shape>
+    <emitter type="point">
+        <point name="position" x="2" y="-1" z="2"/>
+        <rgb name="intensity" value="3, 3, 3"/>
+    </emitter>
+</scene>)";
+
+struct PixelEstimates {
+    std::vector<double> mean, var; ///< per pixel and channel: mean and variance of the mean
+};
+
+/// Radiance along a fixed grid of camera rays, `spp` samples each, with the variance of each mean.
+PixelEstimates estimate(const Scene &scene, const SamplingIntegrator &integrator, int res, int spp,
+                        uint64_t seed) {
+    PixelEstimates e;
+    e.mean.assign(size_t(res) * res * 3, 0.0);
+    e.var.assign(size_t(res) * res * 3, 0.0);
+    auto sampler = make_sampler();
+    Point3f origin(0.5f, -6.f, 2.5f);
+    for (int y = 0; y < res; ++y)
+        for (int x = 0; x < res; ++x) {
+            size_t pixel = size_t(y) * res + x;
+            Vector3f d = normalize(Vector3f(-1.4f + 2.8f * (x + 0.5f) / res, 6.f,
+                                            1.2f - 3.f * (y + 0.5f) / res));
+            Ray ray(origin, d);
+            sampler->seed(seed * 1000003u + pixel);
+            double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
+            for (int s = 0; s < spp; ++s) {
+                Color3f L = integrator.sample(scene, *sampler, ray, nullptr);
+                sampler->advance();
+                for (int c = 0; c < 3; ++c) {
+                    sum[c] += L[c];
+                    sum2[c] += double(L[c]) * L[c];
+                }
+            }
+            for (int c = 0; c < 3; ++c) {
+                double m = sum[c] / spp;
+                e.mean[pixel * 3 + c] = m;
+                e.var[pixel * 3 + c] = std::max(0.0, sum2[c] / spp - m * m) / (spp - 1);
+            }
+        }
+    return e;
+}
+
+void compare(const PixelEstimates &a, const PixelEstimates &b, double max_z) {
+    double sum_a = 0, sum_b = 0, var_sum = 0, worst = 0;
+    size_t worst_index = 0, lit = 0;
+    for (size_t i = 0; i < a.mean.size(); ++i) {
+        sum_a += a.mean[i];
+        sum_b += b.mean[i];
+        double var = a.var[i] + b.var[i];
+        var_sum += var;
+        if (a.mean[i] > 0 || b.mean[i] > 0) ++lit;
+        double diff = std::abs(a.mean[i] - b.mean[i]);
+        if (var == 0) {
+            EXPECT_NEAR(a.mean[i], b.mean[i], 1e-5 * std::max(1.0, a.mean[i])) << "pixel " << i / 3;
+            continue;
+        }
+        double z = diff / std::sqrt(var);
+        if (z > worst) {
+            worst = z;
+            worst_index = i;
+        }
+    }
+    EXPECT_GT(lit, a.mean.size() / 2);
+    EXPECT_LT(worst, max_z) << "pixel " << worst_index / 3 << " channel " << worst_index % 3
+                            << ": " << a.mean[worst_index] << " vs " << b.mean[worst_index];
+    double z_mean = std::abs(sum_a - sum_b) / std::sqrt(var_sum);
+    EXPECT_LT(z_mean, 4.0) << "image means " << sum_a / a.mean.size() << " vs "
+                           << sum_b / b.mean.size();
+}
+
+} // namespace
+
+TEST(PathVsDirect, DirectIllumination) {
+    auto scene = load_scene_string(CORNER_SCENE);
+    const int res = 24, spp = 128;
+    auto path = make_integrator("path", {{"max_depth", 2}});
+    auto direct = make_integrator("direct");
+    auto direct_more = make_integrator("direct", {{"emitter_samples", 2}, {"bsdf_samples", 3}});
+    PixelEstimates p = estimate(*scene, *path, res, spp, 1);
+    PixelEstimates d = estimate(*scene, *direct, res, spp, 2);
+    PixelEstimates d2 = estimate(*scene, *direct_more, res, spp / 2, 3);
+    // 24·24·3 z-scores per comparison: 5.5 σ keeps the family-wise false alarm rate low.
+    compare(p, d, 5.5);
+    compare(d, d2, 5.5);
+}
+
+TEST(PathVsDirect, DepthOneAndHiddenEmitters) {
+    auto scene = load_scene_string(CORNER_SCENE);
+    auto sampler = make_sampler();
+    sampler->seed(4);
+    // Straight at the area light from below: its radiance, and nothing else at depth 1.
+    Ray up(Point3f(-0.5f, 0.5f, 0.5f), Vector3f(0.f, 0.f, 1.f));
+    Ray floor(Point3f(-1.f, -1.f, 2.f), Vector3f(0.f, 0.f, -1.f));
+    for (const char *type : {"path", "direct"}) {
+        // The emitter's own surface reflects light too: same samples, with and without emission.
+        auto emitted = make_integrator(type, {});
+        sampler->seed(4);
+        Color3f L = emitted->sample(*scene, *sampler, up, nullptr);
+        EXPECT_GT(L.r, 12.f) << type;
+        auto hidden = make_integrator(type, {}, true);
+        sampler->seed(4);
+        Color3f Lh = hidden->sample(*scene, *sampler, up, nullptr);
+        EXPECT_NEAR(Lh.r, L.r - 12.f, 1e-5f) << type;
+    }
+    auto depth1 = make_integrator("path", {{"max_depth", 1}});
+    Color3f L = depth1->sample(*scene, *sampler, up, nullptr);
+    EXPECT_NEAR(L.r, 12.f, 1e-5f);
+    EXPECT_NEAR(L.g, 10.f, 1e-5f);
+    EXPECT_TRUE(depth1->sample(*scene, *sampler, floor, nullptr).is_black());
+    auto depth0 = make_integrator("path", {{"max_depth", 0}});
+    EXPECT_TRUE(depth0->sample(*scene, *sampler, up, nullptr).is_black());
+}
+
+TEST(PathVsDirect, HiddenEnvironment) {
+    auto scene = load_scene_string(R"(<scene version="3.0.0">
+    <emitter type="constant"><rgb name="radiance" value="0.5, 1, 2"/></emitter>
+    <shape type="sphere"><float name="radius" value="1"/></shape>
+</scene>)");
+    auto sampler = make_sampler();
+    sampler->seed(5);
+    Ray miss(Point3f(0.f, 0.f, 5.f), Vector3f(0.f, 0.f, 1.f));
+    for (const char *type : {"path", "direct"}) {
+        Color3f L = make_integrator(type)->sample(*scene, *sampler, miss, nullptr);
+        EXPECT_NEAR(L.r, 0.5f, 1e-6f);
+        EXPECT_NEAR(L.b, 2.f, 1e-6f);
+        EXPECT_TRUE(make_integrator(type, {}, true)->sample(*scene, *sampler, miss, nullptr).is_black());
+    }
+}
+
+TEST(Integrators, RejectBadParameters) {
+    EXPECT_THROW(make_integrator("path", {{"max_depth", -2}}), Error);
+    EXPECT_THROW(make_integrator("path", {{"rr_depth", 0}}), Error);
+    EXPECT_THROW(make_integrator("direct", {{"shading_samples", 2}, {"emitter_samples", 1}}), Error);
+    EXPECT_THROW(make_integrator("direct", {{"emitter_samples", 0}, {"bsdf_samples", 0}}), Error);
+    EXPECT_THROW(make_integrator("direct", {{"bsdf_samples", -1}}), Error);
+}
