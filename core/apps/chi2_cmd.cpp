@@ -27,7 +27,7 @@ struct CommonOptions {
     uint32_t tests = 1;
     double significance = 0.01;
     int ires = 7;
-    bool adaptive = false;
+    bool adaptive = false, fixed = false;
     std::string out;
     std::vector<std::string> plugin_dirs;
     bool quiet = false;
@@ -41,7 +41,10 @@ void add_common(CLI::App &app, CommonOptions &o) {
                    "Number of tests run together: the level is Sidak-corrected (default 1)");
     app.add_option("--significance", o.significance, "Family-wise significance level (default 0.01)");
     app.add_option("--ires", o.ires, "Simpson points per axis and cell of the fixed rule (default 7)");
-    app.add_flag("--adaptive", o.adaptive, "Integrate the pdf with adaptive Simpson");
+    app.add_flag("--adaptive", o.adaptive, "Integrate the pdf with adaptive Simpson (the default)");
+    app.add_flag("--fixed", o.fixed,
+                 "Integrate the pdf with the fixed Simpson rule on --ires points (faster, but "
+                 "misses lobes narrower than its spacing)");
     app.add_option("--out", o.out,
                    "Write the heat map (PNG) and tables here, also when the test passes "
                    "(failures always go to ./chi2-failures)");
@@ -103,7 +106,8 @@ int run(const Chi2Adapter &adapter, const CommonOptions &o, const std::string &f
     opts.test_count = std::max(1u, o.tests);
     opts.significance = o.significance;
     opts.ires = o.ires;
-    opts.adaptive = o.adaptive;
+    if (o.adaptive && o.fixed) FACET_THROW("give either --adaptive or --fixed");
+    opts.adaptive = !o.fixed;
     if (!(o.significance > 0.0 && o.significance < 1.0))
         FACET_THROW("--significance {} must be in (0, 1)", o.significance);
 
