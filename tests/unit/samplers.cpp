@@ -125,3 +125,20 @@ TEST(Samplers, SampleCountRounding) {
     EXPECT_EQ(make_sampler("ldsampler", 10)->sample_count(), 16u);
     EXPECT_EQ(make_sampler("multijitter", 10)->sample_count(), 10u);
 }
+
+TEST(Samplers, MultijitterStratifiesGridAndProjections) {
+    const int n = 24; // a 4 x 6 grid
+    auto s = make_sampler("multijitter", n)->clone();
+    s->seed(11);
+    std::vector<int> xs(n, 0), ys(n, 0);
+    for (int i = 0; i < n; ++i) {
+        Point2f p = s->next_2d();
+        xs[size_t(p.x * n)]++;
+        ys[size_t(p.y * n)]++;
+        s->advance();
+    }
+    for (int i = 0; i < n; ++i) {
+        EXPECT_EQ(xs[size_t(i)], 1) << "x stratum " << i;
+        EXPECT_EQ(ys[size_t(i)], 1) << "y stratum " << i;
+    }
+}
