@@ -154,7 +154,7 @@ Scene::Scene(const Properties &props) {
         if (emitter->is_infinite())
             m_environment.push_back(emitter);
 
-    m_device = embree_device();
+    m_device = facet::embree_device(); // the free function, not the accessor of the same name
     rtcRetainDevice(m_device);
     m_rtc_scene = rtcNewScene(m_device);
     rtcSetSceneFlags(m_rtc_scene, RTC_SCENE_FLAG_ROBUST);
