@@ -126,6 +126,29 @@ struct TempFileGuard {
     }
 };
 
+/// Portable float map writer. OpenImageIO 2.4 reads PFM but has no PFM writer, and the format
+/// is a 3-line header plus raw little-endian floats, bottom row first.
+bool write_pfm(const std::string &file, const float *pixels, int width, int height, int channels,
+               std::string &err) {
+    std::FILE *f = std::fopen(file.c_str(), "wb");
+    if (!f) {
+        err = std::strerror(errno);
+        return false;
+    }
+    bool ok = std::fprintf(f, "%s\n%d %d\n-1.0\n", channels == 1 ? "Pf" : "PF", width, height) > 0;
+    static_assert(sizeof(float) == 4, "PFM stores 32-bit floats");
+    for (int y = height - 1; ok && y >= 0; --y) {
+        const size_t n = size_t(width) * size_t(channels);
+        ok = std::fwrite(pixels + size_t(y) * n, sizeof(float), n, f) == n;
+    }
+    if (!ok) err = std::strerror(errno);
+    if (std::fclose(f) != 0 && ok) {
+        ok = false;
+        err = std::strerror(errno);
+    }
+    return ok;
+}
+
 } // namespace
 
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts) {
@@ -138,9 +161,10 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path, dir.string());
 
     const std::string ext = lower_extension(path);
+    const bool pfm = ext == ".pfm";
     // The plugin is chosen by the target's extension; the data goes to a temporary file first.
-    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path);
-    if (!out)
+    std::unique_ptr<OIIO::ImageOutput> out = pfm ? nullptr : OIIO::ImageOutput::create(path);
+    if (!out && !pfm)
         FACET_THROW("cannot write image \"{}\": no image format for the extension \"{}\" ({})", path, ext,
                     OIIO::geterror());
 
@@ -193,16 +217,22 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
 
     const std::string tmp = temp_path_for(path);
     TempFileGuard guard{tmp};
-    if (!out->open(tmp, spec))
+    if (pfm) {
+        std::string err;
+        if (!write_pfm(tmp, static_cast<const float *>(pixels), spec.width, spec.height, spec.nchannels, err))
+            FACET_THROW("cannot write image \"{}\": {}", path, err);
+    } else if (!out->open(tmp, spec))
         FACET_THROW("cannot write image \"{}\": {}", path, out->geterror());
-    bool ok = out->write_image(pixel_type, pixels);
-    std::string err = ok ? "" : out->geterror();
-    if (!out->close() && ok) {
-        ok = false;
-        err = out->geterror();
+    if (out) {
+        bool ok = out->write_image(pixel_type, pixels);
+        std::string err = ok ? "" : out->geterror();
+        if (!out->close() && ok) {
+            ok = false;
+            err = out->geterror();
+        }
+        out.reset();
+        if (!ok) FACET_THROW("cannot write image \"{}\": {}", path, err);
     }
-    out.reset();
-    if (!ok) FACET_THROW("cannot write image \"{}\": {}", path, err);
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
         FACET_THROW("cannot write image \"{}\": renaming the temporary file failed: {}", path,
                     std::strerror(errno));

@@ -1,0 +1,319 @@
+// Reconstruction filters, image blocks and the film: weights, radii, block accumulation, crop
+// window checks and developing known samples.
+#include <facet/film.h>
+#include <facet/plugin.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+using namespace facet;
+
+namespace {
+
+std::shared_ptr<ReconstructionFilter> make_filter(const std::string &name, Properties props = {}) {
+    props.set_plugin_name(name);
+    return PluginRegistry::instance().create_as<ReconstructionFilter>(ObjectType::ReconstructionFilter,
+                                                                      props);
+}
+
+std::shared_ptr<Film> make_film(Properties props) {
+    props.set_plugin_name("hdrfilm");
+    return PluginRegistry::instance().create_as<Film>(ObjectType::Film, props);
+}
+
+std::string error_of(const std::function<void()> &f) {
+    try {
+        f();
+    } catch (const Error &e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+/// Weight stored at block pixel (x, y) of the storage (border included).
+float block_weight(const ImageBlock &b, int x, int y) {
+    const int nc = b.channel_count();
+    return b.data()[(size_t(y) * b.storage_size().x + x) * nc + nc - 1];
+}
+
+} // namespace
+
+TEST(Filters, BoxWeightsAndRadius) {
+    auto box = make_filter("box");
+    EXPECT_FLOAT_EQ(box->radius(), 0.5f);
+    EXPECT_EQ(box->eval(0.f), 1.f);
+    EXPECT_EQ(box->eval(0.49f), 1.f);
+    EXPECT_EQ(box->eval(-0.5f), 1.f);
+    EXPECT_EQ(box->eval(0.5f), 0.f); // half-open: a boundary sample belongs to one pixel
+    EXPECT_EQ(box->eval(0.7f), 0.f);
+    EXPECT_EQ(ImageBlock::border_for(*box), 1);
+}
+
+TEST(Filters, TentWeightsAndRadius) {
+    auto tent = make_filter("tent");
+    EXPECT_FLOAT_EQ(tent->radius(), 1.f);
+    EXPECT_FLOAT_EQ(tent->eval(0.f), 1.f);
+    EXPECT_FLOAT_EQ(tent->eval(0.25f), 0.75f);
+    EXPECT_FLOAT_EQ(tent->eval(-0.5f), 0.5f);
+    EXPECT_FLOAT_EQ(tent->eval(1.f), 0.f);
+    EXPECT_FLOAT_EQ(tent->eval(1.5f), 0.f);
+
+    Properties p;
+    p.set_float("radius", 2.0);
+    auto wide = make_filter("tent", p);
+    EXPECT_FLOAT_EQ(wide->radius(), 2.f);
+    EXPECT_FLOAT_EQ(wide->eval(1.f), 0.5f);
+    EXPECT_EQ(ImageBlock::border_for(*wide), 2);
+
+    Properties bad;
+    bad.set_float("radius", -1.0);
+    EXPECT_NE(error_of([&] { make_filter("tent", bad); }).find("radius"), std::string::npos);
+}
+
+TEST(Filters, GaussianWeightsAndRadius) {
+    auto g = make_filter("gaussian");
+    EXPECT_FLOAT_EQ(g->radius(), 2.f); // 4 standard deviations of 0.5
+    const float bias = std::exp(-0.5f * 16.f);
+    EXPECT_NEAR(g->eval(0.f), 1.f - bias, 1e-6f);
+    EXPECT_NEAR(g->eval(0.5f), std::exp(-0.5f) - bias, 1e-6f);
+    EXPECT_NEAR(g->eval(-1.f), std::exp(-2.f) - bias, 1e-6f);
+    EXPECT_EQ(g->eval(2.f), 0.f);
+    EXPECT_EQ(g->eval(3.f), 0.f);
+    EXPECT_EQ(ImageBlock::border_for(*g), 2);
+
+    Properties p;
+    p.set_float("stddev", 0.25);
+    auto narrow = make_filter("gaussian", p);
+    EXPECT_FLOAT_EQ(narrow->radius(), 1.f);
+    EXPECT_NEAR(narrow->eval(0.25f), std::exp(-0.5f) - std::exp(-8.f), 1e-6f);
+
+    Properties bad;
+    bad.set_float("stddev", 0.0);
+    EXPECT_NE(error_of([&] { make_filter("gaussian", bad); }).find("stddev"), std::string::npos);
+}
+
+TEST(ImageBlock, BoxSampleLandsInOnePixel) {
+    auto box = make_filter("box");
+    ImageBlock block;
+    block.reset({10, 20}, {4, 4}, ImageBlock::border_for(*box));
+    ASSERT_EQ(block.channel_count(), 4);
+    ASSERT_EQ(block.storage_size(), Point2i(6, 6));
+    // Film pixel (12, 21) is storage pixel (12 - 10 + 1, 21 - 20 + 1) = (3, 2).
+    block.put({12.3f, 21.9f}, Color3f(1.f, 2.f, 3.f), *box);
+    // A sample exactly on the left/top edge of a pixel belongs to that pixel.
+    block.put({11.0f, 20.0f}, Color3f(4.f), *box);
+    float total = 0.f;
+    for (int y = 0; y < 6; ++y)
+        for (int x = 0; x < 6; ++x) total += block_weight(block, x, y);
+    EXPECT_EQ(total, 2.f);
+    EXPECT_EQ(block_weight(block, 3, 2), 1.f);
+    EXPECT_EQ(block_weight(block, 2, 1), 1.f);
+    const float *p = block.data().data() + (2 * 6 + 3) * 4;
+    EXPECT_EQ(p[0], 1.f);
+    EXPECT_EQ(p[1], 2.f);
+    EXPECT_EQ(p[2], 3.f);
+}
+
+TEST(ImageBlock, GaussianSpreadsSymmetricallyAndDevelopsToTheSample) {
+    auto g = make_filter("gaussian");
+    ImageBlock block;
+    block.reset({0, 0}, {8, 8}, ImageBlock::border_for(*g));
+    // A sample at the centre of film pixel (4, 4) = storage pixel (6, 6).
+    block.put({4.5f, 4.5f}, Color3f(2.f, 1.f, 0.5f), *g);
+    const float w0 = block_weight(block, 6, 6);
+    EXPECT_NEAR(w0, g->eval(0.f) * g->eval(0.f), 1e-6f);
+    // Separable weights, symmetric around the centre, reaching 1 pixel in each direction
+    // (pixel centres 2 away sit on the radius and get zero).
+    EXPECT_NEAR(block_weight(block, 7, 6), g->eval(1.f) * g->eval(0.f), 1e-6f);
+    EXPECT_EQ(block_weight(block, 7, 6), block_weight(block, 5, 6));
+    EXPECT_EQ(block_weight(block, 6, 7), block_weight(block, 6, 5));
+    EXPECT_NEAR(block_weight(block, 7, 7), g->eval(1.f) * g->eval(1.f), 1e-6f);
+    EXPECT_EQ(block_weight(block, 8, 6), 0.f);
+    int touched = 0;
+    for (int y = 0; y < block.storage_size().y; ++y)
+        for (int x = 0; x < block.storage_size().x; ++x) touched += block_weight(block, x, y) > 0.f;
+    EXPECT_EQ(touched, 9);
+
+    // Developed, every touched pixel holds exactly the sample's value (Σ w·L / Σ w).
+    Properties fp;
+    fp.set_int("width", 8);
+    fp.set_int("height", 8);
+    auto film = make_film(fp);
+    film->prepare();
+    film->put_block(block);
+    Image img = film->develop();
+    ASSERT_EQ(img.channels, 3);
+    for (int y = 3; y <= 5; ++y)
+        for (int x = 3; x <= 5; ++x) {
+            EXPECT_NEAR(img.at(x, y, 0), 2.f, 1e-6f);
+            EXPECT_NEAR(img.at(x, y, 1), 1.f, 1e-6f);
+            EXPECT_NEAR(img.at(x, y, 2), 0.5f, 1e-6f);
+        }
+    EXPECT_EQ(img.at(2, 4, 0), 0.f); // no weight -> 0
+}
+
+TEST(ImageBlock, OffCentreGaussianWeightsFollowTheFilter) {
+    auto g = make_filter("gaussian");
+    ImageBlock block;
+    block.reset({0, 0}, {8, 8}, 2);
+    block.put({3.2f, 5.9f}, Color3f(1.f), *g);
+    // Film pixel (x, y) is storage (x + 2, y + 2); the filter argument is pos - centre.
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            float expected = g->eval(3.2f - (x + 0.5f)) * g->eval(5.9f - (y + 0.5f));
+            EXPECT_NEAR(block_weight(block, x + 2, y + 2), expected, 1e-6f) << x << "," << y;
+        }
+}
+
+TEST(ImageBlock, AOVChannels) {
+    auto box = make_filter("box");
+    ImageBlock block;
+    block.reset({0, 0}, {2, 2}, 1, 2);
+    EXPECT_EQ(block.channel_count(), 6);
+    const float aovs[2] = {0.25f, 7.f};
+    block.put({1.5f, 0.5f}, Color3f(1.f), aovs, *box);
+    block.put({1.5f, 0.5f}, Color3f(3.f), aovs, *box);
+
+    Properties fp;
+    fp.set_int("width", 2);
+    fp.set_int("height", 2);
+    auto film = make_film(fp);
+    film->prepare({"albedo.R", "depth"});
+    film->put_block(block);
+    Image img = film->develop();
+    ASSERT_EQ(img.channels, 5);
+    EXPECT_EQ(img.channel_names, (std::vector<std::string>{"R", "G", "B", "albedo.R", "depth"}));
+    EXPECT_FLOAT_EQ(img.at(1, 0, 0), 2.f);
+    EXPECT_FLOAT_EQ(img.at(1, 0, 3), 0.25f);
+    EXPECT_FLOAT_EQ(img.at(1, 0, 4), 7.f);
+    EXPECT_EQ(img.at(0, 0, 4), 0.f);
+
+    ImageBlock plain;
+    plain.reset({0, 0}, {2, 2}, 1);
+    EXPECT_THROW(film->put_block(plain), Error); // channel count mismatch
+}
+
+TEST(Film, Defaults) {
+    auto film = make_film({});
+    EXPECT_EQ(film->size(), Point2i(768, 576));
+    EXPECT_EQ(film->crop_offset(), Point2i(0, 0));
+    EXPECT_EQ(film->crop_size(), Point2i(768, 576));
+    EXPECT_FLOAT_EQ(film->rfilter().radius(), 2.f); // gaussian
+    EXPECT_TRUE(film->half());
+    EXPECT_FALSE(film->has_alpha());
+    EXPECT_EQ(film->default_extension(), ".exr");
+}
+
+TEST(Film, CropWindowValidation) {
+    auto with = [](std::initializer_list<std::pair<const char *, int>> values) {
+        Properties p;
+        p.set_int("width", 100);
+        p.set_int("height", 50);
+        for (auto &[k, v] : values) p.set_int(k, v);
+        return p;
+    };
+    auto film = make_film(with({{"crop_offset_x", 10}, {"crop_offset_y", 5}}));
+    EXPECT_EQ(film->crop_offset(), Point2i(10, 5));
+    EXPECT_EQ(film->crop_size(), Point2i(90, 45)); // the rest of the film
+    film = make_film(with({{"crop_offset_x", 10}, {"crop_width", 20}, {"crop_height", 50}}));
+    EXPECT_EQ(film->crop_size(), Point2i(20, 50));
+
+    EXPECT_NE(error_of([&] { make_film(with({{"crop_offset_x", 90}, {"crop_width", 20}})); }).find("crop window"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] { make_film(with({{"crop_height", 51}})); }).find("inside the 100x50 film"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] { make_film(with({{"crop_offset_y", -1}})); }).find("crop offset"), std::string::npos);
+    EXPECT_NE(error_of([&] { make_film(with({{"crop_offset_x", 100}})); }).find("crop offset"), std::string::npos);
+    EXPECT_NE(error_of([&] { make_film(with({{"crop_width", 0}})); }).find("crop window"), std::string::npos);
+    EXPECT_NE(error_of([&] { make_film(with({{"width", 0}})); }).find("width"), std::string::npos);
+}
+
+TEST(Film, PutBlockKeepsOnlyTheCropWindow) {
+    Properties p;
+    p.set_int("width", 8);
+    p.set_int("height", 8);
+    p.set_int("crop_offset_x", 2);
+    p.set_int("crop_offset_y", 3);
+    p.set_int("crop_width", 4);
+    p.set_int("crop_height", 2);
+    auto film = make_film(p);
+    auto box = make_filter("box");
+    film->prepare();
+    ImageBlock block;
+    block.reset({2, 3}, {4, 2}, 1);
+    // Inside the crop: pixel (3, 4) -> crop pixel (1, 1).
+    block.put({3.5f, 4.5f}, Color3f(1.f, 2.f, 3.f), *box);
+    block.put({3.5f, 4.5f}, Color3f(3.f, 2.f, 1.f), *box);
+    // In the border, outside the crop window: dropped.
+    block.put({1.5f, 4.5f}, Color3f(100.f), *box);
+    film->put_block(block);
+    Image img = film->develop();
+    ASSERT_EQ(img.width, 4);
+    ASSERT_EQ(img.height, 2);
+    EXPECT_FLOAT_EQ(img.at(1, 1, 0), 2.f);
+    EXPECT_FLOAT_EQ(img.at(1, 1, 1), 2.f);
+    EXPECT_FLOAT_EQ(img.at(1, 1, 2), 2.f);
+    float sum = std::accumulate(img.data.begin(), img.data.end(), 0.f);
+    EXPECT_FLOAT_EQ(sum, 6.f);
+}
+
+TEST(Film, DevelopKnownSamplesWithAlphaAndLuminance) {
+    Properties p;
+    p.set_int("width", 2);
+    p.set_int("height", 1);
+    p.set_string("pixel_format", "rgba");
+    auto film = make_film(p);
+    auto box = make_filter("box");
+    film->prepare();
+    ImageBlock block;
+    block.reset({0, 0}, {2, 1}, 1);
+    block.put({0.2f, 0.5f}, Color3f(1.f, 0.f, 0.f), *box);
+    block.put({0.7f, 0.1f}, Color3f(0.f, 1.f, 0.f), *box);
+    block.put({0.9f, 0.9f}, Color3f(0.f, 0.f, 4.f), *box);
+    film->put_block(block);
+    Image img = film->develop();
+    ASSERT_EQ(img.channels, 4);
+    EXPECT_EQ(img.channel_names[3], "A");
+    EXPECT_FLOAT_EQ(img.at(0, 0, 0), 1.f / 3.f);
+    EXPECT_FLOAT_EQ(img.at(0, 0, 1), 1.f / 3.f);
+    EXPECT_FLOAT_EQ(img.at(0, 0, 2), 4.f / 3.f);
+    EXPECT_EQ(img.at(0, 0, 3), 1.f);
+    EXPECT_EQ(img.at(1, 0, 3), 0.f); // no samples: alpha 0
+    EXPECT_EQ(img.at(1, 0, 0), 0.f);
+
+    p = Properties();
+    p.set_int("width", 1);
+    p.set_int("height", 1);
+    p.set_string("pixel_format", "luminance");
+    film = make_film(p);
+    film->prepare();
+    block.reset({0, 0}, {1, 1}, 1);
+    block.put({0.5f, 0.5f}, Color3f(1.f, 0.5f, 0.25f), *box);
+    film->put_block(block);
+    img = film->develop();
+    ASSERT_EQ(img.channels, 1);
+    EXPECT_EQ(img.channel_names[0], "Y");
+    EXPECT_NEAR(img.at(0, 0, 0), Color3f(1.f, 0.5f, 0.25f).luminance(), 1e-6f);
+}
+
+TEST(Film, HdrfilmFormatsAndErrors) {
+    Properties p;
+    p.set_string("component_format", "float32");
+    p.set_string("file_format", "pfm");
+    auto film = make_film(p);
+    EXPECT_FALSE(film->half());
+    EXPECT_EQ(film->default_extension(), ".pfm");
+
+    Properties bad;
+    bad.set_string("pixel_format", "cmyk");
+    std::string e = error_of([&] { make_film(bad); });
+    EXPECT_NE(e.find("rgb, rgba, luminance"), std::string::npos) << e;
+    Properties bad2;
+    bad2.set_string("component_format", "uint32");
+    EXPECT_NE(error_of([&] { make_film(bad2); }).find("float16 or float32"), std::string::npos);
+    Properties bad3;
+    bad3.set_string("file_format", "tiff");
+    EXPECT_NE(error_of([&] { make_film(bad3); }).find("openexr"), std::string::npos);
+}
