@@ -76,12 +76,9 @@ public:
         // Jacobian of the half-vector map for reflection, dωm/dωo = 1/(4 wo·m) (Walter eq. 14).
         bs.pdf = pdf_m / (4.f * wi_dot_m);
 
-        // weight = f·cos θo / pdf with f·cos θo = F·D·G/(4 cos θi):
-        //   visible normals (pdf_m = D·G1(wi)·(wi·m)/cos θi): F·G1(wo, m);
-        //   all normals (pdf_m = D·cos θm): F·G·(wi·m)/(cos θi·cos θm).
-        float weight = distr.sample_visible()
-                           ? distr.smith_g1(bs.wo, m)
-                           : distr.G(si.wi, bs.wo, m) * wi_dot_m / (cos_i * Frame::cos_theta(m));
+        // weight = f·cos θo / pdf with f·cos θo = F·D·G/(4 cos θi): F times G1(wo, m) for
+        // visible normals, F·G·(wi·m)/(cos θi·cos θm) for all normals (see sample_weight).
+        float weight = distr.sample_weight(si.wi, bs.wo, m, distr);
         if (!(weight > 0.f)) return {bs, Color3f(0.f)};
         Color3f F = fresnel_conductor(wi_dot_m, m_eta->eval(si), m_k->eval(si));
         return {bs, F * m_specular_reflectance->eval(si) * weight};

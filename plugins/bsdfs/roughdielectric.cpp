@@ -116,14 +116,10 @@ public:
         }
         bs.pdf *= std::abs(dm_dwo);
 
-        // f·|cos θo| / pdf reduces to (lobe factor)·G1(wo, m) for visible normals (the D·G1(wi)
-        // terms and the Jacobians cancel) and to D·G·|wi·m| / (D_s·|cos θi|·cos θm) for normals
-        // drawn from the (possibly widened) distribution D_s.
-        if (distr.sample_visible())
-            weight *= distr.smith_g1(bs.wo, m);
-        else
-            weight *= distr.eval(m) * distr.G(si.wi, bs.wo, m) * std::abs(wi_dot_m) /
-                      (pdf_m * std::abs(cos_i));
+        // f·|cos θo| / pdf: the D and Jacobian terms cancel, leaving the lobe factor times
+        // G1(wo, m) for visible normals, or D·G·|wi·m| / (D_s·|cos θi|·cos θm) for normals drawn
+        // from the (possibly widened) distribution D_s (see sample_weight).
+        weight *= distr.sample_weight(si.wi, bs.wo, m, sample_distr);
         if (!(weight > 0.f) || !(bs.pdf > 0.f) || !std::isfinite(weight)) return {bs, Color3f(0.f)};
 
         Color3f result(weight);

@@ -90,17 +90,55 @@ public:
         return smith_g1(wi, m) * smith_g1(wo, m);
     }
 
-    /// Density of sample(wi, ·) per unit solid angle of m. `wi` must be in the upper hemisphere.
+    /**
+     * The exact Smith masking of the unmasked microfacets seen from v (upper hemisphere), which
+     * normalises the distribution of visible normals. Equal to smith_g1() for GGX; for Beckmann
+     * it is 2/(1 + erf(a) + exp(−a²)/(a√π)), a = 1/(α tan θ), of which smith_g1() is Walter's fit.
+     */
+    float visible_normalization(const Vector3f &v) const {
+        float xy_alpha_2 = sqr(m_alpha_u * v.x) + sqr(m_alpha_v * v.y);
+        if (xy_alpha_2 == 0.f) return 1.f;
+        float tan_theta_alpha_2 = xy_alpha_2 / sqr(v.z);
+        if (m_type == MicrofacetType::GGX) return 2.f / (1.f + std::sqrt(1.f + tan_theta_alpha_2));
+        float a = 1.f / std::sqrt(tan_theta_alpha_2);
+        const float InvSqrtPi = 0.56418958354775628f;
+        return 2.f / (1.f + std::erf(a) + std::exp(-a * a) * InvSqrtPi / a);
+    }
+
+    /**
+     * Density of sample(wi, ·) per unit solid angle of m; `wi` must be in the upper hemisphere.
+     * Visible normals have D_wi(m) = G1(wi)·max(0, wi·m)·D(m)/cos θi (Heitz 2014, eq. 2) with the
+     * exact G1 (visible_normalization), so the density integrates to one for Beckmann too.
+     */
     float pdf(const Vector3f &wi, const Vector3f &m) const {
         float d = eval(m);
         if (d == 0.f) return 0.f;
         if (m_sample_visible) {
-            float cos_i = Frame::cos_theta(wi);
-            if (cos_i <= 0.f) return 0.f;
-            // Distribution of visible normals: D_wi(m) = G1(wi, m)·max(0, wi·m)·D(m)/cos θi.
-            return d * smith_g1(wi, m) * std::max(dot(wi, m), 0.f) / cos_i;
+            float cos_i = Frame::cos_theta(wi), wi_dot_m = dot(wi, m);
+            if (cos_i <= 0.f || wi_dot_m <= 0.f) return 0.f;
+            return d * visible_normalization(wi) * wi_dot_m / cos_i;
         }
         return d * Frame::cos_theta(m);
+    }
+
+    /**
+     * Weight f·|cos θo|/pdf of a microfacet BSDF with shadowing-masking G(wi, wo, m) for a normal
+     * m drawn by sample(wi, ·), without the Fresnel and lobe-selection factors: the D and
+     * Jacobian terms cancel. Visible normals: G1(wi, m)·G1(wo, m)/G1_exact(wi) (= G1(wo, m) for
+     * GGX). All normals drawn from `sampled` (this distribution, possibly with widened α):
+     * D(m)·G·|wi·m| / (D_s(m)·|cos θi|·cos θm).
+     */
+    float sample_weight(const Vector3f &wi, const Vector3f &wo, const Vector3f &m,
+                        const MicrofacetDistribution &sampled) const {
+        if (m_sample_visible) {
+            float g1_o = smith_g1(wo, m);
+            if (m_type == MicrofacetType::GGX) return g1_o;
+            Vector3f wi_up = wi * sign(wi.z);
+            return g1_o * smith_g1(wi, m) / visible_normalization(wi_up);
+        }
+        float pdf_s = sampled.eval(m) * Frame::cos_theta(m);
+        if (!(pdf_s > 0.f)) return 0.f;
+        return eval(m) * G(wi, wo, m) * std::abs(dot(wi, m)) / (pdf_s * std::abs(wi.z));
     }
 
     /// Samples a microfacet normal for the incident direction `wi` (upper hemisphere); returns the

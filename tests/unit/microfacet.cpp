@@ -1,0 +1,295 @@
+// Microfacet distributions: normalisation of D, the visible-normal density, Smith G1 against the
+// lecture's formulas, sampling (chi-square) for Beckmann and GGX, and the parameter reader.
+
+#include <facet/chi2.h>
+#include <facet/microfacet.h>
+#include <facet/properties.h>
+#include <facet/random.h>
+#include <facet/warp.h>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+using namespace facet;
+
+namespace {
+
+/// ∫ f(ω) dω over the upper hemisphere by the midpoint rule in (cos θ, φ), with cells refined
+/// near the pole where microfacet distributions concentrate (cos θ = 1 − t², t uniform).
+template <typename F> double integrate_hemisphere(F f, int n_t = 1500, int n_phi = 300) {
+    double sum = 0.0;
+    for (int i = 0; i < n_t; ++i) {
+        double t = (i + 0.5) / n_t;
+        double cos_theta = 1.0 - t * t, dcos = 2.0 * t / n_t;
+        double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+        for (int j = 0; j < n_phi; ++j) {
+            double phi = 2.0 * M_PI * (j + 0.5) / n_phi;
+            Vector3f w(float(sin_theta * std::cos(phi)), float(sin_theta * std::sin(phi)),
+                       float(cos_theta));
+            sum += f(w) * dcos * (2.0 * M_PI / n_phi);
+        }
+    }
+    return sum;
+}
+
+struct Config {
+    MicrofacetType type;
+    float alpha_u, alpha_v;
+};
+
+const Config CONFIGS[] = {
+    {MicrofacetType::Beckmann, 0.1f, 0.1f}, {MicrofacetType::Beckmann, 0.5f, 0.5f},
+    {MicrofacetType::Beckmann, 0.3f, 0.08f}, {MicrofacetType::GGX, 0.1f, 0.1f},
+    {MicrofacetType::GGX, 0.5f, 0.5f},       {MicrofacetType::GGX, 0.05f, 0.4f},
+};
+
+std::string name_of(const Config &c) {
+    return std::string(microfacet_type_name(c.type)) + " " + std::to_string(c.alpha_u) + "/" +
+           std::to_string(c.alpha_v);
+}
+
+/// Exact Smith G1 for Beckmann with a = 1/(α tan θ): 2 / (1 + erf(a) + exp(−a²)/(a√π)).
+double beckmann_g1_exact(double a) {
+    return 2.0 / (1.0 + std::erf(a) + std::exp(-a * a) / (a * std::sqrt(M_PI)));
+}
+
+Properties microfacet_props(std::initializer_list<std::pair<std::string, Properties::Value>> entries) {
+    Properties props("roughconductor");
+    for (const auto &[name, value] : entries) props.set(name, value);
+    return props;
+}
+
+void expect_read_error(const Properties &props, const std::string &fragment) {
+    try {
+        read_microfacet(props);
+        ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+
+TEST(Microfacet, DistributionIntegratesToOneInProjectedArea) {
+    // ∫ D(m) cos θm dω = 1: the microfacets' projected area is the macro surface's.
+    for (const Config &c : CONFIGS) {
+        MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v);
+        double integral = integrate_hemisphere([&](const Vector3f &m) {
+            return double(distr.eval(m)) * m.z;
+        });
+        EXPECT_NEAR(integral, 1.0, 2e-3) << name_of(c);
+    }
+}
+
+TEST(Microfacet, DistributionIsZeroBelowTheHorizon) {
+    MicrofacetDistribution distr(MicrofacetType::GGX, 0.5f);
+    EXPECT_EQ(distr.eval(Vector3f(0.f, 0.f, -1.f)), 0.f);
+    EXPECT_EQ(distr.eval(normalize(Vector3f(1.f, 0.f, -0.1f))), 0.f);
+    // Closed form at the pole: D(n) = 1/(π αu αv) for both.
+    EXPECT_NEAR(distr.eval(Vector3f(0.f, 0.f, 1.f)), 1.f / (Pi * 0.25f), 1e-5f);
+    MicrofacetDistribution beckmann(MicrofacetType::Beckmann, 0.2f, 0.4f);
+    EXPECT_NEAR(beckmann.eval(Vector3f(0.f, 0.f, 1.f)), 1.f / (Pi * 0.08f), 1e-4f);
+}
+
+TEST(Microfacet, LectureBeckmannFormula) {
+    // D(h) = exp(−tan²θ/m²) / (π m² cos⁴θ) for the isotropic case.
+    MicrofacetDistribution distr(MicrofacetType::Beckmann, 0.3f);
+    for (int i = 0; i < 20; ++i) {
+        float theta = 0.07f * i, phi = 0.4f * i;
+        Vector3f h(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+        double t = std::tan(theta), c = std::cos(theta), m2 = 0.09;
+        double expected = std::exp(-t * t / m2) / (M_PI * m2 * c * c * c * c);
+        EXPECT_NEAR(distr.eval(h), expected, 1e-4 * expected + 1e-6) << "theta " << theta;
+    }
+}
+
+TEST(Microfacet, SmithG1MatchesTheLecture) {
+    float alpha = 0.4f;
+    MicrofacetDistribution beckmann(MicrofacetType::Beckmann, alpha);
+    MicrofacetDistribution ggx(MicrofacetType::GGX, alpha);
+    Vector3f m(0.f, 0.f, 1.f);
+    for (int i = 1; i < 90; ++i) {
+        double theta = i * M_PI / 180.0;
+        Vector3f v(float(std::sin(theta)), 0.f, float(std::cos(theta)));
+        double a = 1.0 / (alpha * std::tan(theta));
+        // The lecture's rational approximation (Walter), exactly.
+        double rational = a < 1.6 ? (3.535 * a + 2.181 * a * a) / (1 + 2.276 * a + 2.577 * a * a) : 1.0;
+        EXPECT_NEAR(beckmann.smith_g1(v, m), rational, 2e-5) << "theta " << i;
+        // Which is within 0.35 % of the exact Smith function, used to normalise visible normals.
+        EXPECT_NEAR(beckmann.smith_g1(v, m), beckmann_g1_exact(a), 0.0035 * beckmann_g1_exact(a))
+            << "theta " << i;
+        EXPECT_NEAR(beckmann.visible_normalization(v), beckmann_g1_exact(a), 1e-5) << "theta " << i;
+        EXPECT_EQ(ggx.visible_normalization(v), ggx.smith_g1(v, m));
+        // GGX: 2 / (1 + √(1 + α² tan²θ)).
+        double ggx_exact = 2.0 / (1.0 + std::sqrt(1.0 + 1.0 / (a * a)));
+        EXPECT_NEAR(ggx.smith_g1(v, m), ggx_exact, 2e-6) << "theta " << i;
+    }
+    // χ⁺: a facet seen from behind is masked; normal incidence is never masked.
+    Vector3f v = normalize(Vector3f(1.f, 0.f, 0.3f));
+    Vector3f back_facing = normalize(Vector3f(-1.f, 0.f, 0.2f));
+    EXPECT_EQ(beckmann.smith_g1(v, back_facing), 0.f);
+    EXPECT_EQ(ggx.smith_g1(v, back_facing), 0.f);
+    EXPECT_EQ(ggx.smith_g1(Vector3f(0.f, 0.f, 1.f), m), 1.f);
+    EXPECT_FLOAT_EQ(ggx.G(v, v, m), sqr(ggx.smith_g1(v, m)));
+}
+
+TEST(Microfacet, AnisotropicMaskingUsesTheProjectedRoughness) {
+    PCG32 rng(5);
+    for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::GGX}) {
+        MicrofacetDistribution aniso(type, 0.1f, 0.6f);
+        for (int i = 0; i < 100; ++i) {
+            Vector3f v = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+            float alpha = aniso.project_roughness(v);
+            float phi = std::atan2(v.y, v.x);
+            EXPECT_NEAR(sqr(alpha), sqr(std::cos(phi) * 0.1f) + sqr(std::sin(phi) * 0.6f), 1e-5f);
+            MicrofacetDistribution iso(type, alpha);
+            EXPECT_NEAR(aniso.smith_g1(v, Vector3f(0.f, 0.f, 1.f)),
+                        iso.smith_g1(v, Vector3f(0.f, 0.f, 1.f)), 1e-5f);
+        }
+    }
+}
+
+TEST(Microfacet, VisibleNormalDensityIntegratesToOne) {
+    // ∫ G1(wi) max(0, wi·m) D(m) / cos θi dm = 1 with the exact Smith G1 of each distribution.
+    for (const Config &c : CONFIGS) {
+        MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, true);
+        for (float theta_deg : {0.f, 30.f, 60.f, 85.f}) {
+            Vector3f wi = direction_from_angles(theta_deg, 40.f);
+            double integral = integrate_hemisphere([&](const Vector3f &m) {
+                return double(distr.pdf(wi, m));
+            });
+            EXPECT_NEAR(integral, 1.0, 2e-3) << name_of(c) << " theta " << theta_deg;
+        }
+    }
+}
+
+TEST(Microfacet, SampleReturnsItsPdf) {
+    PCG32 rng(9);
+    for (const Config &c : CONFIGS) {
+        for (bool visible : {false, true}) {
+            MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, visible);
+            int ok = 0;
+            for (int i = 0; i < 2000; ++i) {
+                Vector3f wi = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+                auto [m, pdf] = distr.sample(wi, Point2f(rng.next_float(), rng.next_float()));
+                if (pdf == 0.f) continue;
+                ASSERT_TRUE(is_finite(m));
+                EXPECT_NEAR(norm(m), 1.f, 1e-5f);
+                EXPECT_GT(m.z, 0.f);
+                EXPECT_NEAR(pdf, distr.pdf(wi, m), 1e-4f * pdf) << name_of(c);
+                if (visible) EXPECT_GT(dot(wi, m), 0.f) << name_of(c);
+                ++ok;
+            }
+            EXPECT_GT(ok, 1990) << name_of(c) << (visible ? " visible" : " all");
+        }
+    }
+}
+
+// Chi-square of normal sampling against pdf(): Mitsuba's test matrix (distribution × α ×
+// visible × incident angle), plus anisotropic roughness. One test per distribution and scheme.
+namespace {
+void chi2_matrix(const char *type, bool visible) {
+    Chi2Options opts;
+    opts.samples = 200000;
+    opts.res = 32;
+    opts.test_count = 8;
+    int run = 0;
+    for (auto [au, av] : {std::pair{0.125f, 0.125f}, std::pair{0.5f, 0.5f}, std::pair{0.3f, 0.08f}}) {
+        for (float angle : {15.f, 30.f, 80.f}) {
+            if (au != av && angle == 30.f) continue;
+            MicrofacetAdapter adapter(type, au, av, visible, direction_from_angles(angle, 25.f));
+            opts.seed = uint32_t(run++);
+            Chi2Result result = run_chi2(adapter, opts);
+            EXPECT_TRUE(result.passed) << result.summary();
+            if (!result.passed)
+                write_chi2_heatmap(fmt::format("microfacet_{}_{}_{}_{}_{}.png", type, visible, au,
+                                               av, angle), result);
+        }
+    }
+}
+} // namespace
+
+TEST(MicrofacetSampling, BeckmannAllNormals) { chi2_matrix("beckmann", false); }
+TEST(MicrofacetSampling, BeckmannVisibleNormals) { chi2_matrix("beckmann", true); }
+TEST(MicrofacetSampling, GGXAllNormals) { chi2_matrix("ggx", false); }
+TEST(MicrofacetSampling, GGXVisibleNormals) { chi2_matrix("ggx", true); }
+
+TEST(MicrofacetSampling, VisibleNormalsAreSeenFromWi) {
+    // Every normal drawn by visible sampling faces wi, and at grazing incidence the normals
+    // lean towards wi (those facing away are hidden).
+    for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::GGX}) {
+        MicrofacetDistribution distr(type, 0.5f, 0.5f, true);
+        Vector3f wi = direction_from_angles(85.f, 0.f);
+        PCG32 rng(2);
+        double mean_x = 0.0;
+        for (int i = 0; i < 20000; ++i) {
+            auto [m, pdf] = distr.sample(wi, Point2f(rng.next_float(), rng.next_float()));
+            ASSERT_GT(pdf, 0.f);
+            ASSERT_GT(dot(wi, m), 0.f);
+            mean_x += m.x;
+        }
+        EXPECT_GT(mean_x / 20000, 0.1) << microfacet_type_name(type);
+    }
+}
+
+TEST(MicrofacetParameters, ReadsMitsubaParameters) {
+    Properties defaults("roughconductor");
+    MicrofacetParameters p = read_microfacet(defaults);
+    EXPECT_EQ(p.type(), MicrofacetType::Beckmann);
+    EXPECT_TRUE(p.sample_visible());
+    EXPECT_FALSE(p.is_anisotropic());
+    EXPECT_FALSE(p.is_spatially_varying());
+    SurfaceInteraction si;
+    MicrofacetDistribution d = p.at(si);
+    EXPECT_FLOAT_EQ(d.alpha_u(), 0.1f);
+    EXPECT_FLOAT_EQ(d.alpha_v(), 0.1f);
+
+    Properties aniso = microfacet_props({{"distribution", std::string("ggx")},
+                                         {"alpha_u", 0.2},
+                                         {"alpha_v", 0.05},
+                                         {"sample_visible", false}});
+    p = read_microfacet(aniso);
+    EXPECT_EQ(p.type(), MicrofacetType::GGX);
+    EXPECT_FALSE(p.sample_visible());
+    EXPECT_TRUE(p.is_anisotropic());
+    d = p.at(si);
+    EXPECT_FLOAT_EQ(d.alpha_u(), 0.2f);
+    EXPECT_FLOAT_EQ(d.alpha_v(), 0.05f);
+    EXPECT_TRUE(aniso.unqueried().empty());
+
+    // Equal alpha_u and alpha_v are isotropic.
+    EXPECT_FALSE(read_microfacet(microfacet_props({{"alpha_u", 0.3}, {"alpha_v", 0.3}})).is_anisotropic());
+
+    // The plain-number constructor.
+    MicrofacetDistribution direct(microfacet_props({{"alpha", 0.25}}));
+    EXPECT_FLOAT_EQ(direct.alpha(), 0.25f);
+    EXPECT_TRUE(direct.sample_visible());
+
+    // Tiny roughness is clamped to 1e-4.
+    Properties zero = microfacet_props({{"alpha", 0.0}});
+    EXPECT_FLOAT_EQ(read_microfacet(zero).at(si).alpha(), MicrofacetDistribution::MinAlpha);
+}
+
+TEST(MicrofacetParameters, RejectsBadParameters) {
+    expect_read_error(microfacet_props({{"distribution", std::string("phong")}}),
+                      "distribution must be beckmann or ggx");
+    expect_read_error(microfacet_props({{"distribution", std::string("GGX ")}}),
+                      "distribution must be beckmann or ggx");
+    expect_read_error(microfacet_props({{"alpha", 0.1}, {"alpha_u", 0.2}, {"alpha_v", 0.2}}),
+                      "either alpha or both alpha_u and alpha_v");
+    expect_read_error(microfacet_props({{"alpha", 0.1}, {"alpha_v", 0.2}}),
+                      "either alpha or both alpha_u and alpha_v");
+    expect_read_error(microfacet_props({{"alpha_u", 0.2}}), "found only alpha_u");
+    expect_read_error(microfacet_props({{"alpha_v", 0.2}}), "found only alpha_v");
+    expect_read_error(microfacet_props({{"alpha", -0.1}}), "alpha must be a roughness >= 0");
+    expect_read_error(microfacet_props({{"alpha", std::string("rough")}}), "alpha");
+
+    // Numbers only where textures are not allowed.
+    Properties textured("roughplastic");
+    textured.set_object("alpha", std::make_shared<ConstantTexture>(Color3f(0.2f)));
+    EXPECT_THROW(read_microfacet(textured, 0.1f, false), Error);
+    EXPECT_NO_THROW(read_microfacet(textured, 0.1f, true));
+}
