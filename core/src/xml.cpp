@@ -34,6 +34,7 @@
 #include <map>
 #include <sstream>
 #include <string_view>
+#include <unordered_map>
 
 namespace facet {
 namespace {
@@ -274,13 +275,21 @@ struct ObjectNode {
     std::string id;
     Location location;
     std::vector<Entry> entries;
+    std::unordered_map<std::string, Location> names; ///< entry names, for duplicate checks
     size_t arg_counter = 0; ///< next `_arg_N`
     std::shared_ptr<Object> instance;
 
-    const Entry *find(const std::string &name) const {
-        for (const Entry &e : entries)
+    Entry *find(const std::string &name) {
+        for (Entry &e : entries)
             if (e.name == name) return &e;
         return nullptr;
+    }
+    /// Fails when `name` is taken already (scenes can have many entries: no linear search).
+    void claim_name(const std::string &name, const Location &loc) {
+        auto [it, inserted] = names.emplace(name, loc);
+        if (!inserted)
+            throw Error(loc, fmt::format("duplicate property \"{}\" (first declared at {})", name,
+                                         it->second.to_string()));
     }
     /// "a" for an object with an id, `<bsdf type="diffuse">` otherwise.
     std::string describe() const {
@@ -530,9 +539,7 @@ private:
     void add_entry(size_t parent, Entry entry) {
         ObjectNode &node = m_nodes[parent];
         if (entry.name.empty()) entry.name = fmt::format("_arg_{}", node.arg_counter++);
-        if (const Entry *prev = node.find(entry.name))
-            fail(entry.location, fmt::format("duplicate property \"{}\" (first declared at {})",
-                                             entry.name, prev->location.to_string()));
+        node.claim_name(entry.name, entry.location);
         node.entries.push_back(std::move(entry));
     }
 
@@ -868,18 +875,11 @@ private:
 
     // -- The 0.x upgrade ------------------------------------------------------------------------
 
-    Entry *find_entry(ObjectNode &node, const std::string &name) {
-        for (Entry &e : node.entries)
-            if (e.name == name) return &e;
-        return nullptr;
-    }
-
-    void rename_entry(ObjectNode &node, const std::string &from, const std::string &to) {
-        Entry *e = find_entry(node, from);
+    static void rename_entry(ObjectNode &node, const std::string &from, const std::string &to) {
+        Entry *e = node.find(from);
         if (!e) return;
-        if (const Entry *prev = node.find(to))
-            fail(e->location, fmt::format("duplicate property \"{}\" (first declared at {})", to,
-                                          prev->location.to_string()));
+        node.claim_name(to, e->location);
+        node.names.erase(from);
         e->name = to;
     }
 
@@ -895,7 +895,7 @@ private:
         Location first;
         bool any = false;
         for (int i = 0; i < 4; ++i) {
-            Entry *e = find_entry(node, uv_names[i]);
+            Entry *e = node.find(uv_names[i]);
             if (!e || e->kind != Entry::Kind::Value) continue;
             if (const double *d = std::get_if<double>(&e->value))
                 uv[i] = float(*d);
@@ -905,6 +905,7 @@ private:
                 fail(e->location, fmt::format("\"{}\" must be a number", uv_names[i]));
             if (!any) first = e->location;
             any = true;
+            node.names.erase(e->name);
             node.entries.erase(node.entries.begin() + (e - node.entries.data()));
         }
         if (!any) return;

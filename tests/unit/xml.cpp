@@ -893,6 +893,15 @@ TEST_F(XmlTest, OldVersionsAreUpgraded) {
     expect_matrix_near(tex->props.get_transform("to_uv").matrix, expected.matrix);
 }
 
+TEST_F(XmlTest, UpgradeRenamingCanCollide) {
+    Error e = string_error("<bsdf version=\"0.6.0\" type=\"diffuse\">\n"
+                           "  <rgb name=\"reflectance\" value=\"0.2\"/>\n"
+                           "  <rgb name=\"diffuseReflectance\" value=\"0.3\"/>\n"
+                           "</bsdf>\n");
+    EXPECT_EQ(e.message(), "duplicate property \"reflectance\" (first declared at string:2:4)");
+    EXPECT_EQ(e.location().to_string(), "string:3:4");
+}
+
 TEST_F(XmlTest, UpgradeIsPerSourceFile) {
     write("old.xml", "<scene version=\"0.5.0\">\n  <float name=\"sampleCount\" value=\"1\"/>\n</scene>\n");
     std::string main = write("main.xml", wrap("  <include filename=\"old.xml\"/>\n"
