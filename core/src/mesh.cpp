@@ -238,7 +238,7 @@ std::string Mesh::to_string() const {
                        m_name, vertex_count(), face_count(), has_vertex_normals(), has_uvs(),
                        has_vertex_colors(), m_area, m_flip_normals,
                        m_bsdf ? m_bsdf->to_string() : "none",
-                       m_emitter ? m_emitter->to_string() : "none");
+                       emitter_label());
 }
 
 } // namespace facet

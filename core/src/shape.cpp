@@ -65,11 +65,17 @@ float Shape::pdf_direction(const Interaction &ref, const DirectionSample &ds) co
     return pdf_position(ds) * ds.dist * ds.dist / cos_theta;
 }
 
+std::string Shape::emitter_label() const {
+    if (!m_emitter)
+        return "none";
+    return m_emitter->id().empty() ? "attached" : "\"" + m_emitter->id() + "\"";
+}
+
 std::string Shape::to_string() const {
     return fmt::format("Shape[bbox=[{}, {}, {}]-[{}, {}, {}], area={}, bsdf={}, emitter={}]",
                        bbox().min.x, bbox().min.y, bbox().min.z, bbox().max.x, bbox().max.y,
                        bbox().max.z, surface_area(), m_bsdf ? m_bsdf->to_string() : "none",
-                       m_emitter ? m_emitter->to_string() : "none");
+                       emitter_label());
 }
 
 } // namespace facet

@@ -122,7 +122,7 @@ public:
         return fmt::format("Disk[to_world={}, area={}, flip_normals={}, bsdf={}, emitter={}]",
                            m_to_world.to_string(), m_area, m_flip_normals,
                            m_bsdf ? m_bsdf->to_string() : "none",
-                           m_emitter ? m_emitter->to_string() : "none");
+                           emitter_label());
     }
 
 private:

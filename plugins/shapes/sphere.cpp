@@ -168,7 +168,7 @@ public:
                            "emitter={}]",
                            m_center.x, m_center.y, m_center.z, m_radius, m_flip_normals,
                            m_bsdf ? m_bsdf->to_string() : "none",
-                           m_emitter ? m_emitter->to_string() : "none");
+                           emitter_label());
     }
 
 private:

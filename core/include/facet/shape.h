@@ -60,6 +60,9 @@ public:
 protected:
     /// For shapes that interpret their nested objects themselves (shapegroup, instance).
     Shape() = default;
+    /// Short description of the attached emitter for to_string() ("none", or its id): the
+    /// emitter's own to_string() prints its shape, so printing it here would recurse.
+    std::string emitter_label() const;
 
     std::shared_ptr<BSDF> m_bsdf;
     std::shared_ptr<Emitter> m_emitter;

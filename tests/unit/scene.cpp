@@ -1,0 +1,377 @@
+// The scene: collecting children, defaults, Embree queries, spawned rays that neither self-hit nor
+// leak, and emitter sampling.
+#include <facet/bsdf.h>
+#include <facet/emitter.h>
+#include <facet/integrator.h>
+#include <facet/plugin.h>
+#include <facet/random.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/shape.h>
+#include <facet/warp.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace facet;
+
+namespace {
+
+/// The scene needs the default plugins (path, perspective, diffuse) and these tests use a few more.
+bool have_plugins() {
+    static const bool ok = [] {
+        auto names = PluginRegistry::instance().available();
+        for (const char *n : {"path", "perspective", "diffuse", "area", "point", "constant",
+                              "rectangle", "sphere", "disk", "cube"})
+            if (std::find(names.begin(), names.end(), n) == names.end())
+                return false;
+        return true;
+    }();
+    return ok;
+}
+
+#define REQUIRE_PLUGINS()                                                                          \
+    if (!have_plugins())                                                                           \
+    GTEST_SKIP() << "the default plugins (path, perspective, diffuse, ...) are not built"
+
+std::shared_ptr<Object> create(ObjectType kind, const std::string &type, Properties props = {}) {
+    props.set_plugin_name(type);
+    return PluginRegistry::instance().create(kind, props);
+}
+
+std::shared_ptr<Object> area_light(const Color3f &radiance) {
+    Properties props;
+    props.set_color("radiance", radiance);
+    return create(ObjectType::Emitter, "area", props);
+}
+
+/// Rectangle scaled by 2 in the z = 0 plane and a sphere of radius 0.5 at (0, 0, 2).
+Properties rect_and_sphere(std::shared_ptr<Object> sphere_emitter = nullptr) {
+    Properties rect;
+    rect.set_transform("to_world", Transform::scale(Vector3f(2, 2, 1)));
+    Properties sphere;
+    sphere.set_vector("center", Vector3f(0, 0, 2));
+    sphere.set_float("radius", 0.5);
+    if (sphere_emitter)
+        sphere.set_object("light", sphere_emitter);
+    Properties props;
+    props.set_object("floor", create(ObjectType::Shape, "rectangle", rect));
+    props.set_object("ball", create(ObjectType::Shape, "sphere", sphere));
+    return props;
+}
+
+void expect_near_vec(const Vector3f &a, const Vector3f &b, float tol) {
+    EXPECT_NEAR(a.x, b.x, tol);
+    EXPECT_NEAR(a.y, b.y, tol);
+    EXPECT_NEAR(a.z, b.z, tol);
+}
+
+template <typename F> std::string error_of(F &&f) {
+    try {
+        f();
+    } catch (const Error &e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "expected a facet::Error";
+    return "";
+}
+
+} // namespace
+
+TEST(SceneBuild, DefaultsAreCreated) {
+    REQUIRE_PLUGINS();
+    Scene scene(rect_and_sphere());
+    ASSERT_EQ(scene.shapes().size(), 2u);
+    EXPECT_TRUE(scene.integrator());
+    ASSERT_EQ(scene.sensors().size(), 1u);
+    EXPECT_TRUE(scene.emitters().empty());
+    for (const auto &shape : scene.shapes()) {
+        ASSERT_TRUE(shape->bsdf());
+        EXPECT_TRUE(has_flag(shape->bsdf()->flags(), BSDFFlags::DiffuseReflection));
+    }
+    expect_near_vec(scene.bbox().min, Vector3f(-2, -2, 0), 1e-6f);
+    expect_near_vec(scene.bbox().max, Vector3f(2, 2, 2.5f), 1e-6f);
+    EXPECT_NE(scene.to_string().find("Sphere"), std::string::npos);
+}
+
+TEST(SceneBuild, ChildrenAreCheckedAndOrdered) {
+    REQUIRE_PLUGINS();
+    // Top-level BSDFs are references only; emitters keep declaration order, area emitters
+    // coming with their shape.
+    Properties props = rect_and_sphere(area_light(Color3f(1.f)));
+    props.set_object("unused_bsdf", create(ObjectType::BSDF, "diffuse"));
+    Properties point;
+    point.set_vector("position", Vector3f(0, 0, 5));
+    auto point_light = create(ObjectType::Emitter, "point", point);
+    props.set_object("lamp", point_light);
+    props.set_object("sky", create(ObjectType::Emitter, "constant"));
+    props.set_object("integrator", create(ObjectType::Integrator, "path"));
+    Scene scene(props);
+    ASSERT_EQ(scene.emitters().size(), 3u);
+    EXPECT_EQ(scene.emitters()[0].get(), scene.shapes()[1]->emitter());
+    EXPECT_EQ(scene.emitters()[1], point_light);
+    ASSERT_EQ(scene.environment_emitters().size(), 1u);
+    EXPECT_EQ(scene.environment_emitters()[0], scene.emitters()[2]);
+    EXPECT_TRUE(props.unqueried().empty());
+
+    // Two integrators.
+    Properties two = rect_and_sphere();
+    two.set_object("a", create(ObjectType::Integrator, "path"));
+    two.set_object("b", create(ObjectType::Integrator, "path"));
+    std::string msg = error_of([&] { Scene s(two); });
+    EXPECT_NE(msg.find("integrator"), std::string::npos) << msg;
+
+    // An area emitter that no shape holds.
+    Properties loose = rect_and_sphere();
+    auto light = area_light(Color3f(1.f));
+    light->set_id("lonely_light");
+    loose.set_object("l", light);
+    msg = error_of([&] { Scene s(loose); });
+    EXPECT_NE(msg.find("lonely_light"), std::string::npos) << msg;
+
+    // A shape with two BSDFs.
+    Properties twice;
+    twice.set_plugin_name("rectangle");
+    twice.set_object("a", create(ObjectType::BSDF, "diffuse"));
+    twice.set_object("b", create(ObjectType::BSDF, "diffuse"));
+    msg = error_of([&] { PluginRegistry::instance().create(ObjectType::Shape, twice); });
+    EXPECT_NE(msg.find("more than one bsdf"), std::string::npos) << msg;
+}
+
+TEST(SceneQuery, IntersectionRecords) {
+    REQUIRE_PLUGINS();
+    Scene scene(rect_and_sphere());
+    SurfaceInteraction si;
+    // The floor, from above.
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(1, 0.5f, 3), Vector3f(0, 0, -1)), si));
+    EXPECT_EQ(si.shape, scene.shapes()[0].get());
+    EXPECT_NEAR(si.t, 3.f, 1e-6f);
+    expect_near_vec(si.p, Vector3f(1, 0.5f, 0), 1e-6f);
+    expect_near_vec(si.n, Vector3f(0, 0, 1), 1e-6f);
+    expect_near_vec(si.wi, Vector3f(0, 0, 1), 1e-6f);
+    EXPECT_NEAR(si.uv.x, 0.75f, 1e-6f);
+    EXPECT_NEAR(si.uv.y, 0.625f, 1e-6f);
+    EXPECT_EQ(si.bsdf(), scene.shapes()[0]->bsdf());
+    EXPECT_EQ(si.emitter(), nullptr);
+
+    // The sphere's equator, from +x.
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(5, 0, 2), Vector3f(-1, 0, 0)), si));
+    EXPECT_EQ(si.shape, scene.shapes()[1].get());
+    EXPECT_NEAR(si.t, 4.5f, 1e-6f);
+    expect_near_vec(si.n, Vector3f(1, 0, 0), 1e-6f);
+    EXPECT_NEAR(si.wi.z, 1.f, 1e-6f);
+    EXPECT_NEAR(si.uv.x, 0.f, 1e-6f);
+    EXPECT_NEAR(si.uv.y, 0.5f, 1e-6f);
+
+    // A miss leaves t at infinity.
+    EXPECT_FALSE(scene.ray_intersect(Ray(Point3f(5, 5, 5), Vector3f(0, 0, 1)), si));
+    EXPECT_EQ(si.t, Infinity);
+    EXPECT_FALSE(si.is_valid());
+
+    // Shadow queries honour [mint, maxt].
+    EXPECT_TRUE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1))));
+    EXPECT_FALSE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.4f)));
+    EXPECT_TRUE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.6f)));
+    EXPECT_FALSE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 3.6f, 4.9f)));
+}
+
+namespace {
+
+/// Hits a shape from random directions and checks that rays spawned from the hit point leave the
+/// surface: no ray going back to the side it came from hits the same shape again, and rays going
+/// into a closed shape travel through it rather than stopping at their own start.
+void check_spawned_rays(const Transform &to_world, float radius_world, uint64_t seed) {
+    Properties rect;
+    rect.set_transform("to_world", to_world * Transform::scale(Vector3f(1, 1, 1)));
+    Properties sphere;
+    sphere.set_transform("to_world", to_world * Transform::translate(Vector3f(0, 0, 3)));
+    Properties props;
+    props.set_object("rect", create(ObjectType::Shape, "rectangle", rect));
+    props.set_object("ball", create(ObjectType::Shape, "sphere", sphere));
+    Scene scene(props);
+    const Shape *rect_shape = scene.shapes()[0].get(), *ball = scene.shapes()[1].get();
+    const Point3f center = to_world.apply_point(Point3f(0, 0, 3));
+    const Point3f plane_center = to_world.apply_point(Point3f(0, 0, 0));
+
+    PCG32 rng(seed);
+    int self_hits = 0, short_chords = 0, hits = 0;
+    for (int i = 0; i < 20000; ++i) {
+        bool on_sphere = i % 2 == 1;
+        Point3f target = on_sphere ? center : plane_center;
+        // Camera rays from far away, aimed at the shape with a random offset.
+        Vector3f from = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        if (!on_sphere)
+            from.z = std::abs(from.z) + 0.05f;
+        Point3f o = target + normalize(from) * (radius_world * 20.f);
+        Point3f aim = target + Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f,
+                                        on_sphere ? rng.next_float() - 0.5f : 0.f) *
+                                   (1.6f * radius_world);
+        SurfaceInteraction si;
+        if (!scene.ray_intersect(Ray(o, normalize(aim - o)), si))
+            continue;
+        if (si.shape != (on_sphere ? ball : rect_shape))
+            continue;
+        ++hits;
+        // A random direction back into the hemisphere the ray came from (including grazing).
+        Vector3f n = si.n * sign(dot(si.n, o - si.p));
+        Vector3f local = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        Frame frame(n);
+        Vector3f d = frame.to_world(local);
+        SurfaceInteraction si2;
+        if (scene.ray_intersect(si.spawn_ray(d), si2) && si2.shape == si.shape)
+            ++self_hits;
+        // Into the sphere: the ray must cross it and leave on the far side.
+        if (on_sphere) {
+            Vector3f din = frame.to_world(Vector3f(local.x, local.y, -local.z));
+            if (scene.ray_intersect(si.spawn_ray(din), si2) && si2.shape == ball) {
+                float chord = 2.f * radius_world * std::abs(local.z);
+                if (si2.t < 0.5f * chord)
+                    ++short_chords;
+            } else {
+                ++short_chords;
+            }
+        }
+    }
+    EXPECT_GT(hits, 10000);
+    EXPECT_EQ(self_hits, 0);
+    EXPECT_EQ(short_chords, 0);
+}
+
+} // namespace
+
+TEST(SpawnRay, NoSelfIntersectionAtUnitScale) {
+    REQUIRE_PLUGINS();
+    check_spawned_rays(Transform(), 1.f, 1);
+}
+
+TEST(SpawnRay, NoSelfIntersectionAtLargeCoordinates) {
+    REQUIRE_PLUGINS();
+    check_spawned_rays(Transform::translate(Vector3f(1e4f, -2e4f, 1e4f)), 1.f, 2);
+    check_spawned_rays(Transform::translate(Vector3f(1e4f, 1e4f, 3e4f)) *
+                           Transform::rotate(Vector3f(1, 2, 3), 37.f) *
+                           Transform::scale(Vector3f(50, 50, 50)),
+                       50.f, 3);
+}
+
+TEST(SpawnRay, NoSelfIntersectionAtSmallScale) {
+    REQUIRE_PLUGINS();
+    check_spawned_rays(Transform::translate(Vector3f(0.3f, 0.2f, -0.1f)) *
+                           Transform::scale(Vector3f(1e-2f, 1e-2f, 1e-2f)),
+                       1e-2f, 4);
+}
+
+TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
+    REQUIRE_PLUGINS();
+    // A floor (z = 0) and a wall (x = 0) crossing it.
+    Properties floor;
+    floor.set_transform("to_world", Transform::scale(Vector3f(2, 2, 1)));
+    Properties wall;
+    wall.set_transform("to_world", Transform::rotate(Vector3f(0, 1, 0), 90.f) *
+                                       Transform::scale(Vector3f(2, 2, 1)));
+    Properties props;
+    props.set_object("floor", create(ObjectType::Shape, "rectangle", floor));
+    props.set_object("wall", create(ObjectType::Shape, "rectangle", wall));
+    Properties sphere;
+    sphere.set_vector("center", Vector3f(1, 0, 1));
+    sphere.set_float("radius", 0.25);
+    props.set_object("ball", create(ObjectType::Shape, "sphere", sphere));
+    Scene scene(props);
+
+    PCG32 rng(5);
+    const Shape &ball = *scene.shapes()[2];
+    for (int i = 0; i < 2000; ++i) {
+        // A point on the floor right of the wall, found by tracing down.
+        Point3f start(0.05f + 1.9f * rng.next_float(), 3.8f * rng.next_float() - 1.9f, 1.f);
+        SurfaceInteraction ref;
+        ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(start.x, start.y, 3.f), Vector3f(0, 0, -1)), ref));
+        if (ref.shape != scene.shapes()[0].get())
+            continue; // under the ball
+        // Points on the ball: those facing the reference point are visible, the others are not.
+        PositionSample ps = ball.sample_position(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f to_ref = normalize(ref.p - ps.p);
+        float facing = dot(ps.n, to_ref);
+        if (std::abs(facing) < 0.05f)
+            continue; // the silhouette, where both answers are right
+        bool blocked = scene.ray_test(ref.spawn_ray_to(ps.p));
+        EXPECT_EQ(blocked, facing < 0.f) << "floor point " << ref.p << ", ball point " << ps.p;
+    }
+    // Through the wall: from the floor just left of it to points on its right.
+    for (float x : {-1e-3f, -1e-4f}) {
+        SurfaceInteraction ref;
+        ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(x, 0.3f, 3.f), Vector3f(0, 0, -1)), ref));
+        for (Point3f target : {Point3f(0.5f, 0.3f, 0.5f), Point3f(1.f, -1.f, 1e-3f),
+                               Point3f(0.01f, 0.3f, 1.f)})
+            EXPECT_TRUE(scene.ray_test(ref.spawn_ray_to(target))) << x << " -> " << target;
+        // The same points are reachable from the right side.
+        SurfaceInteraction right;
+        ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-x, 0.3f, 3.f), Vector3f(0, 0, -1)), right));
+        EXPECT_FALSE(scene.ray_test(right.spawn_ray_to(Point3f(0.5f, 0.3f, 0.5f))));
+    }
+}
+
+TEST(SceneEmitters, SampleAndPdfAgree) {
+    REQUIRE_PLUGINS();
+    const Color3f radiance(2.f, 3.f, 4.f);
+    Properties props = rect_and_sphere(area_light(radiance));
+    Properties point;
+    point.set_vector("position", Vector3f(1, 1, 4));
+    props.set_object("lamp", create(ObjectType::Emitter, "point", point));
+    Scene scene(props);
+    ASSERT_EQ(scene.emitters().size(), 2u);
+    const Emitter *sphere_light = scene.shapes()[1]->emitter();
+
+    SurfaceInteraction ref;
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(0.7f, -0.4f, 3.f), Vector3f(0, 0, -1)), ref));
+    PCG32 rng(8);
+    int area_samples = 0, point_samples = 0;
+    for (int i = 0; i < 1000; ++i) {
+        Point2f u(rng.next_float(), rng.next_float());
+        auto [ds, weight] = scene.sample_emitter_direction(ref, u, true);
+        if (u.x < 0.5f) {
+            ASSERT_EQ(ds.emitter, sphere_light);
+            ASSERT_GT(ds.pdf, 0.f);
+            ++area_samples;
+            EXPECT_NEAR(scene.pdf_emitter_direction(ref, ds), ds.pdf, 1e-5f * ds.pdf);
+            // The point on the ball seen from the floor is visible: the weight is L / pdf.
+            EXPECT_NEAR(weight.r * ds.pdf, radiance.r, 1e-4f);
+            EXPECT_NEAR(weight.b * ds.pdf, radiance.b, 1e-4f);
+            // Half of the pdf comes from picking this emitter.
+            EXPECT_NEAR(ds.pdf, 0.5f * sphere_light->pdf_direction(ref, ds), 1e-5f * ds.pdf);
+        } else {
+            ASSERT_NE(ds.emitter, sphere_light);
+            EXPECT_TRUE(ds.delta);
+            ++point_samples;
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), 0.f);
+            // The ball sits between the floor point and the lamp only for some points.
+            Ray shadow = ref.spawn_ray_to(ds.p);
+            EXPECT_EQ(weight.is_black(), scene.ray_test(shadow));
+        }
+    }
+    EXPECT_GT(area_samples, 400);
+    EXPECT_GT(point_samples, 400);
+
+    // Occluded: from (-1, -1, 0) the line to the lamp passes through the centre of the ball.
+    SurfaceInteraction under;
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-1.f, -1.f, 1.f), Vector3f(0, 0, -1)), under));
+    auto [ds, weight] = scene.sample_emitter_direction(under, Point2f(0.75f, 0.5f), true);
+    EXPECT_TRUE(weight.is_black());
+    auto [ds2, weight2] = scene.sample_emitter_direction(under, Point2f(0.75f, 0.5f), false);
+    EXPECT_FALSE(weight2.is_black());
+}
+
+TEST(SceneEmitters, EnvironmentIsEvaluatedOnMisses) {
+    REQUIRE_PLUGINS();
+    Properties props = rect_and_sphere();
+    Properties sky;
+    sky.set_color("radiance", Color3f(0.5f, 0.25f, 0.125f));
+    props.set_object("sky", create(ObjectType::Emitter, "constant", sky));
+    Scene scene(props);
+    ASSERT_EQ(scene.environment_emitters().size(), 1u);
+    Color3f env = scene.eval_environment(Ray(Point3f(0, 0, 5), Vector3f(0, 0, 1)));
+    EXPECT_NEAR(env.r, 0.5f, 1e-6f);
+    EXPECT_NEAR(env.g, 0.25f, 1e-6f);
+    EXPECT_NEAR(env.b, 0.125f, 1e-6f);
+    Scene empty_env(rect_and_sphere());
+    EXPECT_TRUE(empty_env.eval_environment(Ray(Point3f(0, 0, 5), Vector3f(0, 0, 1))).is_black());
+}
