@@ -36,6 +36,13 @@ std::string join(const std::vector<std::string> &v) {
 
 std::string kind_name(ObjectType kind) { return object_type_name(kind); }
 
+/// "a bsdf", "an emitter", "an integrator".
+std::string with_article(ObjectType kind) {
+    std::string name = kind_name(kind);
+    bool vowel = !name.empty() && std::string("aeiou").find(name[0]) != std::string::npos;
+    return (vowel ? "an " : "a ") + name;
+}
+
 } // namespace
 
 PluginRegistry::PluginRegistry() = default;
@@ -120,8 +127,8 @@ const PluginDescriptor &PluginRegistry::load_library(const std::string &path, Ob
         FACET_THROW("plugin \"{}\" calls itself \"{}\"; the library must be named after its plugin",
                     path, desc->name ? desc->name : "");
     if (expected != ObjectType::Unknown && desc->kind != expected)
-        FACET_THROW("plugin \"{}\" ({}) is a {} plugin, but a {} was expected here", desc->name, path,
-                    kind_name(desc->kind), kind_name(expected));
+        FACET_THROW("plugin \"{}\" ({}) is {} plugin, but {} was expected here", desc->name, path,
+                    with_article(desc->kind), with_article(expected));
     m_loaded[desc->name] = desc;
     return *desc;
 }
@@ -139,23 +146,23 @@ const PluginDescriptor &PluginRegistry::descriptor(const std::string &name, Obje
             std::vector<std::string> known = available(expected);
             std::string msg = fmt::format("unknown {}plugin \"{}\"", kind, name);
             std::string close = closest_name(name, known);
-            if (!close.empty()) msg += fmt::format("; did you mean \"{}\"?", close);
+            msg += close.empty() ? "." : fmt::format("; did you mean \"{}\"?", close);
             if (known.empty())
-                msg += fmt::format(". No {}plugins were found (searched: {})", kind,
+                msg += fmt::format(" No {}plugins were found (searched: {})", kind,
                                    join(search_path()));
             else
-                msg += fmt::format(". Known {}plugins: {}", kind, join(known));
+                msg += fmt::format(" Known {}plugins: {}", kind, join(known));
             throw Error(msg);
         }
         desc = &load_library(path, ObjectType::Unknown);
         if (expected != ObjectType::Unknown && desc->kind != expected)
-            FACET_THROW("plugin \"{}\" ({}) is a {} plugin, but a {} was expected here", name, path,
-                        kind_name(desc->kind), kind_name(expected));
+            FACET_THROW("plugin \"{}\" ({}) is {} plugin, but {} was expected here", name, path,
+                        with_article(desc->kind), with_article(expected));
         return *desc;
     }
     if (expected != ObjectType::Unknown && desc->kind != expected)
-        FACET_THROW("plugin \"{}\" is a {} plugin, but a {} was expected here", name,
-                    kind_name(desc->kind), kind_name(expected));
+        FACET_THROW("plugin \"{}\" is {} plugin, but {} was expected here", name,
+                    with_article(desc->kind), with_article(expected));
     return *desc;
 }
 
@@ -187,8 +194,8 @@ std::shared_ptr<Object> PluginRegistry::create(ObjectType expected, const Proper
                        kind_name(desc->kind), name);
     if (expected != ObjectType::Unknown && obj->type() != expected)
         FACET_THROW_AT(props.location(),
-                       "plugin \"{}\" created an object of kind {}, but a {} was expected here", name,
-                       kind_name(obj->type()), kind_name(expected));
+                       "plugin \"{}\" created {}, but {} was expected here", name,
+                       with_article(obj->type()), with_article(expected));
     if (!props.id().empty()) obj->set_id(props.id());
     check_unqueried(props, obj->type(), lenient);
     return obj;

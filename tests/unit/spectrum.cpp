@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
