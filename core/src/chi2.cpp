@@ -550,7 +550,9 @@ void write_chi2_heatmap(const std::string &path, const Chi2Result &r) {
         for (int ip = 0; ip < r.phi_res; ++ip) {
             size_t k = size_t(jc) * r.phi_res + ip;
             double o = r.observed[k], e = r.expected[k];
-            Color3f panels[3] = {sequential(o / peak), sequential(e / peak), Color3f(1.f)};
+            // Logarithmic, so that faint lobes next to a peak stay visible.
+            Color3f panels[3] = {sequential(std::log1p(o) / std::log1p(peak)),
+                                 sequential(std::log1p(e) / std::log1p(peak)), Color3f(0.12f)};
             if (e > 0.0)
                 panels[2] = diverging((o - e) / std::sqrt(e) / 5.0);
             else if (o > 0.0)

@@ -114,8 +114,10 @@ struct Chi2Result {
 /// Runs the whole test.
 Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts = {});
 
-/// Writes observed | expected | difference side by side as a PNG (difference = (o - e)/√e, red
-/// above and blue below expectation; cells with samples but zero expectation are green).
+/// Writes observed | expected | difference side by side as a PNG: φ from -π to π left to right,
+/// cos θ from 1 (top) to -1. Counts on a logarithmic scale; difference = (o - e)/√e, red above
+/// and blue below expectation (full colour at 5), dark grey where both are zero, green where
+/// samples fell into a cell expecting none.
 void write_chi2_heatmap(const std::string &path, const Chi2Result &result);
 /// Writes the observed and expected tables as text (one line per cell).
 void write_chi2_tables(const std::string &path, const Chi2Result &result);
