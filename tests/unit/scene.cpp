@@ -375,3 +375,36 @@ TEST(SceneEmitters, EnvironmentIsEvaluatedOnMisses) {
     Scene empty_env(rect_and_sphere());
     EXPECT_TRUE(empty_env.eval_environment(Ray(Point3f(0, 0, 5), Vector3f(0, 0, 1))).is_black());
 }
+
+TEST(SceneQuery, InstancesDispatchToTheGroupMembers) {
+    REQUIRE_PLUGINS();
+    auto names = PluginRegistry::instance().available();
+    if (std::find(names.begin(), names.end(), "instance") == names.end())
+        GTEST_SKIP() << "instance plugin not built";
+    Properties ball;
+    ball.set_float("radius", 0.5);
+    Properties group("shapegroup");
+    group.set_object("ball", create(ObjectType::Shape, "sphere", ball));
+    auto group_obj = PluginRegistry::instance().create(ObjectType::Shape, group);
+    Properties props;
+    for (float x : {-2.f, 2.f}) {
+        Properties inst;
+        inst.set_object("group", group_obj);
+        inst.set_transform("to_world", Transform::translate(Vector3f(x, 0, 0)));
+        props.set_object(fmt::format("inst{}", x), create(ObjectType::Shape, "instance", inst));
+    }
+    props.set_object("group", group_obj);
+    Scene scene(props);
+    SurfaceInteraction si;
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(2, 0, 5), Vector3f(0, 0, -1)), si));
+    EXPECT_NEAR(si.t, 4.5f, 1e-5f);
+    expect_near_vec(si.p, Vector3f(2, 0, 0.5f), 1e-5f);
+    expect_near_vec(si.n, Vector3f(0, 0, 1), 1e-5f);
+    ASSERT_NE(si.shape, nullptr);
+    EXPECT_NE(si.bsdf(), nullptr); // members of groups get the default BSDF too
+    EXPECT_FALSE(scene.ray_intersect(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1)), si));
+    EXPECT_TRUE(scene.ray_test(Ray(Point3f(-2, 0, 5), Vector3f(0, 0, -1))));
+    // The group itself is not visible and does not extend the bounds twice.
+    expect_near_vec(scene.bbox().min, Vector3f(-2.5f, -0.5f, -0.5f), 1e-5f);
+    expect_near_vec(scene.bbox().max, Vector3f(2.5f, 0.5f, 0.5f), 1e-5f);
+}
