@@ -82,9 +82,16 @@ RTCDevice embree_device(int threads) {
 }
 
 Scene::Scene(const Properties &props) {
-    // Embree asks every thread that builds or traces to flush denormals.
-    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    // Embree asks every thread that builds or traces to flush denormals; the caller's mode is
+    // restored afterwards (render threads set their own).
+    struct FlushDenormals {
+        unsigned csr = _mm_getcsr();
+        FlushDenormals() {
+            _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+            _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+        }
+        ~FlushDenormals() { _mm_setcsr(csr); }
+    } flush_denormals;
 
     for (const auto &[name, obj] : props.objects()) {
         if (!obj)
@@ -159,24 +166,31 @@ Scene::Scene(const Properties &props) {
     m_rtc_scene = rtcNewScene(m_device);
     rtcSetSceneFlags(m_rtc_scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
-    for (auto &shape : m_shapes) {
-        RTCGeometry geom = shape->embree_geometry(m_device);
-        if (!geom)
-            continue; // a shape group: only visible through its instances
-        unsigned id = rtcAttachGeometry(m_rtc_scene, geom);
-        rtcReleaseGeometry(geom); // the scene holds it now
-        if (id >= m_geometry_shapes.size())
-            m_geometry_shapes.resize(id + 1, nullptr);
-        m_geometry_shapes[id] = shape.get();
-        m_bbox.expand(shape->bbox());
-    }
-    rtcCommitScene(m_rtc_scene);
-    RTCError err = rtcGetDeviceError(m_device);
-    if (err != RTC_ERROR_NONE)
-        FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));
+    try {
+        for (auto &shape : m_shapes) {
+            RTCGeometry geom = shape->embree_geometry(m_device);
+            if (!geom)
+                continue; // a shape group: only visible through its instances
+            unsigned id = rtcAttachGeometry(m_rtc_scene, geom);
+            rtcReleaseGeometry(geom); // the scene holds it now
+            if (id >= m_geometry_shapes.size())
+                m_geometry_shapes.resize(id + 1, nullptr);
+            m_geometry_shapes[id] = shape.get();
+            m_bbox.expand(shape->bbox());
+        }
+        rtcCommitScene(m_rtc_scene);
+        RTCError err = rtcGetDeviceError(m_device);
+        if (err != RTC_ERROR_NONE)
+            FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));
 
-    for (auto &emitter : m_emitters)
-        emitter->set_scene(*this);
+        for (auto &emitter : m_emitters)
+            emitter->set_scene(*this);
+    } catch (...) {
+        // The destructor does not run for a half-built object.
+        rtcReleaseScene(m_rtc_scene);
+        rtcReleaseDevice(m_device);
+        throw;
+    }
 }
 
 Scene::~Scene() {
