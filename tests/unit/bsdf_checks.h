@@ -146,3 +146,18 @@ inline void expect_chi2(const Chi2Adapter &adapter, const std::string &name, Chi
 }
 
 } // namespace bsdf_checks
+
+namespace bsdf_checks {
+
+/// Every parameter the plugin asked for (present or not) appears as a row of its doc table.
+inline void expect_documented(const std::string &plugin, const Params &params = {}) {
+    Properties props = make_props(plugin, params);
+    PluginRegistry::instance().create(ObjectType::BSDF, props);
+    std::string doc = PluginRegistry::instance().descriptor(plugin, ObjectType::BSDF).doc;
+    EXPECT_FALSE(props.requested_names().empty());
+    for (const std::string &name : props.requested_names())
+        EXPECT_NE(doc.find("| " + name + " |"), std::string::npos)
+            << plugin << ": parameter \"" << name << "\" is missing from the doc table";
+}
+
+} // namespace bsdf_checks
