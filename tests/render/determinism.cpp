@@ -1,0 +1,213 @@
+// The render loop: bit-identical images for any thread count, seeds that matter, cancellation,
+// dropped NaN samples and AOV channels.
+#include <facet/integrator.h>
+#include <facet/plugin.h>
+#include <facet/render.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/xml.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+using namespace facet;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Writes `xml` to a scene file in a temporary folder and loads it with the XML loader.
+std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::string &xml) {
+    fs::path dir = fs::temp_directory_path() / fmt::format("facet-determinism-{}", ::getpid());
+    fs::create_directories(dir);
+    fs::path file = dir / (name + ".xml");
+    std::ofstream(file) << xml;
+    auto scene = load_scene(file.string());
+    fs::remove_all(dir);
+    return scene;
+}
+
+std::string scene_xml(const std::string &integrator, int size, int spp, const std::string &rfilter) {
+    return fmt::format(R"(<scene version="3.0.0">
+    {integrator}
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world">
+            <lookat origin="0, 1.5, 5" target="0, 0.3, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent">
+            <integer name="sample_count" value="{spp}"/>
+            <integer name="seed" value="3"/>
+        </sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="{size}"/>
+            <integer name="height" value="{size}"/>
+            {rfilter}
+        </film>
+    </sensor>
+    <emitter type="constant">
+        <rgb name="radiance" value="0.3, 0.4, 0.5"/>
+    </emitter>
+    <emitter type="point">
+        <point name="position" x="2" y="3" z="2"/>
+        <rgb name="intensity" value="20, 18, 15"/>
+    </emitter>
+    <shape type="sphere">
+        <point name="center" x="0" y="0.5" z="0"/>
+        <float name="radius" value="0.5"/>
+        <bsdf type="diffuse">
+            <rgb name="reflectance" value="0.8, 0.3, 0.2"/>
+        </bsdf>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <rotate x="1" angle="-90"/>
+            <scale value="3"/>
+        </transform>
+        <bsdf type="diffuse">
+            <rgb name="reflectance" value="0.5"/>
+        </bsdf>
+    </shape>
+</scene>)",
+                       fmt::arg("integrator", integrator), fmt::arg("size", size), fmt::arg("spp", spp),
+                       fmt::arg("rfilter", rfilter));
+}
+
+const char *PATH = R"(<integrator type="path"><integer name="max_depth" value="6"/></integrator>)";
+
+RenderResult render_with(const Scene &scene, int threads, uint64_t seed = 0, int block_size = 8) {
+    RenderOptions opts;
+    opts.threads = threads;
+    opts.seed = seed;
+    opts.block_size = block_size;
+    opts.progress = false;
+    return render(scene, *scene.sensors().at(0), opts);
+}
+
+bool identical(const Image &a, const Image &b) {
+    return a.width == b.width && a.height == b.height && a.channels == b.channels &&
+           a.data.size() == b.data.size() &&
+           std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(float)) == 0;
+}
+
+/// Test integrator: radiance 1 for most samples and NaN or infinity for the others (decided by
+/// the sampler, so it varies within a pixel); AOVs "test.half" = 0.5 and "test.dz" = -ray.d.z.
+class InvalidSamplesIntegrator final : public SamplingIntegrator {
+public:
+    explicit InvalidSamplesIntegrator(const Properties &) {}
+    Color3f sample(const Scene &, Sampler &sampler, const Ray &ray, float *aovs) const override {
+        aovs[0] = 0.5f;
+        aovs[1] = -ray.d.z; // the camera looks down -z
+        float u = sampler.next_1d();
+        if (u < 0.2f) return Color3f(std::nanf(""), 1.f, 1.f);
+        if (u < 0.3f) return Color3f(1.f, Infinity, 1.f);
+        return Color3f(1.f, 2.f, 3.f);
+    }
+    std::vector<std::string> aov_names() const override { return {"test.half", "test.dz"}; }
+};
+
+const PluginDescriptor *invalid_samples_descriptor() {
+    static const PluginDescriptor desc{FACET_ABI_VERSION, ObjectType::Integrator, "test_invalid_samples",
+                                       "test integrator", "",
+                                       [](const Properties &p) -> Object * { return new InvalidSamplesIntegrator(p); }};
+    return &desc;
+}
+
+} // namespace
+
+TEST(RenderLoop, BitIdenticalForAnyThreadCount) {
+    auto scene = load_temp_scene("threads", scene_xml(PATH, 32, 16, ""));
+    RenderResult one = render_with(*scene, 1);
+    RenderResult two = render_with(*scene, 2);
+    RenderResult four = render_with(*scene, 4);
+    ASSERT_EQ(one.image.width, 32);
+    ASSERT_EQ(one.image.height, 32);
+    ASSERT_EQ(one.image.channels, 3);
+    EXPECT_EQ(one.blocks_total, 16u);
+    EXPECT_EQ(one.blocks_done, 16u);
+    EXPECT_FALSE(one.cancelled);
+    EXPECT_EQ(one.samples, 32u * 32u * 16u);
+    EXPECT_TRUE(identical(one.image, two.image));
+    EXPECT_TRUE(identical(one.image, four.image));
+
+    // Not a trivially constant image: lit and unlit parts, all finite and non-negative.
+    float lo = Infinity, hi = 0.f;
+    for (float v : one.image.data) {
+        ASSERT_TRUE(std::isfinite(v));
+        ASSERT_GE(v, 0.f);
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    }
+    EXPECT_GT(hi, 2.f * lo + 0.05f);
+}
+
+TEST(RenderLoop, SeedSelectsTheNoise) {
+    auto scene = load_temp_scene("seed", scene_xml(PATH, 16, 4, "<rfilter type=\"box\"/>"));
+    RenderResult a = render_with(*scene, 2, 0);
+    RenderResult b = render_with(*scene, 2, 0);
+    RenderResult c = render_with(*scene, 2, 1);
+    EXPECT_TRUE(identical(a.image, b.image));
+    EXPECT_FALSE(identical(a.image, c.image));
+    // Different noise, same picture: the means agree within a few percent.
+    double ma = 0, mc = 0;
+    for (size_t i = 0; i < a.image.data.size(); ++i) {
+        ma += a.image.data[i];
+        mc += c.image.data[i];
+    }
+    EXPECT_NEAR(ma / mc, 1.0, 0.1);
+}
+
+TEST(RenderLoop, SppOverride) {
+    auto scene = load_temp_scene("spp", scene_xml(PATH, 8, 4, ""));
+    RenderOptions opts;
+    opts.progress = false;
+    opts.spp = 3;
+    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
+    EXPECT_EQ(r.samples, 8u * 8u * 3u);
+    opts.spp = -1;
+    EXPECT_THROW(render(*scene, *scene->sensors().at(0), opts), Error);
+}
+
+TEST(RenderLoop, CancelBeforeStartRendersNothing) {
+    auto scene = load_temp_scene("cancel", scene_xml(PATH, 16, 2, ""));
+    std::atomic<bool> cancel{true};
+    RenderOptions opts;
+    opts.progress = false;
+    opts.cancel = &cancel;
+    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
+    EXPECT_TRUE(r.cancelled);
+    EXPECT_EQ(r.blocks_done, 0u);
+    EXPECT_EQ(r.samples, 0u);
+    ASSERT_EQ(r.image.width, 16);
+    for (float v : r.image.data) EXPECT_EQ(v, 0.f);
+}
+
+TEST(RenderLoop, InvalidSamplesAreDroppedAndAovsDeveloped) {
+    PluginRegistry::instance().register_static(invalid_samples_descriptor());
+    auto scene = load_temp_scene(
+        "nan", scene_xml("<integrator type=\"test_invalid_samples\"/>", 8, 16, "<rfilter type=\"tent\"/>"));
+    const size_t warnings = Logger::warning_count();
+    RenderResult r = render_with(*scene, 2);
+    EXPECT_GT(Logger::warning_count(), warnings); // reported
+    ASSERT_EQ(r.image.channels, 5);
+    EXPECT_EQ(r.image.channel_names,
+              (std::vector<std::string>{"R", "G", "B", "test.half", "test.dz"}));
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            // Every pixel only averages the valid samples.
+            EXPECT_FLOAT_EQ(r.image.at(x, y, 0), 1.f);
+            EXPECT_FLOAT_EQ(r.image.at(x, y, 1), 2.f);
+            EXPECT_FLOAT_EQ(r.image.at(x, y, 2), 3.f);
+            EXPECT_FLOAT_EQ(r.image.at(x, y, 3), 0.5f);
+            // The camera looks down -z: -d.z is largest in the middle of the image.
+            float dz = r.image.at(x, y, 4);
+            EXPECT_GT(dz, 0.f);
+            EXPECT_LE(dz, 1.f);
+        }
+    EXPECT_GT(r.image.at(4, 4, 4), r.image.at(0, 0, 4));
+}
