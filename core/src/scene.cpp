@@ -21,26 +21,26 @@ namespace facet {
 namespace {
 
 /// Per-thread count of ray_intersect() and ray_test() calls, summed by Scene::ray_count() for
-/// `facet bench`. The hot path only does a relaxed load and store on its own thread's counter
-/// (plain moves: no lock, no read-modify-write). Each counter registers once per thread and folds
-/// its count into the retired total when its thread ends.
-struct RayCounter {
+/// `facet bench`. The hot path only does a relaxed load and store on its own thread's slot (plain
+/// moves: no lock, no read-modify-write). A thread registers its slot on its first ray. Slots and
+/// their list are never freed, so nothing needs destroying when threads or the process end (TBB
+/// workers can outlive static destructors).
+struct alignas(64) RayCounter {
     std::atomic<uint64_t> count{0};
-    static std::mutex &mutex() { static std::mutex m; return m; }
-    static std::vector<RayCounter *> &all() { static std::vector<RayCounter *> v; return v; }
-    static uint64_t &retired() { static uint64_t r = 0; return r; }
-    RayCounter() {
-        std::lock_guard<std::mutex> lock(mutex());
-        all().push_back(this);
-    }
-    ~RayCounter() {
-        std::lock_guard<std::mutex> lock(mutex());
-        retired() += count.load(std::memory_order_relaxed);
-        all().erase(std::find(all().begin(), all().end(), this));
-    }
-    void add() { count.store(count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed); }
 };
-thread_local RayCounter t_ray_counter;
+std::mutex g_ray_counter_mutex;
+std::vector<RayCounter *> *g_ray_counters = new std::vector<RayCounter *>();
+thread_local RayCounter *t_ray_counter = nullptr;
+
+inline void count_ray() {
+    RayCounter *c = t_ray_counter;
+    if (!c) {
+        c = t_ray_counter = new RayCounter();
+        std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
+        g_ray_counters->push_back(c);
+    }
+    c->count.store(c->count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
 
 const char *embree_error_name(RTCError code) {
     switch (code) {
@@ -201,14 +201,14 @@ Scene::~Scene() {
 }
 
 uint64_t Scene::ray_count() {
-    std::lock_guard<std::mutex> lock(RayCounter::mutex());
-    uint64_t total = RayCounter::retired();
-    for (const RayCounter *c : RayCounter::all()) total += c->count.load(std::memory_order_relaxed);
+    std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
+    uint64_t total = 0;
+    for (const RayCounter *c : *g_ray_counters) total += c->count.load(std::memory_order_relaxed);
     return total;
 }
 
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
-    t_ray_counter.add();
+    count_ray();
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
@@ -246,7 +246,7 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
 }
 
 bool Scene::ray_test(const Ray &ray) const {
-    t_ray_counter.add();
+    count_ray();
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay r;
