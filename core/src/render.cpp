@@ -66,7 +66,7 @@ public:
         const int filled = int(frac * width + 0.5);
         std::string bar(size_t(filled), '=');
         bar.append(size_t(width - filled), ' ');
-        std::string eta = done > 0 ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac) : "";
+        std::string eta = done > 0 && done < total ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac) : "";
         std::string line = fmt::format("\rRendering [{}] {:3d}% ({:.1f}s{})", bar, int(frac * 100.0), elapsed, eta);
         // Pad to clear what a longer earlier line left behind.
         if (line.size() < m_width) line.append(m_width - line.size(), ' ');

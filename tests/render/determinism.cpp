@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -118,6 +119,24 @@ const PluginDescriptor *invalid_samples_descriptor() {
     return &desc;
 }
 
+/// Test integrator that raises a cancel flag the first time it runs, and returns radiance 1.
+std::atomic<bool> *g_cancel_flag = nullptr;
+class CancellingIntegrator final : public SamplingIntegrator {
+public:
+    explicit CancellingIntegrator(const Properties &) {}
+    Color3f sample(const Scene &, Sampler &, const Ray &, float *) const override {
+        if (g_cancel_flag) g_cancel_flag->store(true);
+        return Color3f(1.f);
+    }
+};
+
+const PluginDescriptor *cancelling_descriptor() {
+    static const PluginDescriptor desc{FACET_ABI_VERSION, ObjectType::Integrator, "test_cancelling",
+                                       "test integrator", "",
+                                       [](const Properties &p) -> Object * { return new CancellingIntegrator(p); }};
+    return &desc;
+}
+
 } // namespace
 
 TEST(RenderLoop, BitIdenticalForAnyThreadCount) {
@@ -210,4 +229,46 @@ TEST(RenderLoop, InvalidSamplesAreDroppedAndAovsDeveloped) {
             EXPECT_LE(dz, 1.f);
         }
     EXPECT_GT(r.image.at(4, 4, 4), r.image.at(0, 0, 4));
+}
+
+TEST(RenderLoop, CancelFinishesTheBlockInFlight) {
+    PluginRegistry::instance().register_static(cancelling_descriptor());
+    auto scene = load_temp_scene(
+        "cancel_mid", scene_xml("<integrator type=\"test_cancelling\"/>", 8, 2, "<rfilter type=\"box\"/>"));
+    std::atomic<bool> cancel{false};
+    g_cancel_flag = &cancel;
+    RenderOptions opts;
+    opts.threads = 1;
+    opts.block_size = 4;
+    opts.progress = false;
+    opts.cancel = &cancel;
+    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
+    g_cancel_flag = nullptr;
+    // The first block (pixels 0-3 of rows 0-3) is finished and merged, the other three are not.
+    EXPECT_TRUE(r.cancelled);
+    EXPECT_EQ(r.blocks_total, 4u);
+    EXPECT_EQ(r.blocks_done, 1u);
+    EXPECT_EQ(r.samples, 4u * 4u * 2u);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) EXPECT_EQ(r.image.at(x, y, 0), (x < 4 && y < 4) ? 1.f : 0.f) << x << "," << y;
+}
+
+TEST(RenderLoop, InterruptHandlerSetsTheFlagOnce) {
+    std::atomic<bool> flag{false};
+    struct sigaction before;
+    sigaction(SIGINT, nullptr, &before);
+    install_interrupt_handler(&flag);
+    ::raise(SIGINT);
+    EXPECT_TRUE(flag.load());
+    // After the first signal the default action is back, so a second Ctrl-C quits.
+    struct sigaction now;
+    sigaction(SIGINT, nullptr, &now);
+    EXPECT_EQ(now.sa_handler, SIG_DFL);
+    flag = false;
+    install_interrupt_handler(&flag);
+    ::raise(SIGHUP);
+    EXPECT_TRUE(flag.load());
+    uninstall_interrupt_handler();
+    sigaction(SIGINT, nullptr, &now);
+    EXPECT_EQ(now.sa_handler, before.sa_handler);
 }
