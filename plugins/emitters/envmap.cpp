@@ -95,34 +95,23 @@ public:
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
                                                          const Point2f &u) const override {
         DirectionSample ds;
-        Vector3f local;
-        float pdf;
-        if (m_importance && m_distribution.valid()) {
-            float pdf_uv;
-            Point2f uv = m_distribution.sample(u, pdf_uv);
-            local = uv_to_direction(uv);
-            float sin_theta = std::sin(uv.y * Pi);
-            pdf = sin_theta > 0.f ? pdf_uv / (2.f * Pi * Pi * sin_theta) : 0.f;
-        } else {
-            local = warp::square_to_uniform_sphere(u);
-            pdf = InvFourPi;
-        }
-        if (!(pdf > 0.f)) return {ds, Color3f(0.f)};
+        Vector3f local = m_importance && m_cells.sum() > 0.0 ? uv_to_direction(sample_uv(u))
+                                                             : warp::square_to_uniform_sphere(u);
         ds.d = normalize(m_to_world.apply_vector(local));
         ds.dist = Infinity;
         ds.p = ref.p + ds.d * (2.f * m_radius + norm(ref.p - m_center));
         ds.n = -ds.d;
-        ds.pdf = pdf;
         ds.emitter = this;
-        return {ds, lookup(local) / pdf};
+        // Density and radiance of the direction as pdf_direction() and eval() will see it, so
+        // the three agree to the last bit even where rounding moves it across a cell border.
+        local = normalize(m_to_world.inverse().apply_vector(ds.d));
+        ds.pdf = pdf_local(local);
+        if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
+        return {ds, lookup(local) / ds.pdf};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
-        if (!(m_importance && m_distribution.valid())) return InvFourPi;
-        Vector3f local = normalize(m_to_world.inverse().apply_vector(ds.d));
-        Point2f uv = direction_to_uv(local);
-        float sin_theta = std::sin(uv.y * Pi);
-        return sin_theta > 0.f ? m_distribution.pdf(uv) / (2.f * Pi * Pi * sin_theta) : 0.f;
+        return pdf_local(normalize(m_to_world.inverse().apply_vector(ds.d)));
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
@@ -165,25 +154,117 @@ private:
                (pixel(x0, y0 + 1) * (1.f - tx) + pixel(x0 + 1, y0 + 1) * tx) * ty;
     }
 
-    /// Cell weights: the largest luminance the bilinear lookup can reach inside the cell (its
-    /// pixel and the 8 neighbours), times the cell's solid angle, so that every direction with
-    /// non-zero radiance has a non-zero density.
-    void build_distribution() {
-        std::vector<float> weights(size_t(m_width) * m_height);
-        for (int y = 0; y < m_height; ++y) {
-            float theta0 = float(y) / float(m_height) * Pi, theta1 = float(y + 1) / float(m_height) * Pi;
-            float solid_angle = std::cos(theta0) - std::cos(theta1);
-            for (int x = 0; x < m_width; ++x) {
-                float lum = 0.f;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        if (!m_bilinear && (dx != 0 || dy != 0)) continue;
-                        lum = std::max(lum, pixel(x + dx, y + dy).luminance());
-                    }
-                weights[size_t(y) * m_width + x] = lum * solid_angle;
-            }
+    // -- Importance sampling ------------------------------------------------------------------
+    // The bilinear lookup is a bilinear patch between each 2×2 group of pixel centres, so the
+    // sampling density is built on those patches: cell (i, j) spans u from (i + ½)/W to
+    // (i + 1½)/W (wrapping around) and v from (j - ½)/H to (j + ½)/H (clamped to [0, 1]; the
+    // half cells at the poles are constant in v). A cell is picked in proportion to its mean
+    // luminance times its solid angle, and a point inside it in proportion to the bilinear
+    // luminance, so the density is zero exactly where the radiance is. With nearest lookups
+    // the cells are the pixels and the density is constant inside each.
+
+    struct Cell {
+        float u0, du, v0, dv;
+        float a, b, c, d; ///< luminance at the corners (u0,v0), (u0+du,v0), (u0,v0+dv), (u0+du,v0+dv)
+    };
+
+    Cell cell(int i, int j) const {
+        Cell c;
+        if (!m_bilinear) {
+            c.u0 = float(i) / float(m_width);
+            c.du = 1.f / float(m_width);
+            c.v0 = float(j) / float(m_height);
+            c.dv = 1.f / float(m_height);
+            c.a = c.b = c.c = c.d = pixel(i, j).luminance();
+            return c;
         }
-        m_distribution = Distribution2D(weights, m_width, m_height);
+        c.u0 = (float(i) + 0.5f) / float(m_width);
+        c.du = 1.f / float(m_width);
+        float v0 = std::max(0.f, (float(j) - 0.5f) / float(m_height));
+        float v1 = std::min(1.f, (float(j) + 0.5f) / float(m_height));
+        c.v0 = v0;
+        c.dv = v1 - v0;
+        c.a = pixel(i, j - 1).luminance();
+        c.b = pixel(i + 1, j - 1).luminance();
+        c.c = pixel(i, j).luminance();
+        c.d = pixel(i + 1, j).luminance();
+        return c;
+    }
+
+    int cells_x() const { return m_width; }
+    int cells_y() const { return m_bilinear ? m_height + 1 : m_height; }
+
+    /// Cell holding uv, its index, and uv's position (s, t) inside it.
+    Cell locate(const Point2f &uv, size_t &index, float &s, float &t) const {
+        int i, j;
+        if (m_bilinear) {
+            float fx = uv.x * float(m_width) - 0.5f;
+            i = int(std::floor(fx));
+            j = std::clamp(int(std::floor(uv.y * float(m_height) + 0.5f)), 0, m_height);
+        } else {
+            i = int(uv.x * float(m_width));
+            j = std::clamp(int(uv.y * float(m_height)), 0, m_height - 1);
+        }
+        i = ((i % m_width) + m_width) % m_width;
+        index = size_t(j) * size_t(cells_x()) + size_t(i);
+        Cell c = cell(i, j);
+        float du = uv.x - c.u0;
+        du -= std::floor(du); // wrap across the seam
+        s = clamp(du / c.du, 0.f, 1.f);
+        t = c.dv > 0.f ? clamp((uv.y - c.v0) / c.dv, 0.f, 1.f) : 0.f;
+        return c;
+    }
+
+    static float bilinear(const Cell &c, float s, float t) {
+        return (1.f - s) * (1.f - t) * c.a + s * (1.f - t) * c.b + (1.f - s) * t * c.c + s * t * c.d;
+    }
+
+    /// Inverse CDF of the density on [0, 1] proportional to the line from v0 to v1.
+    static float sample_linear(float u, float v0, float v1) {
+        if (std::abs(v0 - v1) < 1e-6f * std::max(v0, v1)) return u;
+        float x = (v0 - safe_sqrt(lerp(u, v0 * v0, v1 * v1))) / (v0 - v1);
+        return clamp(x, 0.f, 1.f);
+    }
+
+    Point2f sample_uv(Point2f u) const {
+        float uc = u.x;
+        size_t index = m_cells.sample_reuse(uc);
+        Cell c = cell(int(index % size_t(cells_x())), int(index / size_t(cells_x())));
+        float t = sample_linear(u.y, 0.5f * (c.a + c.b), 0.5f * (c.c + c.d));
+        float s = sample_linear(uc, lerp(t, c.a, c.c), lerp(t, c.b, c.d));
+        float uu = c.u0 + s * c.du;
+        uu -= std::floor(uu);
+        return {std::min(uu, OneMinusEpsilon), c.v0 + t * c.dv};
+    }
+
+    /// Density per unit solid angle at uv (local direction `local`): the cell's probability
+    /// spread by the bilinear luminance, over the Jacobian dω = 2π² sin θ du dv.
+    float pdf_solid_angle(const Point2f &uv, const Vector3f &local) const {
+        float s, t;
+        size_t index;
+        Cell c = locate(uv, index, s, t);
+        float mean = 0.25f * (c.a + c.b + c.c + c.d);
+        // sin θ straight from the direction: acos near the poles would lose precision.
+        float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
+        if (!(mean > 0.f) || !(sin_theta > 0.f)) return 0.f;
+        float pdf_uv = m_cells.pmf(index) / (c.du * c.dv) * bilinear(c, s, t) / mean;
+        return pdf_uv / (2.f * Pi * Pi * sin_theta);
+    }
+
+    float pdf_local(const Vector3f &local) const {
+        if (!(m_importance && m_cells.sum() > 0.0)) return InvFourPi;
+        return pdf_solid_angle(direction_to_uv(local), local);
+    }
+
+    void build_distribution() {
+        std::vector<float> weights(size_t(cells_x()) * size_t(cells_y()));
+        for (int j = 0; j < cells_y(); ++j)
+            for (int i = 0; i < cells_x(); ++i) {
+                Cell c = cell(i, j);
+                float solid_angle = 2.f * Pi * c.du * (std::cos(c.v0 * Pi) - std::cos((c.v0 + c.dv) * Pi));
+                weights[size_t(j) * size_t(cells_x()) + size_t(i)] = 0.25f * (c.a + c.b + c.c + c.d) * solid_angle;
+            }
+        m_cells.build(weights.data(), weights.size());
     }
 
     std::string m_path;
@@ -192,7 +273,7 @@ private:
     bool m_bilinear = true, m_importance = true;
     int m_width = 0, m_height = 0;
     std::vector<Color3f> m_pixels;
-    Distribution2D m_distribution;
+    DiscreteDistribution m_cells;
     Point3f m_center;
     float m_radius = 1.f;
 };

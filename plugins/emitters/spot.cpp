@@ -29,6 +29,7 @@ the cone's cross-section at the cutoff angle) and multiplies the intensity.
 #include <facet/plugin.h>
 #include <facet/texture.h>
 #include <facet/transform.h>
+#include <facet/warp.h>
 
 namespace facet {
 
@@ -87,6 +88,19 @@ public:
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
+
+    /// Directions uniformly inside the cone (the falloff is smooth enough not to need more).
+    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
+        Vector3f local = warp::square_to_uniform_cone(u_dir, m_cos_cutoff);
+        float pdf = warp::square_to_uniform_cone_pdf(local, m_cos_cutoff);
+        Ray ray(m_position, normalize(m_to_world.apply_vector(local)));
+        return {ray, intensity(local) / pdf};
+    }
+
+    float pdf_ray_direction(const Vector3f &d) const override {
+        Vector3f local = normalize(m_to_world.inverse().apply_vector(d));
+        return warp::square_to_uniform_cone_pdf(local, m_cos_cutoff);
+    }
     Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
 
     std::string to_string() const override {

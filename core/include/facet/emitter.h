@@ -2,6 +2,7 @@
 
 #include <facet/color.h>
 #include <facet/interaction.h>
+#include <facet/logger.h>
 #include <facet/object.h>
 
 #include <utility>
@@ -39,6 +40,19 @@ public:
     virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const = 0;
     /// Emitted radiance; zero for delta emitters.
     virtual Color3f eval(const SurfaceInteraction &si) const = 0;
+
+    /// Samples a ray leaving the emitter (light tracing, photon emission) from two uniform pairs:
+    /// `u_pos` for the position, `u_dir` for the direction. Returns the ray and the power
+    /// weight (emitted intensity or radiance·cos over the joint density). Not every emitter
+    /// supports it; those that do not throw.
+    virtual std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const {
+        FACET_THROW("{} cannot sample emitted rays", to_string());
+    }
+    /// Solid-angle density of the directions sample_ray() draws, for emitters with one origin
+    /// (point, spot); `d` is a unit world-space direction.
+    virtual float pdf_ray_direction(const Vector3f &d) const {
+        FACET_THROW("{} cannot sample emitted rays", to_string());
+    }
 
     /// Called by the shape that owns an area emitter.
     virtual void set_shape(const Shape *shape) { m_shape = shape; }

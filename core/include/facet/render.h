@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/fwd.h>
 #include <facet/image.h>
 
 #include <atomic>

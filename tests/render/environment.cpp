@@ -1,0 +1,136 @@
+// Environment lighting: a diffuse plane seen by an orthographic camera straight from above, lit
+// by an environment map. Every pixel then estimates the same number, ρ/π ∫ L(ω) cos θ dω over
+// the upper hemisphere, which the test integrates by quadrature of the emitter's own lookup.
+// Importance sampling and uniform sampling of the map must agree with it (and with each other)
+// within their noise, and importance sampling must be the less noisy one.
+
+#include <facet/emitter.h>
+#include <facet/image.h>
+#include <facet/render.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/xml.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+using namespace facet;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A 64×32 sky: a blue-to-white gradient, a warm bright "sun" patch, dark below the horizon.
+std::string write_sky(const fs::path &dir) {
+    Image img(64, 32, 3);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            float t = float(y) / float(img.height - 1);
+            Color3f c = t < 0.5f ? Color3f(0.3f + t, 0.5f + t, 1.0f) : Color3f(0.05f, 0.04f, 0.03f);
+            if (x >= 40 && x < 43 && y >= 8 && y < 10) c = Color3f(400.f, 300.f, 200.f);
+            for (int ch = 0; ch < 3; ++ch) img.at(x, y, ch) = c[ch];
+        }
+    std::string path = (dir / "sky.exr").string();
+    write_image(path, img);
+    return path;
+}
+
+std::string scene_xml(const std::string &sky, bool importance) {
+    return R"(<scene version="3.0.0">
+    <integrator type="direct"/>
+    <sensor type="orthographic">
+        <transform name="to_world">
+            <scale value="0.5"/>
+            <lookat origin="0, 5, 0" target="0, 0, 0" up="0, 0, 1"/>
+        </transform>
+        <sampler type="independent"><integer name="sample_count" value="32"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="32"/><integer name="height" value="32"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="envmap">
+        <string name="filename" value=")" + sky + R"("/>
+        <boolean name="importance_sampling" value=")" + (importance ? "true" : "false") + R"("/>
+    </emitter>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="100"/><rotate x="1" angle="-90"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
+    </shape>
+</scene>)";
+}
+
+struct Stats {
+    Color3f mean, stderr_;
+    float luminance_stddev = 0.f;
+};
+
+Stats render_stats(const std::string &xml) {
+    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
+    RenderOptions opts;
+    opts.progress = false;
+    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
+    const Image &img = r.image;
+    size_t n = size_t(img.width) * img.height;
+    Stats s;
+    Color3f sum, sum2;
+    double lsum = 0, lsum2 = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            Color3f c(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2));
+            sum += c;
+            sum2 += c * c;
+            lsum += c.luminance();
+            lsum2 += double(c.luminance()) * c.luminance();
+        }
+    s.mean = sum / float(n);
+    for (int ch = 0; ch < 3; ++ch) {
+        float var = sum2[ch] / float(n) - s.mean[ch] * s.mean[ch];
+        s.stderr_[ch] = std::sqrt(std::max(var, 0.f) / float(n - 1));
+    }
+    double lm = lsum / double(n);
+    s.luminance_stddev = float(std::sqrt(std::max(lsum2 / double(n) - lm * lm, 0.0)));
+    return s;
+}
+
+/// ρ/π ∫ L(ω) cos θ dω over the upper hemisphere, by the midpoint rule on a fine (θ, φ) grid.
+Color3f reference_radiance(const std::string &xml) {
+    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
+    const Emitter &env = *scene->environment_emitters().at(0);
+    const int nt = 512, np = 1024;
+    Color3f sum;
+    for (int i = 0; i < nt; ++i) {
+        double theta = (i + 0.5) * (M_PI / 2) / nt;
+        for (int j = 0; j < np; ++j) {
+            double phi = (j + 0.5) * 2 * M_PI / np;
+            Vector3f d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+                       float(std::sin(theta) * std::sin(phi)));
+            SurfaceInteraction si;
+            si.wi = -d;
+            sum += env.eval(si) * float(std::cos(theta) * std::sin(theta));
+        }
+    }
+    double dA = (M_PI / 2 / nt) * (2 * M_PI / np);
+    return sum * float(dA * 0.5 / M_PI);
+}
+
+} // namespace
+
+TEST(EnvironmentMap, ImportanceAndUniformSamplingAgreeWithQuadrature) {
+    fs::path dir = fs::temp_directory_path() / "facet-envmap-render";
+    fs::create_directories(dir);
+    std::string sky = write_sky(dir);
+    Color3f ref = reference_radiance(scene_xml(sky, true));
+    Stats is = render_stats(scene_xml(sky, true));
+    Stats us = render_stats(scene_xml(sky, false));
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(is.mean[ch], ref[ch], 4.f * is.stderr_[ch] + 1e-3f * ref[ch]) << "importance, channel " << ch;
+        EXPECT_NEAR(us.mean[ch], ref[ch], 4.f * us.stderr_[ch] + 1e-3f * ref[ch]) << "uniform, channel " << ch;
+        float se = std::sqrt(sqr(is.stderr_[ch]) + sqr(us.stderr_[ch]));
+        EXPECT_NEAR(is.mean[ch], us.mean[ch], 4.f * se) << "channel " << ch;
+    }
+    // The sun holds most of the energy in a tiny solid angle: sampling by luminance must be
+    // far less noisy than sampling the sphere uniformly.
+    EXPECT_LT(is.luminance_stddev * 3.f, us.luminance_stddev);
+}
