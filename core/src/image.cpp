@@ -1,5 +1,6 @@
 #include <facet/image.h>
 #include <facet/logger.h>
+#include <facet/spectrum.h>
 
 #include <OpenColorIO/OpenColorIO.h>
 #include <OpenImageIO/imageio.h>
@@ -84,10 +85,19 @@ std::vector<uint8_t> to_display_8bit(const Image &image, const std::vector<int> 
     const int nout = int(ch.size());
     const bool grey = nout <= 2, alpha = nout == 2 || nout == 4;
     // OCIO works on RGB or RGBA; grey values are expanded to RGB and the red channel is kept.
+    // Films developed to CIE XYZ (pixel_format xyz) are displayed through linear Rec.709.
+    const bool xyz = !grey && image.channel_names.size() >= 3 && image.channel_names[0] == "X" &&
+                     image.channel_names[1] == "Y" && image.channel_names[2] == "Z";
     std::vector<float> rgb(npix * 3);
     for (size_t i = 0; i < npix; ++i) {
         const float *src = image.data.data() + i * image.channels;
         for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = src[grey ? ch[0] : ch[c]];
+        if (xyz) {
+            Color3f c = xyz_to_srgb(Color3f(rgb[i * 3], rgb[i * 3 + 1], rgb[i * 3 + 2]));
+            rgb[i * 3] = c.r;
+            rgb[i * 3 + 1] = c.g;
+            rgb[i * 3 + 2] = c.b;
+        }
     }
     auto cpu = display_processor(ocio_config_path(opts.ocio_config), opts.display, opts.view);
     OCIO::PackedImageDesc desc(rgb.data(), long(image.width), long(image.height), 3);

@@ -7,6 +7,7 @@
 #include <facet/scene.h>
 #include <facet/sensor.h>
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -15,6 +16,7 @@
 #include <unistd.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -172,6 +174,11 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     const bool needs_aperture = sensor.needs_aperture_sample();
     const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
 
+    // More threads than cores is allowed (TBB otherwise caps its workers at the core count).
+    std::unique_ptr<tbb::global_control> allow;
+    if (opts.threads > 0)
+        allow = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      size_t(opts.threads));
     tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
     const int workers = arena.max_concurrency();
     FACET_LOG(Info, "Starting render job ({}x{}, {} samples, {} threads)", crop_size.x, crop_size.y, spp, workers);
@@ -215,6 +222,8 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
                         const Point2f pos(float(x) + u.x, float(y) + u.y);
                         const Point2f aperture = needs_aperture ? sampler->next_2d() : Point2f(0.5f, 0.5f);
                         auto [ray, weight] = sensor.sample_ray(0.f, pos * inv_film_size, aperture);
+                        // Integrators need not write every AOV for every sample (e.g. on a miss).
+                        std::fill(aovs.begin(), aovs.end(), 0.f);
                         Color3f L = integrator->sample(scene, *sampler, ray, aovs.data()) * weight;
                         bool valid = L.is_finite();
                         for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
