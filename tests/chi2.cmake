@@ -1,0 +1,138 @@
+# The chi-square suite (label chi2): one ctest per line of chi2/configs.txt, each running
+# `facet chi2 <line> --tests <number of lines>`, so the whole family keeps the 1 % level (Sidak).
+# A line is registered only when every plugin it names exists in plugins/ (so the suite runs
+# while plugins are still being written); the list itself stays complete.
+# Also: a test-only plugin with a deliberate bug (chi2_plugins/, built here, never installed) and
+# a check of the command's exit codes and pictures on it.
+
+if(NOT TARGET facet_cli)
+    return()
+endif()
+
+set(FACET_CHI2_DIR ${CMAKE_CURRENT_SOURCE_DIR}/chi2)
+set(FACET_CHI2_WORK ${CMAKE_BINARY_DIR}/tests/chi2)
+file(MAKE_DIRECTORY ${FACET_CHI2_WORK})
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${FACET_CHI2_DIR}/configs.txt)
+
+file(STRINGS ${FACET_CHI2_DIR}/configs.txt _chi2_all)
+set(_chi2_lines "")
+foreach(_line IN LISTS _chi2_all)
+    string(STRIP "${_line}" _line)
+    if(_line STREQUAL "" OR _line MATCHES "^#")
+        continue()
+    endif()
+    list(APPEND _chi2_lines "${_line}")
+endforeach()
+list(LENGTH _chi2_lines _chi2_count)
+
+# True when plugins/<any kind>/<name>.cpp exists.
+function(_chi2_plugin_exists name out)
+    file(GLOB _found ${PROJECT_SOURCE_DIR}/plugins/*/${name}.cpp)
+    if(_found)
+        set(${out} TRUE PARENT_SCOPE)
+    else()
+        set(${out} FALSE PARENT_SCOPE)
+    endif()
+endfunction()
+
+set(_chi2_registered 0)
+set(_chi2_skipped "")
+set(_chi2_index 0)
+foreach(_line IN LISTS _chi2_lines)
+    math(EXPR _chi2_index "${_chi2_index} + 1")
+    string(REPLACE "@CHI2_DATA@" "${FACET_CHI2_DIR}" _line "${_line}")
+    separate_arguments(_args UNIX_COMMAND "${_line}")
+    list(GET _args 0 _kind)
+    list(LENGTH _args _nargs)
+
+    # The plugins this line needs.
+    set(_needs "")
+    set(_name "")
+    if(_nargs GREATER 1)
+        list(GET _args 1 _name)
+    endif()
+    if(NOT _kind STREQUAL "microfacet" AND NOT _name MATCHES "^-")
+        list(APPEND _needs ${_name})
+    endif()
+    string(REGEX MATCHALL "type=\"[A-Za-z0-9_]+\"" _types "${_line}")
+    foreach(_t IN LISTS _types)
+        string(REGEX REPLACE "type=\"([A-Za-z0-9_]+)\"" "\\1" _t "${_t}")
+        list(APPEND _needs ${_t})
+    endforeach()
+    if(_kind STREQUAL "emitter" AND _name STREQUAL "area")
+        list(FIND _args "--shape" _at)
+        if(_at GREATER -1)
+            math(EXPR _at "${_at} + 1")
+            list(GET _args ${_at} _shape)
+        else()
+            set(_shape rectangle)
+        endif()
+        list(APPEND _needs ${_shape})
+    endif()
+    set(_missing "")
+    foreach(_p IN LISTS _needs)
+        _chi2_plugin_exists(${_p} _ok)
+        if(NOT _ok)
+            list(APPEND _missing ${_p})
+        endif()
+    endforeach()
+
+    # A readable test name: chi2.bsdf.roughconductor.distribution=ggx.alpha=0.2.theta=60
+    set(_test "chi2.${_kind}")
+    set(_skip_next FALSE)
+    foreach(_a IN LISTS _args)
+        if(_skip_next)
+            set(_skip_next FALSE)
+            continue()
+        endif()
+        if(_a STREQUAL _kind)
+            continue()
+        endif()
+        if(_a STREQUAL "--xml")
+            set(_test "${_test}.xml${_chi2_index}")
+            set(_skip_next TRUE)
+            continue()
+        endif()
+        if(_a MATCHES "^--")
+            string(REGEX REPLACE "^--" "" _a "${_a}")
+            set(_test "${_test}.${_a}")
+            continue()
+        endif()
+        string(REGEX REPLACE "=/.*/" "=" _a "${_a}") # file names without their folder
+        string(REGEX REPLACE "[^A-Za-z0-9_=.,:+-]" "_" _a "${_a}")
+        if(_test MATCHES "\\.(theta|phi|wi|ref|component|alpha|alpha-v|visible|shape|mode)$")
+            set(_test "${_test}=${_a}")
+        else()
+            set(_test "${_test}.${_a}")
+        endif()
+    endforeach()
+
+    if(_missing)
+        string(REPLACE ";" ", " _missing "${_missing}")
+        list(APPEND _chi2_skipped "${_test} (needs ${_missing})")
+        continue()
+    endif()
+    add_test(NAME ${_test} COMMAND facet_cli chi2 ${_args} --tests ${_chi2_count}
+             WORKING_DIRECTORY ${FACET_CHI2_WORK})
+    set_tests_properties(${_test} PROPERTIES LABELS chi2 TIMEOUT 300)
+    math(EXPR _chi2_registered "${_chi2_registered} + 1")
+endforeach()
+list(LENGTH _chi2_skipped _chi2_nskipped)
+message(STATUS "chi2: ${_chi2_registered} of ${_chi2_count} configurations registered "
+               "(${_chi2_nskipped} wait for plugins that do not exist yet)")
+
+# The test-only plugin and the check of the command's behaviour on it.
+set(FACET_CHI2_PLUGIN_DIR ${CMAKE_BINARY_DIR}/tests/chi2_plugins)
+file(GLOB _chi2_test_plugins ${CMAKE_CURRENT_SOURCE_DIR}/chi2_plugins/*.cpp)
+foreach(_src IN LISTS _chi2_test_plugins)
+    get_filename_component(_p ${_src} NAME_WE)
+    add_library(${_p} MODULE ${_src})
+    set_target_properties(${_p} PROPERTIES PREFIX "" CXX_VISIBILITY_PRESET hidden
+                          LIBRARY_OUTPUT_DIRECTORY ${FACET_CHI2_PLUGIN_DIR})
+    target_link_libraries(${_p} PRIVATE facet facet_warnings)
+endforeach()
+add_test(NAME chi2.cli.exit_codes_and_pictures
+         COMMAND ${CMAKE_COMMAND} -DFACET=$<TARGET_FILE:facet_cli>
+                 -DPLUGIN_DIR=${FACET_CHI2_PLUGIN_DIR} -DWORK=${FACET_CHI2_WORK}/cli_check
+                 -P ${FACET_CHI2_DIR}/cli_check.cmake)
+set_tests_properties(chi2.cli.exit_codes_and_pictures PROPERTIES LABELS chi2 TIMEOUT 300)
