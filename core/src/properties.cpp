@@ -51,8 +51,8 @@ const char *Properties::type_name(Type t) {
 }
 
 void Properties::set(const std::string &name, Value value, const Location &loc, bool overwrite) {
-    for (auto &e : m_entries) {
-        if (e.name != name) continue;
+    if (auto it = m_index.find(name); it != m_index.end()) {
+        Entry &e = m_entries[it->second];
         if (!overwrite)
             FACET_THROW_AT(loc.valid() ? loc : m_location,
                            "property \"{}\" was specified multiple times", name);
@@ -61,23 +61,22 @@ void Properties::set(const std::string &name, Value value, const Location &loc, 
         e.queried = false;
         return;
     }
+    m_index.emplace(name, m_entries.size());
     m_entries.push_back(Entry{name, std::move(value), loc, false});
 }
 
 bool Properties::remove(const std::string &name) {
-    for (auto it = m_entries.begin(); it != m_entries.end(); ++it) {
-        if (it->name == name) {
-            m_entries.erase(it);
-            return true;
-        }
-    }
-    return false;
+    auto it = m_index.find(name);
+    if (it == m_index.end()) return false;
+    m_entries.erase(m_entries.begin() + long(it->second));
+    m_index.clear();
+    for (size_t i = 0; i < m_entries.size(); ++i) m_index.emplace(m_entries[i].name, i);
+    return true;
 }
 
 const Properties::Entry *Properties::find(const std::string &name) const {
-    for (const auto &e : m_entries)
-        if (e.name == name) return &e;
-    return nullptr;
+    auto it = m_index.find(name);
+    return it == m_index.end() ? nullptr : &m_entries[it->second];
 }
 
 void Properties::note_request(const std::string &name) const {

@@ -9,6 +9,7 @@
 
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <variant>
 #include <vector>
 
@@ -119,6 +120,7 @@ private:
     std::string m_plugin_name, m_id;
     Location m_location;
     std::vector<Entry> m_entries;
+    std::unordered_map<std::string, size_t> m_index; ///< name -> position in m_entries
     mutable std::vector<std::string> m_requested;
 };
 
