@@ -134,8 +134,10 @@ public:
         std::ifstream in(path, std::ios::binary);
         if (!in) FACET_THROW_AT(props.location("filename"), "serialized: cannot open \"{}\"", path);
         std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        load(file, path, index, props);
+        // Like obj and ply: smooth normals unless the scene or the file asks for face normals.
+        bool file_face_normals = load(file, path, index, props);
         initialize(to_world, face_normals, flip);
+        if (!face_normals && !file_face_normals && !has_vertex_normals()) recompute_vertex_normals();
     }
 
     std::string to_string() const override {
@@ -144,7 +146,8 @@ public:
     }
 
 private:
-    void load(const std::vector<uint8_t> &file, const std::string &path, int64_t index,
+    /// Reads mesh `index`; returns whether the file asks for face normals.
+    bool load(const std::vector<uint8_t> &file, const std::string &path, int64_t index,
               const Properties &props) {
         if (file.size() < 8) FACET_THROW("serialized: \"{}\" is too small to be a mesh file", path);
         uint16_t id, version;
@@ -205,6 +208,7 @@ private:
         m_faces.resize(size_t(nf) * 3);
         for (auto &f : m_faces) f = r.read<uint32_t>();
         if (flags & FaceNormals) m_normals.clear();
+        return (flags & FaceNormals) != 0;
     }
 };
 

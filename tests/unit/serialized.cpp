@@ -103,11 +103,22 @@ TEST(Serialized, RoundTripVersion4Float) {
             EXPECT_FLOAT_EQ(v.z, float(ref.positions[3 * i + 2]));
         }
         for (size_t i = 0; i < ref.faces.size(); ++i) EXPECT_EQ(mesh->faces()[i], ref.faces[i]);
-        EXPECT_EQ(mesh->has_vertex_normals(), !ref.normals.empty());
+        // From the file, or recomputed (smooth) when the file has none, as obj and ply do.
+        EXPECT_TRUE(mesh->has_vertex_normals());
         EXPECT_EQ(mesh->has_uvs(), !ref.uvs.empty());
     }
     EXPECT_FLOAT_EQ(load(p, 1)->surface_area(), 3.f);
     EXPECT_FLOAT_EQ(load(p, 0)->surface_area(), 1.f);
+}
+
+TEST(Serialized, FaceNormalsDropVertexNormals) {
+    fs::path p = write_file("faces.serialized", write_serialized(two_meshes(), 4, false));
+    Properties props("serialized");
+    props.set_string("filename", p.string());
+    props.set_bool("face_normals", true);
+    auto mesh = std::dynamic_pointer_cast<Mesh>(PluginRegistry::instance().create(ObjectType::Shape, props));
+    ASSERT_TRUE(mesh);
+    EXPECT_FALSE(mesh->has_vertex_normals());
 }
 
 TEST(Serialized, RoundTripVersion3Double) {
