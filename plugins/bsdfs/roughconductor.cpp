@@ -73,15 +73,15 @@ public:
         bs.sampled_type = BSDFFlags::GlossyReflection;
         bs.sampled_component = 0;
         if (Frame::cos_theta(bs.wo) <= 0.f) return {bs, Color3f(0.f)};
-        // Jacobian of the half-vector map for reflection, dωm/dωo = 1/(4 wo·m) (Walter eq. 14).
-        bs.pdf = pdf_m / (4.f * wi_dot_m);
 
-        // weight = f·cos θo / pdf with f·cos θo = F·D·G/(4 cos θi): F times G1(wo, m) for
-        // visible normals, F·G·(wi·m)/(cos θi·cos θm) for all normals (see sample_weight).
-        float weight = distr.sample_weight(si.wi, bs.wo, m, distr);
-        if (!(weight > 0.f)) return {bs, Color3f(0.f)};
-        Color3f F = fresnel_conductor(wi_dot_m, m_eta->eval(si), m_k->eval(si));
-        return {bs, F * m_specular_reflectance->eval(si) * weight};
+        // The weight F·G1(wo, m) (visible normals) or F·G·(wi·m)/(cos θi·cos θm) (all normals)
+        // is evaluated as eval/pdf at wo: near grazing back-scattering, recovering m from
+        // (wi, wo) is ill-conditioned in float, and this way bs.pdf is exactly what pdf() and
+        // MIS see for the same direction.
+        auto [value, pdf] = eval_pdf(ctx, si, bs.wo);
+        if (!(pdf > 0.f) || value.is_black()) return {bs, Color3f(0.f)};
+        bs.pdf = pdf;
+        return {bs, value / pdf};
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,

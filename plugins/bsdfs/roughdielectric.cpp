@@ -70,8 +70,7 @@ public:
         float cos_i = Frame::cos_theta(si.wi);
         if ((!has_reflection && !has_transmission) || cos_i == 0.f) return {bs, Color3f(0.f)};
 
-        MicrofacetDistribution distr = m_microfacet.at(si);
-        MicrofacetDistribution sample_distr = sampling_distribution(distr, cos_i);
+        MicrofacetDistribution sample_distr = sampling_distribution(m_microfacet.at(si), cos_i);
 
         // Sample a normal as seen from wi mirrored into the upper hemisphere.
         Vector3f wi_up = si.wi * sign(cos_i);
@@ -82,50 +81,30 @@ public:
 
         auto [F, cos_t, eta_it, eta_ti] = fresnel_dielectric(wi_dot_m, m_eta);
 
-        bool reflect_lobe;
-        float weight;
-        bs.pdf = pdf_m;
-        if (has_reflection && has_transmission) {
-            reflect_lobe = sample1 < F;
-            bs.pdf *= reflect_lobe ? F : 1.f - F;
-            weight = 1.f;
-        } else {
-            reflect_lobe = has_reflection;
-            weight = reflect_lobe ? F : 1.f - F;
-        }
-
-        float wo_dot_m, dm_dwo;
+        // Lobe choice by the facet's Fresnel term; with one lobe enabled it is always taken.
+        bool reflect_lobe = has_reflection && has_transmission ? sample1 < F : has_reflection;
         if (reflect_lobe) {
             bs.wo = facet::reflect(si.wi, m);
             bs.eta = 1.f;
             bs.sampled_type = BSDFFlags::GlossyReflection;
             bs.sampled_component = 0;
             if (Frame::cos_theta(bs.wo) * cos_i <= 0.f) return {bs, Color3f(0.f)};
-            wo_dot_m = dot(bs.wo, m);
-            dm_dwo = 1.f / (4.f * wo_dot_m); // Walter eq. 14
         } else {
             bs.wo = refract(si.wi, m, cos_t, eta_ti);
             bs.eta = eta_it;
             bs.sampled_type = BSDFFlags::GlossyTransmission;
             bs.sampled_component = 1;
             if (Frame::cos_theta(bs.wo) * cos_i >= 0.f) return {bs, Color3f(0.f)};
-            wo_dot_m = dot(bs.wo, m);
-            // Walter eq. 17 with η = η_t/η_i.
-            dm_dwo = eta_it * eta_it * wo_dot_m / sqr(wi_dot_m + eta_it * wo_dot_m);
-            if (ctx.mode == TransportMode::Radiance) weight *= eta_ti * eta_ti;
         }
-        bs.pdf *= std::abs(dm_dwo);
 
-        // f·|cos θo| / pdf: the D and Jacobian terms cancel, leaving the lobe factor times
-        // G1(wo, m) for visible normals, or D·G·|wi·m| / (D_s·|cos θi|·cos θm) for normals drawn
-        // from the (possibly widened) distribution D_s (see sample_weight).
-        weight *= distr.sample_weight(si.wi, bs.wo, m, sample_distr);
-        if (!(weight > 0.f) || !(bs.pdf > 0.f) || !std::isfinite(weight)) return {bs, Color3f(0.f)};
-
-        Color3f result(weight);
-        if (reflect_lobe && m_specular_reflectance) result *= m_specular_reflectance->eval(si);
-        if (!reflect_lobe && m_specular_transmittance) result *= m_specular_transmittance->eval(si);
-        return {bs, result};
+        // The weight (lobe factor · G1(wo, m) for visible normals, D·G·|wi·m| /
+        // (D_s·|cos θi|·cos θm) for all normals, times η_ti² for radiance refraction) is evaluated
+        // as eval/pdf at wo: recovering m from (wi, wo) is ill-conditioned in float near grazing
+        // back-scattering, and this way bs.pdf is exactly what pdf() and MIS see.
+        auto [value, pdf] = eval_pdf_impl<true, true>(ctx, si, bs.wo);
+        if (!(pdf > 0.f) || value.is_black()) return {bs, Color3f(0.f)};
+        bs.pdf = pdf;
+        return {bs, value / pdf};
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,

@@ -121,26 +121,6 @@ public:
         return d * Frame::cos_theta(m);
     }
 
-    /**
-     * Weight f·|cos θo|/pdf of a microfacet BSDF with shadowing-masking G(wi, wo, m) for a normal
-     * m drawn by sample(wi, ·), without the Fresnel and lobe-selection factors: the D and
-     * Jacobian terms cancel. Visible normals: G1(wi, m)·G1(wo, m)/G1_exact(wi) (= G1(wo, m) for
-     * GGX). All normals drawn from `sampled` (this distribution, possibly with widened α):
-     * D(m)·G·|wi·m| / (D_s(m)·|cos θi|·cos θm).
-     */
-    float sample_weight(const Vector3f &wi, const Vector3f &wo, const Vector3f &m,
-                        const MicrofacetDistribution &sampled) const {
-        if (m_sample_visible) {
-            float g1_o = smith_g1(wo, m);
-            if (m_type == MicrofacetType::GGX) return g1_o;
-            Vector3f wi_up = wi * sign(wi.z);
-            return g1_o * smith_g1(wi, m) / visible_normalization(wi_up);
-        }
-        float pdf_s = sampled.eval(m) * Frame::cos_theta(m);
-        if (!(pdf_s > 0.f)) return 0.f;
-        return eval(m) * G(wi, wo, m) * std::abs(dot(wi, m)) / (pdf_s * std::abs(wi.z));
-    }
-
     /// Samples a microfacet normal for the incident direction `wi` (upper hemisphere); returns the
     /// normal and pdf(wi, m) (zero on failure).
     std::pair<Vector3f, float> sample(const Vector3f &wi, const Point2f &u) const;
