@@ -9,8 +9,9 @@ spheres).
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | radiance | spectrum or texture | 1 | Emitted radiance (a number, `rgb`, `spectrum` or nested texture, evaluated at the surface uv) |
+| to_world | transform | — | Not accepted (an error): the emitter follows the shape it is nested in |
 
-An area emitter must be nested in a shape and takes no `to_world`: it follows its shape.
+An area emitter must be nested in a shape (or referenced by one).
 
 ```xml
 <shape type="rectangle">

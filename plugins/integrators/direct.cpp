@@ -108,6 +108,7 @@ public:
 
         const BSDFContext ctx;
         const BSDF *bsdf = si.bsdf();
+        if (!bsdf) return result;
 
         // ---- Emitter sampling ----
         if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {

@@ -117,6 +117,7 @@ public:
 
             if (depth + 1 >= m_max_depth) break;
             const BSDF *bsdf = si.bsdf();
+            if (!bsdf) break;
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
             if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
