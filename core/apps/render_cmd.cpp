@@ -160,14 +160,14 @@ int render_main(int argc, char **argv) {
     int used_spp = spp > 0 ? spp : int(sensor.sampler().sample_count());
     int threads = cli::effective_threads(opts.threads);
 
+    // From here on Ctrl-C stops the render and the partial image is written.
+    install_interrupt_handler(&cancel);
     if (!opts.quiet) {
         fmt::print("Rendering {}: {}x{} pixels, {} spp, {} thread{}\n", opts.scene,
                    film.crop_size().x, film.crop_size().y, used_spp, threads,
                    threads == 1 ? "" : "s");
         std::fflush(stdout);
     }
-
-    install_interrupt_handler(&cancel);
     RenderResult result;
     try {
         result = render(*scene, sensor, ropts);

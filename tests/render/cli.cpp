@@ -1,0 +1,354 @@
+// The `facet` command as a user runs it: outputs, naming, -D, one-line errors, plugin listing,
+// determinism across thread counts, Ctrl-C and atomic writes.
+
+#include <facet/image.h>
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char **environ;
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string FACET = FACET_BINARY_DIR "/bin/facet";
+
+/// A small scene: a diffuse sphere under a constant sky, seen by a perspective camera.
+const char *TINY_SCENE = R"(<scene version="3.0.0">
+    <default name="spp" value="4"/>
+    <default name="res" value="32"/>
+    <integrator type="path">
+        <integer name="max_depth" value="4"/>
+    </integrator>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world">
+            <lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent">
+            <integer name="sample_count" value="$spp"/>
+        </sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="$res"/>
+            <integer name="height" value="$res"/>
+        </film>
+    </sensor>
+    <emitter type="constant">
+        <rgb name="radiance" value="1, 0.9, 0.8"/>
+    </emitter>
+    <shape type="sphere">
+        <bsdf type="diffuse">
+            <rgb name="reflectance" value="0.2, 0.5, 0.7"/>
+        </bsdf>
+    </shape>
+</scene>
+)";
+
+struct Result {
+    int code = -1;
+    std::string out, err;
+};
+
+std::string read_file(const fs::path &path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+void write_file(const fs::path &path, const std::string &text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+std::vector<std::string> lines(const std::string &text) {
+    std::vector<std::string> result;
+    std::stringstream ss(text);
+    for (std::string line; std::getline(ss, line);)
+        if (!line.empty()) result.push_back(line);
+    return result;
+}
+
+class CliTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
+        m_dir = fs::temp_directory_path() /
+                (std::string("facet_cli_") + info->name() + "_" + std::to_string(getpid()));
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+        write_file(m_dir / "scene.xml", TINY_SCENE);
+    }
+    void TearDown() override {
+        if (!HasFailure()) fs::remove_all(m_dir);
+    }
+
+    /// Runs `facet <args>` in the test folder; stdout and stderr are captured.
+    Result run(const std::string &args) {
+        fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
+        std::string cmd = "cd '" + m_dir.string() + "' && '" + FACET + "' " + args + " > '" +
+                          out.string() + "' 2> '" + err.string() + "' < /dev/null";
+        int status = std::system(cmd.c_str());
+        Result r;
+        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        r.out = read_file(out);
+        r.err = read_file(err);
+        fs::remove(out);
+        fs::remove(err);
+        return r;
+    }
+
+    /// Expects a failure reported as exactly one "facet: error: ..." line; returns that line.
+    std::string expect_one_line_error(const std::string &args) {
+        Result r = run(args);
+        EXPECT_NE(r.code, 0) << args;
+        auto err = lines(r.err);
+        EXPECT_EQ(err.size(), 1u) << args << "\nstderr:\n" << r.err;
+        if (err.empty()) return "";
+        EXPECT_EQ(err[0].rfind("facet: error: ", 0), 0u) << err[0];
+        return err[0];
+    }
+
+    /// Every file in the test folder (temporary files of interrupted writes would show here).
+    std::set<std::string> files() const {
+        std::set<std::string> names;
+        for (const auto &e : fs::directory_iterator(m_dir)) names.insert(e.path().filename().string());
+        return names;
+    }
+
+    fs::path m_dir;
+};
+
+std::string attribute(const std::string &path, const std::string &name) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return "<cannot open>";
+    return in->spec().get_string_attribute(name, "<missing>");
+}
+
+TEST_F(CliTest, RenderWritesExrNextToTheScene) {
+    Result r = run("render scene.xml");
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_TRUE(fs::exists(m_dir / "scene.exr"));
+    facet::Image img = facet::read_image((m_dir / "scene.exr").string());
+    EXPECT_EQ(img.width, 32);
+    EXPECT_EQ(img.height, 32);
+    EXPECT_GE(img.channels, 3);
+    // The summary names the size, spp, threads and time.
+    EXPECT_NE(r.out.find("32x32"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("4 spp"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("thread"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(" s"), std::string::npos) << r.out;
+    // Metadata: spp, render time, scene, seed.
+    std::string exr = (m_dir / "scene.exr").string();
+    EXPECT_EQ(attribute(exr, "facet:spp"), "4");
+    EXPECT_EQ(attribute(exr, "facet:seed"), "0");
+    EXPECT_NE(attribute(exr, "facet:scene").find("scene.xml"), std::string::npos);
+    EXPECT_NE(attribute(exr, "facet:render_time"), "<missing>");
+    EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", "scene.exr"}));
+}
+
+TEST_F(CliTest, SceneFileAloneMeansRender) {
+    fs::create_directories(m_dir / "sub");
+    fs::rename(m_dir / "scene.xml", m_dir / "sub" / "box.xml");
+    Result r = run("sub/box.xml -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(m_dir / "sub" / "box.exr")); // next to the scene, not in the cwd
+    EXPECT_FALSE(fs::exists(m_dir / "box.exr"));
+    EXPECT_TRUE(r.out.empty()) << "-q printed: " << r.out;
+}
+
+TEST_F(CliTest, OutputNames) {
+    ASSERT_EQ(run("render scene.xml -q -o out").code, 0);
+    EXPECT_TRUE(fs::exists(m_dir / "out.exr")); // the film's extension is added
+    ASSERT_EQ(run("render scene.xml -q -o picture.png").code, 0);
+    ASSERT_TRUE(fs::exists(m_dir / "picture.png"));
+    auto in = OIIO::ImageInput::open((m_dir / "picture.png").string());
+    ASSERT_TRUE(in);
+    EXPECT_EQ(in->format_name(), std::string("png"));
+    EXPECT_EQ(in->spec().width, 32);
+    EXPECT_EQ(in->spec().format, OIIO::TypeDesc::UINT8);
+    in->close();
+    EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", "out.exr", "picture.png"}));
+}
+
+TEST_F(CliTest, DefineSetsSceneParameters) {
+    Result r = run("render scene.xml -q -D res=16 -D spp=2 -o small.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    facet::Image img = facet::read_image((m_dir / "small.exr").string());
+    EXPECT_EQ(img.width, 16);
+    EXPECT_EQ(img.height, 16);
+    EXPECT_EQ(attribute((m_dir / "small.exr").string(), "facet:spp"), "2");
+}
+
+TEST_F(CliTest, ThreadsBelowOneBecomeOneWithAWarning) {
+    Result r = run("render scene.xml -q -t 0 -o t0.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(m_dir / "t0.exr"));
+    EXPECT_NE(r.err.find("1 thread"), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, MissingSceneFileIsOneLineError) {
+    std::string line = expect_one_line_error("render nosuch.xml");
+    EXPECT_NE(line.find("nosuch.xml"), std::string::npos) << line;
+}
+
+TEST_F(CliTest, MalformedXmlNamesFileLineAndColumn) {
+    write_file(m_dir / "bad.xml", "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n</scene>\n");
+    std::string line = expect_one_line_error("render bad.xml");
+    EXPECT_TRUE(std::regex_search(line, std::regex(R"(bad\.xml:\d+:\d+)"))) << line;
+    EXPECT_FALSE(fs::exists(m_dir / "bad.exr"));
+}
+
+TEST_F(CliTest, UnknownPluginListsTheKnownOnes) {
+    std::string text = TINY_SCENE;
+    text.replace(text.find("type=\"diffuse\""), 14, "type=\"difuse\"");
+    write_file(m_dir / "typo.xml", text);
+    std::string line = expect_one_line_error("render typo.xml");
+    EXPECT_NE(line.find("difuse"), std::string::npos) << line;
+    EXPECT_NE(line.find("diffuse"), std::string::npos) << line;
+    EXPECT_TRUE(std::regex_search(line, std::regex(R"(typo\.xml:\d+:\d+)"))) << line;
+}
+
+TEST_F(CliTest, UnusedDefineIsAnError) {
+    std::string line = expect_one_line_error("render scene.xml -D nosuchparam=3");
+    EXPECT_NE(line.find("nosuchparam"), std::string::npos) << line;
+    EXPECT_FALSE(fs::exists(m_dir / "scene.exr"));
+    // --lenient makes it a warning.
+    Result r = run("render scene.xml -q --lenient -D nosuchparam=3");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("nosuchparam"), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, MisspeltParameterIsAnError) {
+    std::string text = TINY_SCENE;
+    text.replace(text.find("<shape type=\"sphere\">"), 21,
+                 "<shape type=\"sphere\">\n        <float name=\"radiuss\" value=\"2\"/>");
+    write_file(m_dir / "param.xml", text);
+    std::string line = expect_one_line_error("render param.xml");
+    EXPECT_NE(line.find("radiuss"), std::string::npos) << line;
+}
+
+TEST_F(CliTest, DefineWithoutEqualsIsAnError) {
+    std::string line = expect_one_line_error("render scene.xml -D spp");
+    EXPECT_NE(line.find("key=value"), std::string::npos) << line;
+    EXPECT_FALSE(fs::exists(m_dir / "scene.exr"));
+}
+
+TEST_F(CliTest, UnknownOptionIsAnError) {
+    std::string line = expect_one_line_error("render scene.xml --no-such-option");
+    EXPECT_NE(line.find("no-such-option"), std::string::npos) << line;
+}
+
+TEST_F(CliTest, PluginsListsEveryKind) {
+    Result r = run("plugins");
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char *name : {"diffuse", "path", "sphere", "perspective", "hdrfilm", "independent",
+                             "gaussian", "area", "constant"})
+        EXPECT_TRUE(std::regex_search(r.out, std::regex(std::string(R"((^|\n)\s+)") + name + R"(\s)")))
+            << name << " missing from:\n" << r.out;
+    EXPECT_NE(r.out.find("bsdfs"), std::string::npos);
+    EXPECT_NE(r.out.find("integrators"), std::string::npos);
+
+    Result bsdfs = run("plugins bsdf");
+    ASSERT_EQ(bsdfs.code, 0) << bsdfs.err;
+    EXPECT_NE(bsdfs.out.find("diffuse"), std::string::npos);
+    EXPECT_EQ(bsdfs.out.find("perspective"), std::string::npos) << bsdfs.out;
+}
+
+TEST_F(CliTest, PluginsPrintsOnePluginsTable) {
+    Result r = run("plugins diffuse");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*Parameter\s*\|\s*Type\s*\|)"))) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*reflectance\s*\|)"))) << r.out;
+
+    std::string line = expect_one_line_error("plugins difuse");
+    EXPECT_NE(line.find("diffuse"), std::string::npos) << line; // the suggestion
+}
+
+TEST_F(CliTest, SameImageForAnyThreadCount) {
+    ASSERT_EQ(run("render scene.xml -q -D spp=8 -t 1 -o one.exr").code, 0);
+    ASSERT_EQ(run("render scene.xml -q -D spp=8 -t 2 -o two.exr").code, 0);
+    facet::Image a = facet::read_image((m_dir / "one.exr").string());
+    facet::Image b = facet::read_image((m_dir / "two.exr").string());
+    ASSERT_EQ(a.width, b.width);
+    ASSERT_EQ(a.channels, b.channels);
+    EXPECT_TRUE(a.data == b.data) << "-t 1 and -t 2 give different pixels";
+    // A different seed gives a different image, so the comparison above means something.
+    ASSERT_EQ(run("render scene.xml -q -D spp=8 -t 2 --seed 1 -o seed.exr").code, 0);
+    facet::Image c = facet::read_image((m_dir / "seed.exr").string());
+    EXPECT_FALSE(a.data == c.data);
+}
+
+TEST_F(CliTest, InterruptWritesThePartialImage) {
+    // Far too many samples to finish: about 2·10⁹ camera samples in small blocks.
+    fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
+    std::string scene = (m_dir / "scene.xml").string(), image = (m_dir / "long.exr").string();
+    std::vector<std::string> args = {FACET, "render", scene, "-D", "res=2048", "-D", "spp=512",
+                                     "-t", "2", "-o", image};
+    std::vector<char *> argv;
+    for (auto &a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, FACET.c_str(), &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+
+    using clock = std::chrono::steady_clock;
+    // Wait until the render has started (the scene is loaded and the handler installed).
+    auto start = clock::now();
+    while (read_file(out).find("Rendering") == std::string::npos &&
+           clock::now() - start < std::chrono::seconds(120))
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    ASSERT_EQ(kill(pid, SIGINT), 0);
+
+    int status = 0;
+    auto sent = clock::now();
+    while (waitpid(pid, &status, WNOHANG) == 0) {
+        if (clock::now() - sent > std::chrono::seconds(60)) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &status, 0);
+            FAIL() << "facet did not stop within 60 s of SIGINT";
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_TRUE(WIFEXITED(status)) << "facet died from a signal";
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    std::string errors = read_file(err);
+    EXPECT_NE(errors.find("partial"), std::string::npos) << errors;
+
+    ASSERT_TRUE(fs::exists(image));
+    facet::Image img = facet::read_image(image);
+    EXPECT_EQ(img.width, 2048);
+    size_t lit = 0, black = 0;
+    for (int y = 0; y < img.height; y += 16)
+        for (int x = 0; x < img.width; x += 16) (img.at(x, y, 0) > 0.f ? lit : black)++;
+    EXPECT_GT(lit, 0u) << "nothing was rendered";
+    EXPECT_GT(black, 0u) << "the render was not interrupted";
+    fs::remove(out);
+    fs::remove(err);
+    EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", "long.exr"}));
+}
+
+} // namespace
