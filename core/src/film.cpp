@@ -14,8 +14,8 @@ int ImageBlock::border_for(const ReconstructionFilter &filter) {
 
 void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, int aov_count) {
     if (size.x < 0 || size.y < 0 || border < 0 || aov_count < 0)
-        FACET_THROW("ImageBlock::reset: invalid size {}x{}, border {} or AOV count {}", size.x, size.y,
-                    border, aov_count);
+        FACET_THROW("ImageBlock::reset: invalid size {}x{}, border {} or AOV count {}", size.x,
+                    size.y, border, aov_count);
     m_offset = offset;
     m_size = size;
     m_border = border;
@@ -74,8 +74,9 @@ namespace {
 int read_positive(const Properties &props, const char *name, int64_t def) {
     int64_t v = props.get_int(name, def);
     if (v <= 0 || v > (1 << 20))
-        FACET_THROW_AT(props.location(name), "{} must be a positive number of pixels (at most {}), got {}",
-                       name, 1 << 20, v);
+        FACET_THROW_AT(props.location(name),
+                       "{} must be a positive number of pixels (at most {}), got {}", name, 1 << 20,
+                       v);
     return int(v);
 }
 
@@ -86,16 +87,17 @@ Film::Film(const Properties &props) {
 
     int64_t ox = props.get_int("crop_offset_x", 0), oy = props.get_int("crop_offset_y", 0);
     if (ox < 0 || oy < 0 || ox >= m_size.x || oy >= m_size.y)
-        FACET_THROW_AT(props.location(), "the crop offset ({}, {}) must lie inside the {}x{} film", ox, oy,
-                       m_size.x, m_size.y);
+        FACET_THROW_AT(props.location(), "the crop offset ({}, {}) must lie inside the {}x{} film",
+                       ox, oy, m_size.x, m_size.y);
     m_crop_offset = {int(ox), int(oy)};
     int64_t cw = props.get_int("crop_width", m_size.x - ox);
     int64_t ch = props.get_int("crop_height", m_size.y - oy);
     if (cw <= 0 || ch <= 0 || ox + cw > m_size.x || oy + ch > m_size.y)
-        FACET_THROW_AT(props.location(),
-                       "the crop window (offset ({}, {}), size {}x{}) must be non-empty and lie inside the "
-                       "{}x{} film",
-                       ox, oy, cw, ch, m_size.x, m_size.y);
+        FACET_THROW_AT(
+            props.location(),
+            "the crop window (offset ({}, {}), size {}x{}) must be non-empty and lie inside the "
+            "{}x{} film",
+            ox, oy, cw, ch, m_size.x, m_size.y);
     m_crop_size = {int(cw), int(ch)};
 
     for (const auto &[name, obj] : props.objects()) {
@@ -171,10 +173,11 @@ void Film::write(const Image &image, const std::string &path, const ImageWriteOp
 }
 
 std::string Film::to_string() const {
-    return fmt::format("Film[size={}x{}, crop_offset=({}, {}), crop_size={}x{}, component_format={}, "
-                       "alpha={}, rfilter={}]",
-                       m_size.x, m_size.y, m_crop_offset.x, m_crop_offset.y, m_crop_size.x, m_crop_size.y,
-                       m_half ? "float16" : "float32", m_alpha, m_filter ? m_filter->to_string() : "none");
+    return fmt::format(
+        "Film[size={}x{}, crop_offset=({}, {}), crop_size={}x{}, component_format={}, "
+        "alpha={}, rfilter={}]",
+        m_size.x, m_size.y, m_crop_offset.x, m_crop_offset.y, m_crop_size.x, m_crop_size.y,
+        m_half ? "float16" : "float32", m_alpha, m_filter ? m_filter->to_string() : "none");
 }
 
 } // namespace facet

@@ -5,19 +5,18 @@
 #include <OpenColorIO/OpenColorIO.h>
 #include <OpenImageIO/imageio.h>
 
-#include <dlfcn.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <dlfcn.h>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <tuple>
+#include <unistd.h>
 
 namespace OCIO = OCIO_NAMESPACE;
 namespace fs = std::filesystem;
@@ -28,7 +27,8 @@ namespace {
 
 std::string lower_extension(const std::string &path) {
     std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     return ext;
 }
 
@@ -38,25 +38,28 @@ bool is_linear_format(const std::string &ext) {
 }
 
 /// CPU processor for (config, display, view), created once per combination.
-OCIO::ConstCPUProcessorRcPtr display_processor(const std::string &config_path, const std::string &display,
+OCIO::ConstCPUProcessorRcPtr display_processor(const std::string &config_path,
+                                               const std::string &display,
                                                const std::string &view) {
     static std::mutex mutex;
-    static std::map<std::tuple<std::string, std::string, std::string>, OCIO::ConstCPUProcessorRcPtr> cache;
+    static std::map<std::tuple<std::string, std::string, std::string>, OCIO::ConstCPUProcessorRcPtr>
+        cache;
     std::lock_guard<std::mutex> lock(mutex);
     auto key = std::make_tuple(config_path, display, view);
     auto it = cache.find(key);
     if (it != cache.end()) return it->second;
     try {
         OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(config_path.c_str());
-        OCIO::ConstProcessorRcPtr proc = config->getProcessor(OCIO::ROLE_SCENE_LINEAR, display.c_str(),
-                                                              view.c_str(), OCIO::TRANSFORM_DIR_FORWARD);
+        OCIO::ConstProcessorRcPtr proc = config->getProcessor(
+            OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD);
         OCIO::ConstCPUProcessorRcPtr cpu = proc->getDefaultCPUProcessor();
         cache.emplace(key, cpu);
         return cpu;
     } catch (const OCIO::Exception &e) {
-        FACET_THROW("OpenColorIO: cannot build the display transform (display \"{}\", view \"{}\") from "
-                    "config \"{}\": {}",
-                    display, view, config_path, e.what());
+        FACET_THROW(
+            "OpenColorIO: cannot build the display transform (display \"{}\", view \"{}\") from "
+            "config \"{}\": {}",
+            display, view, config_path, e.what());
     }
 }
 
@@ -72,8 +75,9 @@ std::vector<int> output_channels(const Image &image, const std::string &path) {
     if (image.channels >= 4 && image.channel_names.size() > 3 && image.channel_names[3] == "A")
         ch.push_back(3);
     if (int(ch.size()) < image.channels)
-        FACET_LOG(Warn, "\"{}\": this format holds only {} channels; the other {} (AOVs) are not written "
-                        "(use .exr to keep them)",
+        FACET_LOG(Warn,
+                  "\"{}\": this format holds only {} channels; the other {} (AOVs) are not written "
+                  "(use .exr to keep them)",
                   path, ch.size(), image.channels - int(ch.size()));
     return ch;
 }
@@ -164,19 +168,20 @@ bool write_pfm(const std::string &file, const float *pixels, int width, int heig
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts) {
     if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
         image.data.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
-        FACET_THROW("cannot write image \"{}\": invalid image ({}x{}, {} channels, {} values)", path,
-                    image.width, image.height, image.channels, image.data.size());
+        FACET_THROW("cannot write image \"{}\": invalid image ({}x{}, {} channels, {} values)",
+                    path, image.width, image.height, image.channels, image.data.size());
     fs::path dir = fs::path(path).parent_path();
     if (!dir.empty() && !fs::is_directory(dir))
-        FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path, dir.string());
+        FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path,
+                    dir.string());
 
     const std::string ext = lower_extension(path);
     const bool pfm = ext == ".pfm";
     // The plugin is chosen by the target's extension; the data goes to a temporary file first.
     std::unique_ptr<OIIO::ImageOutput> out = pfm ? nullptr : OIIO::ImageOutput::create(path);
     if (!out && !pfm)
-        FACET_THROW("cannot write image \"{}\": no image format for the extension \"{}\" ({})", path, ext,
-                    OIIO::geterror());
+        FACET_THROW("cannot write image \"{}\": no image format for the extension \"{}\" ({})",
+                    path, ext, OIIO::geterror());
 
     const bool linear = is_linear_format(ext);
     std::vector<float> linear_pixels;
@@ -191,7 +196,9 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         for (int c = 0; c < image.channels; ++c) {
             std::string name = c < int(image.channel_names.size()) ? image.channel_names[c] : "";
             if (name.empty())
-                name = image.channels == 1 ? "Y" : (c < 4 ? std::string(1, "RGBA"[c]) : fmt::format("channel{}", c));
+                name = image.channels == 1
+                           ? "Y"
+                           : (c < 4 ? std::string(1, "RGBA"[c]) : fmt::format("channel{}", c));
             spec.channelnames[c] = name;
         }
         spec.alpha_channel = -1;
@@ -229,7 +236,8 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
     TempFileGuard guard{tmp};
     if (pfm) {
         std::string err;
-        if (!write_pfm(tmp, static_cast<const float *>(pixels), spec.width, spec.height, spec.nchannels, err))
+        if (!write_pfm(tmp, static_cast<const float *>(pixels), spec.width, spec.height,
+                       spec.nchannels, err))
             FACET_THROW("cannot write image \"{}\": {}", path, err);
     } else if (!out->open(tmp, spec))
         FACET_THROW("cannot write image \"{}\": {}", path, out->geterror());

@@ -11,17 +11,16 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include <pmmintrin.h>
-#include <signal.h>
-#include <unistd.h>
-#include <xmmintrin.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <pmmintrin.h>
+#include <signal.h>
+#include <unistd.h>
+#include <xmmintrin.h>
 
 namespace facet {
 
@@ -68,8 +67,11 @@ public:
         const int filled = int(frac * width + 0.5);
         std::string bar(size_t(filled), '=');
         bar.append(size_t(width - filled), ' ');
-        std::string eta = done > 0 && done < total ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac) : "";
-        std::string line = fmt::format("\rRendering [{}] {:3d}% ({:.1f}s{})", bar, int(frac * 100.0), elapsed, eta);
+        std::string eta = done > 0 && done < total
+                              ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac)
+                              : "";
+        std::string line = fmt::format("\rRendering [{}] {:3d}% ({:.1f}s{})", bar,
+                                       int(frac * 100.0), elapsed, eta);
         // Pad to clear what a longer earlier line left behind.
         if (line.size() < m_width) line.append(m_width - line.size(), ' ');
         m_width = line.size();
@@ -108,7 +110,8 @@ public:
         std::lock_guard<std::mutex> lock(m_mutex);
         m_pending.emplace(index, std::move(block));
         ++m_finished;
-        for (auto it = m_pending.begin(); it != m_pending.end() && it->first == m_next; it = m_pending.begin()) {
+        for (auto it = m_pending.begin(); it != m_pending.end() && it->first == m_next;
+             it = m_pending.begin()) {
             m_film.put_block(*it->second);
             m_free.push_back(std::move(it->second));
             m_pending.erase(it);
@@ -143,12 +146,15 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     const auto start = Clock::now();
     auto integrator = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator());
     if (!integrator)
-        FACET_THROW("cannot render with the integrator {}: facet's render loop needs a sampling integrator "
-                    "(path, direct, ...)",
-                    scene.integrator() ? scene.integrator()->to_string() : "(none)");
+        FACET_THROW(
+            "cannot render with the integrator {}: facet's render loop needs a sampling integrator "
+            "(path, direct, ...)",
+            scene.integrator() ? scene.integrator()->to_string() : "(none)");
     if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
-    if (opts.block_size <= 0) FACET_THROW("the block size must be positive, got {}", opts.block_size);
-    if (opts.threads < 0) FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
+    if (opts.block_size <= 0)
+        FACET_THROW("the block size must be positive, got {}", opts.block_size);
+    if (opts.threads < 0)
+        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
 
     Film &film = sensor.film();
     const Sampler &proto_sampler = sensor.sampler();
@@ -165,7 +171,8 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     const int aov_count = int(aov_names.size());
     film.prepare(aov_names);
 
-    const Point2i film_size = film.size(), crop_offset = film.crop_offset(), crop_size = film.crop_size();
+    const Point2i film_size = film.size(), crop_offset = film.crop_offset(),
+                  crop_size = film.crop_size();
     const int bs = opts.block_size;
     const int blocks_x = (crop_size.x + bs - 1) / bs, blocks_y = (crop_size.y + bs - 1) / bs;
     const size_t total = size_t(blocks_x) * size_t(blocks_y);
@@ -181,7 +188,8 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
                                                       size_t(opts.threads));
     tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
     const int workers = arena.max_concurrency();
-    FACET_LOG(Info, "Starting render job ({}x{}, {} samples, {} threads)", crop_size.x, crop_size.y, spp, workers);
+    FACET_LOG(Info, "Starting render job ({}x{}, {} samples, {} threads)", crop_size.x, crop_size.y,
+              spp, workers);
 
     BlockMerger merger(film);
     ProgressLine progress(opts.progress);
@@ -220,18 +228,22 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
                         if (s > 0) sampler->advance();
                         const Point2f u = sampler->next_2d();
                         const Point2f pos(float(x) + u.x, float(y) + u.y);
-                        const Point2f aperture = needs_aperture ? sampler->next_2d() : Point2f(0.5f, 0.5f);
+                        const Point2f aperture =
+                            needs_aperture ? sampler->next_2d() : Point2f(0.5f, 0.5f);
                         auto [ray, weight] = sensor.sample_ray(0.f, pos * inv_film_size, aperture);
                         // Integrators need not write every AOV for every sample (e.g. on a miss).
                         std::fill(aovs.begin(), aovs.end(), 0.f);
                         Color3f L = integrator->sample(scene, *sampler, ray, aovs.data()) * weight;
                         bool valid = L.is_finite();
-                        for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
+                        for (int k = 0; k < aov_count; ++k)
+                            valid = valid && std::isfinite(aovs[size_t(k)]);
                         if (!valid) {
                             // One bad sample must not turn the whole pixel into NaN: drop it.
                             if (invalid++ == 0) {
                                 uint64_t cur = first_invalid_pixel.load();
-                                while (pixel_index < cur && !first_invalid_pixel.compare_exchange_weak(cur, pixel_index)) {}
+                                while (
+                                    pixel_index < cur &&
+                                    !first_invalid_pixel.compare_exchange_weak(cur, pixel_index)) {}
                             }
                             continue;
                         }
@@ -263,7 +275,9 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
         FACET_LOG(Warn, "Rendering cancelled after {} of {} blocks", result.blocks_done, total);
     if (invalid_samples > 0) {
         uint64_t p = first_invalid_pixel.load();
-        FACET_LOG(Warn, "{} samples had NaN or infinite radiance and were dropped (the first at pixel ({}, {}))",
+        FACET_LOG(Warn,
+                  "{} samples had NaN or infinite radiance and were dropped (the first at pixel "
+                  "({}, {}))",
                   invalid_samples.load(), p % uint64_t(film_size.x), p / uint64_t(film_size.x));
     }
     result.image = film.develop();

@@ -11,7 +11,8 @@ Sensor::Sensor(const Properties &props) {
     double close = props.get_float("shutter_close", 0.0);
     if (close < open)
         FACET_THROW_AT(props.location("shutter_close"),
-                       "shutter_close ({}) must not be earlier than shutter_open ({})", close, open);
+                       "shutter_close ({}) must not be earlier than shutter_open ({})", close,
+                       open);
 
     for (const auto &[name, obj] : props.objects()) {
         if (!obj) continue;
@@ -27,7 +28,8 @@ Sensor::Sensor(const Properties &props) {
     }
     auto &registry = PluginRegistry::instance();
     if (!m_film) m_film = registry.create_as<Film>(ObjectType::Film, Properties("hdrfilm"));
-    if (!m_sampler) m_sampler = registry.create_as<Sampler>(ObjectType::Sampler, Properties("independent"));
+    if (!m_sampler)
+        m_sampler = registry.create_as<Sampler>(ObjectType::Sampler, Properties("independent"));
 }
 
 } // namespace facet

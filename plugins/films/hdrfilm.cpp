@@ -75,10 +75,12 @@ public:
             m_pixel_format = PixelFormat::XYZA;
         else
             FACET_THROW_AT(props.location("pixel_format"),
-                           "pixel_format must be rgb, rgba, luminance, luminance_alpha, xyz or xyza, got \"{}\"",
+                           "pixel_format must be rgb, rgba, luminance, luminance_alpha, xyz or "
+                           "xyza, got \"{}\"",
                            pixel_format);
         m_pixel_format_name = pixel_format;
-        m_alpha = m_pixel_format == PixelFormat::RGBA || m_pixel_format == PixelFormat::LuminanceAlpha ||
+        m_alpha = m_pixel_format == PixelFormat::RGBA ||
+                  m_pixel_format == PixelFormat::LuminanceAlpha ||
                   m_pixel_format == PixelFormat::XYZA;
 
         std::string component_format = lower(props.get_string("component_format", "float16"));
@@ -88,7 +90,8 @@ public:
             m_half = false;
         else
             FACET_THROW_AT(props.location("component_format"),
-                           "component_format must be float16 or float32, got \"{}\"{}", component_format,
+                           "component_format must be float16 or float32, got \"{}\"{}",
+                           component_format,
                            component_format == "uint32" ? " (uint32 is not supported)" : "");
 
         // Compatibility switches without an effect in facet (see the table above).
@@ -109,8 +112,10 @@ public:
         const int ncol = lum ? 1 : 3;
         const int rest = rgb.channels - 3;
         Image out(rgb.width, rgb.height, ncol + rest);
-        out.channel_names = lum ? std::vector<std::string>{"Y"} : std::vector<std::string>{"X", "Y", "Z"};
-        out.channel_names.insert(out.channel_names.end(), rgb.channel_names.begin() + 3, rgb.channel_names.end());
+        out.channel_names =
+            lum ? std::vector<std::string>{"Y"} : std::vector<std::string>{"X", "Y", "Z"};
+        out.channel_names.insert(out.channel_names.end(), rgb.channel_names.begin() + 3,
+                                 rgb.channel_names.end());
         for (size_t i = 0, n = size_t(rgb.width) * rgb.height; i < n; ++i) {
             const float *src = rgb.data.data() + i * rgb.channels;
             float *dst = out.data.data() + i * out.channels;
@@ -131,13 +136,14 @@ public:
     std::string default_extension() const override { return m_extension; }
 
     std::string to_string() const override {
-        return fmt::format("HDRFilm[file_format={}, pixel_format={}, {}]", m_file_format, m_pixel_format_name,
-                           Film::to_string());
+        return fmt::format("HDRFilm[file_format={}, pixel_format={}, {}]", m_file_format,
+                           m_pixel_format_name, Film::to_string());
     }
 
 private:
     static std::string lower(std::string s) {
-        std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        std::transform(s.begin(), s.end(), s.begin(),
+                       [](unsigned char c) { return char(std::tolower(c)); });
         return s;
     }
 
@@ -147,4 +153,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::HDRFilm, Film, "hdrfilm", "High dynamic range film (OpenEXR and friends)", DOC)
+FACET_EXPORT_PLUGIN(facet::HDRFilm, Film, "hdrfilm",
+                    "High dynamic range film (OpenEXR and friends)", DOC)

@@ -26,8 +26,8 @@ public:
     explicit GaussianFilter(const Properties &props) {
         double stddev = props.get_float("stddev", 0.5);
         if (!(stddev > 0.0) || !std::isfinite(stddev))
-            FACET_THROW_AT(props.location("stddev"), "stddev must be a positive number of pixels, got {}",
-                           stddev);
+            FACET_THROW_AT(props.location("stddev"),
+                           "stddev must be a positive number of pixels, got {}", stddev);
         m_stddev = float(stddev);
         m_radius = 4.f * m_stddev;
         m_alpha = -1.f / (2.f * m_stddev * m_stddev);

@@ -25,15 +25,17 @@ public:
     explicit TentFilter(const Properties &props) {
         double radius = props.get_float("radius", 1.0);
         if (!(radius > 0.0) || !std::isfinite(radius))
-            FACET_THROW_AT(props.location("radius"), "radius must be a positive number of pixels, got {}",
-                           radius);
+            FACET_THROW_AT(props.location("radius"),
+                           "radius must be a positive number of pixels, got {}", radius);
         m_radius = float(radius);
         m_inv_radius = 1.f / m_radius;
     }
 
     float eval(float x) const override { return std::max(0.f, 1.f - std::abs(x) * m_inv_radius); }
 
-    std::string to_string() const override { return fmt::format("TentFilter[radius={}]", m_radius); }
+    std::string to_string() const override {
+        return fmt::format("TentFilter[radius={}]", m_radius);
+    }
 
 private:
     float m_inv_radius = 1.f;
@@ -41,4 +43,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::TentFilter, ReconstructionFilter, "tent", "Tent (triangle) pixel filter", DOC)
+FACET_EXPORT_PLUGIN(facet::TentFilter, ReconstructionFilter, "tent", "Tent (triangle) pixel filter",
+                    DOC)

@@ -52,17 +52,18 @@ public:
         m_near_clip = float(props.get_float("near_clip", 1e-2));
         m_far_clip = float(props.get_float("far_clip", 1e4));
         if (!(m_near_clip > 0.f) || !(m_far_clip > m_near_clip) || !std::isfinite(m_far_clip))
-            FACET_THROW_AT(props.location(),
-                           "the clipping planes must satisfy 0 < near_clip < far_clip (finite), got "
-                           "near_clip = {}, far_clip = {}",
-                           m_near_clip, m_far_clip);
+            FACET_THROW_AT(
+                props.location(),
+                "the clipping planes must satisfy 0 < near_clip < far_clip (finite), got "
+                "near_clip = {}, far_clip = {}",
+                m_near_clip, m_far_clip);
         m_principal_offset = Point2f(float(props.get_float("principal_point_offset_x", 0.0)),
                                      float(props.get_float("principal_point_offset_y", 0.0)));
         if (props.has("focus_distance")) {
             double fd = props.get_float("focus_distance");
             if (!(fd > 0.0))
-                FACET_THROW_AT(props.location("focus_distance"), "focus_distance must be positive, got {}",
-                               fd);
+                FACET_THROW_AT(props.location("focus_distance"),
+                               "focus_distance must be positive, got {}", fd);
         }
 
         m_tan_x = float(std::tan(0.5 * m_x_fov * 3.14159265358979323846 / 180.0));
@@ -74,18 +75,21 @@ public:
                                        const Point2f &aperture_sample) const override {
         // Film x grows to the right, which is local -X (local +X is the camera's left).
         const float u = film_pos.x + m_principal_offset.x, v = film_pos.y + m_principal_offset.y;
-        const Vector3f local = normalize(Vector3f((1.f - 2.f * u) * m_tan_x, (1.f - 2.f * v) * m_tan_y, 1.f));
+        const Vector3f local =
+            normalize(Vector3f((1.f - 2.f * u) * m_tan_x, (1.f - 2.f * v) * m_tan_y, 1.f));
         const float inv_z = 1.f / local.z;
-        Ray ray(m_origin, normalize(m_to_world.apply_vector(local)), m_near_clip * inv_z, m_far_clip * inv_z);
+        Ray ray(m_origin, normalize(m_to_world.apply_vector(local)), m_near_clip * inv_z,
+                m_far_clip * inv_z);
         ray.time = time;
         return {ray, Color3f(1.f)};
     }
 
     std::string to_string() const override {
-        return fmt::format("PerspectiveCamera[x_fov={:.4f}, near_clip={}, far_clip={}, origin=({}, {}, {}), "
-                           "film={}, sampler={}]",
-                           m_x_fov, m_near_clip, m_far_clip, m_origin.x, m_origin.y, m_origin.z,
-                           m_film->to_string(), m_sampler->to_string());
+        return fmt::format(
+            "PerspectiveCamera[x_fov={:.4f}, near_clip={}, far_clip={}, origin=({}, {}, {}), "
+            "film={}, sampler={}]",
+            m_x_fov, m_near_clip, m_far_clip, m_origin.x, m_origin.y, m_origin.z,
+            m_film->to_string(), m_sampler->to_string());
     }
 
 private:
@@ -98,4 +102,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::PerspectiveCamera, Sensor, "perspective", "Pinhole perspective camera", DOC)
+FACET_EXPORT_PLUGIN(facet::PerspectiveCamera, Sensor, "perspective", "Pinhole perspective camera",
+                    DOC)

@@ -33,7 +33,8 @@ std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::strin
     return scene;
 }
 
-std::string scene_xml(const std::string &integrator, int size, int spp, const std::string &rfilter) {
+std::string scene_xml(const std::string &integrator, int size, int spp,
+                      const std::string &rfilter) {
     return fmt::format(R"(<scene version="3.0.0">
     {integrator}
     <sensor type="perspective">
@@ -75,8 +76,8 @@ std::string scene_xml(const std::string &integrator, int size, int spp, const st
         </bsdf>
     </shape>
 </scene>)",
-                       fmt::arg("integrator", integrator), fmt::arg("size", size), fmt::arg("spp", spp),
-                       fmt::arg("rfilter", rfilter));
+                       fmt::arg("integrator", integrator), fmt::arg("size", size),
+                       fmt::arg("spp", spp), fmt::arg("rfilter", rfilter));
 }
 
 const char *PATH = R"(<integrator type="path"><integer name="max_depth" value="6"/></integrator>)";
@@ -113,9 +114,13 @@ public:
 };
 
 const PluginDescriptor *invalid_samples_descriptor() {
-    static const PluginDescriptor desc{FACET_ABI_VERSION, ObjectType::Integrator, "test_invalid_samples",
-                                       "test integrator", "",
-                                       [](const Properties &p) -> Object * { return new InvalidSamplesIntegrator(p); }};
+    static const PluginDescriptor desc{
+        FACET_ABI_VERSION,
+        ObjectType::Integrator,
+        "test_invalid_samples",
+        "test integrator",
+        "",
+        [](const Properties &p) -> Object * { return new InvalidSamplesIntegrator(p); }};
     return &desc;
 }
 
@@ -131,9 +136,13 @@ public:
 };
 
 const PluginDescriptor *cancelling_descriptor() {
-    static const PluginDescriptor desc{FACET_ABI_VERSION, ObjectType::Integrator, "test_cancelling",
-                                       "test integrator", "",
-                                       [](const Properties &p) -> Object * { return new CancellingIntegrator(p); }};
+    static const PluginDescriptor desc{
+        FACET_ABI_VERSION,
+        ObjectType::Integrator,
+        "test_cancelling",
+        "test integrator",
+        "",
+        [](const Properties &p) -> Object * { return new CancellingIntegrator(p); }};
     return &desc;
 }
 
@@ -208,8 +217,8 @@ TEST(RenderLoop, CancelBeforeStartRendersNothing) {
 
 TEST(RenderLoop, InvalidSamplesAreDroppedAndAovsDeveloped) {
     PluginRegistry::instance().register_static(invalid_samples_descriptor());
-    auto scene = load_temp_scene(
-        "nan", scene_xml("<integrator type=\"test_invalid_samples\"/>", 8, 16, "<rfilter type=\"tent\"/>"));
+    auto scene = load_temp_scene("nan", scene_xml("<integrator type=\"test_invalid_samples\"/>", 8,
+                                                  16, "<rfilter type=\"tent\"/>"));
     const size_t warnings = Logger::warning_count();
     RenderResult r = render_with(*scene, 2);
     EXPECT_GT(Logger::warning_count(), warnings); // reported
@@ -233,8 +242,8 @@ TEST(RenderLoop, InvalidSamplesAreDroppedAndAovsDeveloped) {
 
 TEST(RenderLoop, CancelFinishesTheBlockInFlight) {
     PluginRegistry::instance().register_static(cancelling_descriptor());
-    auto scene = load_temp_scene(
-        "cancel_mid", scene_xml("<integrator type=\"test_cancelling\"/>", 8, 2, "<rfilter type=\"box\"/>"));
+    auto scene = load_temp_scene("cancel_mid", scene_xml("<integrator type=\"test_cancelling\"/>",
+                                                         8, 2, "<rfilter type=\"box\"/>"));
     std::atomic<bool> cancel{false};
     g_cancel_flag = &cancel;
     RenderOptions opts;
@@ -250,7 +259,8 @@ TEST(RenderLoop, CancelFinishesTheBlockInFlight) {
     EXPECT_EQ(r.blocks_done, 1u);
     EXPECT_EQ(r.samples, 4u * 4u * 2u);
     for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) EXPECT_EQ(r.image.at(x, y, 0), (x < 4 && y < 4) ? 1.f : 0.f) << x << "," << y;
+        for (int x = 0; x < 8; ++x)
+            EXPECT_EQ(r.image.at(x, y, 0), (x < 4 && y < 4) ? 1.f : 0.f) << x << "," << y;
 }
 
 TEST(RenderLoop, InterruptHandlerSetsTheFlagOnce) {

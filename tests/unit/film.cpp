@@ -14,8 +14,8 @@ namespace {
 
 std::shared_ptr<ReconstructionFilter> make_filter(const std::string &name, Properties props = {}) {
     props.set_plugin_name(name);
-    return PluginRegistry::instance().create_as<ReconstructionFilter>(ObjectType::ReconstructionFilter,
-                                                                      props);
+    return PluginRegistry::instance().create_as<ReconstructionFilter>(
+        ObjectType::ReconstructionFilter, props);
 }
 
 std::shared_ptr<Film> make_film(Properties props) {
@@ -220,13 +220,26 @@ TEST(Film, CropWindowValidation) {
     film = make_film(with({{"crop_offset_x", 10}, {"crop_width", 20}, {"crop_height", 50}}));
     EXPECT_EQ(film->crop_size(), Point2i(20, 50));
 
-    EXPECT_NE(error_of([&] { make_film(with({{"crop_offset_x", 90}, {"crop_width", 20}})); }).find("crop window"),
+    EXPECT_NE(error_of([&] {
+                  make_film(with({{"crop_offset_x", 90}, {"crop_width", 20}}));
+              }).find("crop window"),
               std::string::npos);
-    EXPECT_NE(error_of([&] { make_film(with({{"crop_height", 51}})); }).find("inside the 100x50 film"),
+    EXPECT_NE(error_of([&] {
+                  make_film(with({{"crop_height", 51}}));
+              }).find("inside the 100x50 film"),
               std::string::npos);
-    EXPECT_NE(error_of([&] { make_film(with({{"crop_offset_y", -1}})); }).find("crop offset"), std::string::npos);
-    EXPECT_NE(error_of([&] { make_film(with({{"crop_offset_x", 100}})); }).find("crop offset"), std::string::npos);
-    EXPECT_NE(error_of([&] { make_film(with({{"crop_width", 0}})); }).find("crop window"), std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  make_film(with({{"crop_offset_y", -1}}));
+              }).find("crop offset"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  make_film(with({{"crop_offset_x", 100}}));
+              }).find("crop offset"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  make_film(with({{"crop_width", 0}}));
+              }).find("crop window"),
+              std::string::npos);
     EXPECT_NE(error_of([&] { make_film(with({{"width", 0}})); }).find("width"), std::string::npos);
 }
 

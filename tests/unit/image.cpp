@@ -20,8 +20,8 @@ class ImageIO : public ::testing::Test {
 protected:
     void SetUp() override {
         const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_dir = fs::temp_directory_path() /
-                fmt::format("facet-image-{}-{}-{}", ::getpid(), info->test_suite_name(), info->name());
+        m_dir = fs::temp_directory_path() / fmt::format("facet-image-{}-{}-{}", ::getpid(),
+                                                        info->test_suite_name(), info->name());
         fs::remove_all(m_dir);
         fs::create_directories(m_dir);
     }
@@ -30,7 +30,8 @@ protected:
     /// Files in the folder, hidden ones included.
     std::vector<std::string> listing() const {
         std::vector<std::string> names;
-        for (const auto &e : fs::directory_iterator(m_dir)) names.push_back(e.path().filename().string());
+        for (const auto &e : fs::directory_iterator(m_dir))
+            names.push_back(e.path().filename().string());
         std::sort(names.begin(), names.end());
         return names;
     }
@@ -46,7 +47,8 @@ Image gradient(int w, int h, int c) {
     Image img(w, h, c);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            for (int k = 0; k < c; ++k) img.at(x, y, k) = 0.01f * float(x + 3 * y) + 0.37f * float(k) + 1e-3f * x * x;
+            for (int k = 0; k < c; ++k)
+                img.at(x, y, k) = 0.01f * float(x + 3 * y) + 0.37f * float(k) + 1e-3f * x * x;
     return img;
 }
 
@@ -105,7 +107,8 @@ TEST_F(ImageIO, ExrKeepsAovChannelNames) {
     ASSERT_EQ(back.channels, 5);
     // EXR sorts channels inside a layer; find them by name.
     for (int c = 0; c < 5; ++c) {
-        auto it = std::find(back.channel_names.begin(), back.channel_names.end(), img.channel_names[c]);
+        auto it =
+            std::find(back.channel_names.begin(), back.channel_names.end(), img.channel_names[c]);
         ASSERT_NE(it, back.channel_names.end()) << img.channel_names[c];
         int bc = int(it - back.channel_names.begin());
         EXPECT_EQ(back.at(3, 2, bc), img.at(3, 2, c));

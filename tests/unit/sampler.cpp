@@ -36,7 +36,8 @@ std::vector<float> stream(Sampler &s, uint64_t pixel_seed, int n) {
 } // namespace
 
 TEST(IndependentSampler, Parameters) {
-    auto s = PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler, Properties("independent"));
+    auto s = PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler,
+                                                           Properties("independent"));
     EXPECT_EQ(s->sample_count(), 4u);
     EXPECT_EQ(s->base_seed(), 0u);
     auto t = independent(64, 17);

@@ -25,7 +25,9 @@ std::shared_ptr<Sensor> camera(int w, int h, Properties p = {}) {
     return PluginRegistry::instance().create_as<Sensor>(ObjectType::Sensor, p);
 }
 
-Vector3f dir(const Sensor &s, float u, float v) { return s.sample_ray(0.f, {u, v}, {0.5f, 0.5f}).first.d; }
+Vector3f dir(const Sensor &s, float u, float v) {
+    return s.sample_ray(0.f, {u, v}, {0.5f, 0.5f}).first.d;
+}
 
 /// Full horizontal field of view in degrees, measured from the rays through the film edges.
 double measured_x_fov(const Sensor &s) {
@@ -59,7 +61,8 @@ TEST(Perspective, Default50mmLens) {
     q.set_string("focal_length", "28mm"); // diagonal 2·atan(43.267/56) = 75.38°
     auto cam = camera(100, 100, q);
     double diag = 2.0 * std::atan(std::sqrt(36.0 * 36 + 24 * 24) / 56.0);
-    EXPECT_NEAR(measured_x_fov(*cam), 2.0 * std::atan(std::tan(diag / 2) / std::sqrt(2.0)) * RadToDeg, 1e-3);
+    EXPECT_NEAR(measured_x_fov(*cam),
+                2.0 * std::atan(std::tan(diag / 2) / std::sqrt(2.0)) * RadToDeg, 1e-3);
 }
 
 TEST(Perspective, FovAxes) {
@@ -165,7 +168,8 @@ TEST(Perspective, PrincipalPointAndFocusDistance) {
 }
 
 TEST(Sensor, DefaultFilmAndSampler) {
-    auto cam = PluginRegistry::instance().create_as<Sensor>(ObjectType::Sensor, Properties("perspective"));
+    auto cam =
+        PluginRegistry::instance().create_as<Sensor>(ObjectType::Sensor, Properties("perspective"));
     EXPECT_EQ(cam->film().size(), Point2i(768, 576));
     EXPECT_EQ(cam->sampler().sample_count(), 4u);
     EXPECT_FALSE(cam->needs_aperture_sample());

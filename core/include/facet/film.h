@@ -27,7 +27,8 @@ public:
         put(pos, L, nullptr, filter);
     }
     /// The same with `aov_count()` extra values (`aovs` may be null when there are none).
-    void put(const Point2f &pos, const Color3f &L, const float *aovs, const ReconstructionFilter &filter);
+    void put(const Point2f &pos, const Color3f &L, const float *aovs,
+             const ReconstructionFilter &filter);
     const Point2i &offset() const { return m_offset; }
     const Point2i &size() const { return m_size; }
     int border() const { return m_border; }
@@ -79,7 +80,8 @@ public:
     /// Extension the film writes by default (".exr").
     virtual std::string default_extension() const { return ".exr"; }
     /// Writes `image` to `path` through image I/O (atomically), float16 or float32 as configured.
-    virtual void write(const Image &image, const std::string &path, const ImageWriteOptions &opts) const;
+    virtual void write(const Image &image, const std::string &path,
+                       const ImageWriteOptions &opts) const;
 
     bool half() const { return m_half; }
     bool has_alpha() const { return m_alpha; }
@@ -90,8 +92,8 @@ protected:
     std::shared_ptr<ReconstructionFilter> m_filter;
     std::vector<double> m_storage; ///< Σ w·L (3), Σ w·aov (per AOV) and Σ w per crop pixel
     std::vector<std::string> m_aov_names;
-    bool m_half = true;            ///< component_format float16
-    bool m_alpha = false;          ///< pixel_format rgba
+    bool m_half = true;   ///< component_format float16
+    bool m_alpha = false; ///< pixel_format rgba
 };
 
 } // namespace facet
