@@ -1,0 +1,211 @@
+static const char *DOC = R"DOC(
+# blendbsdf: linear blend of two BSDFs
+
+Mixes two nested BSDFs with a weight that may vary over the surface:
+f = (1 − weight)·f_first + weight·f_second. A weight of 0 gives the first BSDF, 1 the second.
+Sampling picks one of the two with probability 1 − weight and weight and reuses the lobe choice
+number for the picked BSDF; the density is the blend of the two densities, and a smooth sample's
+weight is the blend's value over that density (so MIS sees exactly what was sampled).
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| weight | float or texture | 0.5 | Blend weight in [0, 1]: 0 = the first BSDF, 1 = the second (textures are clamped to [0, 1]) |
+| (nested bsdf) | bsdf | — | Exactly two nested BSDFs, in order: first, second |
+
+Components: the first BSDF's components, then the second's; the flags are their union. A delta
+direction that both BSDFs produce (two mirrors, say) is sampled through either one and weighted
+as if only that one had it; the estimate stays unbiased.
+
+```xml
+<bsdf type="blendbsdf">
+    <float name="weight" value="0.3"/>
+    <bsdf type="diffuse"/>
+    <bsdf type="roughconductor">
+        <float name="alpha" value="0.2"/>
+    </bsdf>
+</bsdf>
+```
+)DOC";
+
+#include <facet/bsdf.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/texture.h>
+
+#include <fmt/format.h>
+
+namespace facet {
+
+class BlendBSDF final : public BSDF {
+public:
+    explicit BlendBSDF(const Properties &props) {
+        size_t count = 0;
+        for (const auto &[name, obj] : props.objects()) {
+            auto bsdf = std::dynamic_pointer_cast<BSDF>(obj);
+            if (!bsdf) continue;
+            if (count == 2)
+                FACET_THROW_AT(props.location(), "blendbsdf takes exactly two nested BSDFs, found "
+                               "a third (\"{}\")", name);
+            m_nested[count++] = bsdf;
+            props.mark_queried(name);
+        }
+        if (count != 2)
+            FACET_THROW_AT(props.location(), "blendbsdf takes exactly two nested BSDFs, found {}",
+                           count);
+
+        m_weight = props.texture("weight", 0.5f);
+        if (!m_weight->is_spatially_varying()) {
+            float value = m_weight->mean().mean();
+            if (!(value >= 0.f && value <= 1.f))
+                FACET_THROW_AT(props.has("weight") ? props.location("weight") : props.location(),
+                               "blendbsdf: weight must be in [0, 1], found {}", value);
+        }
+
+        std::vector<BSDFFlags> components;
+        for (const auto &b : m_nested)
+            for (size_t i = 0; i < b->component_count(); ++i) {
+                BSDFFlags f = b->flags(i);
+                if (m_weight->is_spatially_varying()) f |= BSDFFlags::SpatiallyVarying;
+                components.push_back(f);
+            }
+        set_components(std::move(components));
+        m_first_count = uint32_t(m_nested[0]->component_count());
+    }
+
+    std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                          float sample1, const Point2f &sample2) const override {
+        float w = weight(si);
+        if (ctx.component != uint32_t(-1)) {
+            // One component: only its BSDF is sampled, and carries its blend factor.
+            BSDFContext sub;
+            int which = route(ctx, sub);
+            auto [bs, value] = m_nested[which]->sample(sub, si, sample1, sample2);
+            if (which == 1 && bs.sampled_component != uint32_t(-1))
+                bs.sampled_component += m_first_count;
+            return {bs, value * (which == 0 ? 1.f - w : w)};
+        }
+
+        // Pick the second BSDF with probability w and rescale sample1 for its own lobe choice.
+        int which;
+        float u;
+        if (sample1 < w) {
+            which = 1;
+            u = sample1 / w;
+        } else {
+            which = 0;
+            u = (sample1 - w) / (1.f - w);
+        }
+        u = clamp(u, 0.f, OneMinusEpsilon);
+        float p_which = which == 1 ? w : 1.f - w;
+        auto [bs, value] = m_nested[which]->sample(ctx, si, u, sample2);
+        if (which == 1 && bs.sampled_component != uint32_t(-1)) bs.sampled_component += m_first_count;
+        if (value.is_black() || !(p_which > 0.f)) return {bs, Color3f(0.f)};
+
+        if (has_flag(bs.sampled_type, BSDFFlags::Delta | BSDFFlags::Delta1D)) {
+            // Value scaled by p_which and discrete probability scaled by p_which: same weight.
+            bs.pdf *= p_which;
+            return {bs, value};
+        }
+        // A smooth direction may also be reached through the other BSDF: the weight is the
+        // blend's value over the blend's density.
+        auto [blend_value, blend_pdf] = eval_pdf(ctx, si, bs.wo);
+        if (!(blend_pdf > 0.f) || blend_value.is_black()) return {bs, Color3f(0.f)};
+        bs.pdf = blend_pdf;
+        return {bs, blend_value / blend_pdf};
+    }
+
+    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
+                 const Vector3f &wo) const override {
+        float w = weight(si);
+        if (ctx.component != uint32_t(-1)) {
+            BSDFContext sub;
+            int which = route(ctx, sub);
+            return m_nested[which]->eval(sub, si, wo) * (which == 0 ? 1.f - w : w);
+        }
+        Color3f result(0.f);
+        if (w < 1.f) result += m_nested[0]->eval(ctx, si, wo) * (1.f - w);
+        if (w > 0.f) result += m_nested[1]->eval(ctx, si, wo) * w;
+        return result;
+    }
+
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+              const Vector3f &wo) const override {
+        float w = weight(si);
+        if (ctx.component != uint32_t(-1)) {
+            BSDFContext sub;
+            int which = route(ctx, sub);
+            return m_nested[which]->pdf(sub, si, wo);
+        }
+        float result = 0.f;
+        if (w < 1.f) result += m_nested[0]->pdf(ctx, si, wo) * (1.f - w);
+        if (w > 0.f) result += m_nested[1]->pdf(ctx, si, wo) * w;
+        return result;
+    }
+
+    std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                       const Vector3f &wo) const override {
+        float w = weight(si);
+        if (ctx.component != uint32_t(-1)) {
+            BSDFContext sub;
+            int which = route(ctx, sub);
+            auto [value, pdf] = m_nested[which]->eval_pdf(sub, si, wo);
+            return {value * (which == 0 ? 1.f - w : w), pdf};
+        }
+        Color3f value(0.f);
+        float pdf = 0.f;
+        if (w < 1.f) {
+            auto [v0, p0] = m_nested[0]->eval_pdf(ctx, si, wo);
+            value += v0 * (1.f - w);
+            pdf += p0 * (1.f - w);
+        }
+        if (w > 0.f) {
+            auto [v1, p1] = m_nested[1]->eval_pdf(ctx, si, wo);
+            value += v1 * w;
+            pdf += p1 * w;
+        }
+        return {value, pdf};
+    }
+
+    Color3f eval_null_transmission(const SurfaceInteraction &si) const override {
+        float w = weight(si);
+        return m_nested[0]->eval_null_transmission(si) * (1.f - w) +
+               m_nested[1]->eval_null_transmission(si) * w;
+    }
+
+    Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const override {
+        float w = weight(si);
+        return m_nested[0]->eval_diffuse_reflectance(si) * (1.f - w) +
+               m_nested[1]->eval_diffuse_reflectance(si) * w;
+    }
+
+    void parameters_changed() override {
+        m_nested[0]->parameters_changed();
+        m_nested[1]->parameters_changed();
+    }
+
+    std::string to_string() const override {
+        return fmt::format("BlendBSDF[weight = {}, first = {}, second = {}]", m_weight->to_string(),
+                           m_nested[0]->to_string(), m_nested[1]->to_string());
+    }
+
+private:
+    float weight(const SurfaceInteraction &si) const { return clamp(m_weight->eval_1(si), 0.f, 1.f); }
+
+    /// The nested BSDF that owns ctx.component, and the context with the component renumbered
+    /// for it.
+    int route(const BSDFContext &ctx, BSDFContext &sub) const {
+        sub = ctx;
+        if (ctx.component < m_first_count) return 0;
+        sub.component = ctx.component - m_first_count;
+        return 1;
+    }
+
+    std::shared_ptr<BSDF> m_nested[2];
+    std::shared_ptr<Texture> m_weight;
+    uint32_t m_first_count = 0;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::BlendBSDF, BSDF, "blendbsdf",
+                    "Linear blend of two BSDFs with a constant or textured weight", DOC)

@@ -1,0 +1,242 @@
+static const char *DOC = R"DOC(
+# bitmap: image texture
+
+An image file (PNG, JPEG, EXR, HDR, TIFF, ... anything OpenImageIO reads) looked up by the
+texture coordinates of the surface point. The pixel at the top-left corner of the image is at
+uv = (0, 0) and u grows to the right, v downwards, as in Mitsuba; mesh loaders that flip v (OBJ,
+by default) therefore show the image's top row at the file's v = 1. Outside [0, 1]² the image
+repeats, mirrors or clamps as `wrap_mode` says.
+
+8-bit and 16-bit formats (PNG, JPEG, ...) store sRGB-encoded values and are decoded to linear
+RGB on load, unless `raw` is set (for data such as roughness, opacity or normal maps); EXR, HDR
+and PFM images are linear already and are used as stored. Grey images give grey colours (an
+alpha channel is ignored). `eval_1` (scalar parameters such as a roughness) returns the grey
+value, or the luminance of a colour image.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| filename | string | — | Image file, found through the scene's file resolver |
+| filter_type | string | bilinear | Lookup filter: bilinear (interpolates the four nearest pixel centres) or nearest |
+| wrap_mode | string | repeat | Behaviour outside [0, 1]²: repeat, mirror or clamp |
+| raw | boolean | false | Use 8-bit values as stored (no sRGB decoding), for non-colour data |
+| to_uv | transform | identity | Transform applied to the texture coordinates (its x, y affine part) |
+| format | string | variant | Accepted for compatibility (variant, fp16, fp32); pixels are always stored as 32-bit floats |
+| accel | boolean | true | Accepted for compatibility; lookups always run on the CPU |
+
+```xml
+<bsdf type="diffuse">
+    <texture type="bitmap" name="reflectance">
+        <string name="filename" value="textures/wood.jpg"/>
+        <string name="wrap_mode" value="mirror"/>
+        <transform name="to_uv">
+            <scale x="4" y="4"/>
+        </transform>
+    </texture>
+</bsdf>
+```
+)DOC";
+
+#include <facet/image.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/resolver.h>
+#include <facet/texture.h>
+#include <facet/transform.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <vector>
+
+namespace facet {
+
+namespace {
+
+enum class FilterType { Nearest, Bilinear };
+enum class WrapMode { Repeat, Mirror, Clamp };
+
+/// sRGB electro-optical transfer function (IEC 61966-2-1): encoded value -> linear.
+float srgb_to_linear(float v) {
+    if (v <= 0.04045f) return v * (1.f / 12.92f);
+    return std::pow((v + 0.055f) * (1.f / 1.055f), 2.4f);
+}
+
+/// Formats whose pixels are scene-linear floating-point values.
+bool is_linear_format(const std::string &path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".exr" || ext == ".hdr" || ext == ".rgbe" || ext == ".pfm";
+}
+
+} // namespace
+
+class Bitmap final : public Texture {
+public:
+    explicit Bitmap(const Properties &props) {
+        m_filename = props.get_string("filename");
+        std::string filter = props.get_string("filter_type", "bilinear");
+        if (filter == "bilinear")
+            m_filter = FilterType::Bilinear;
+        else if (filter == "nearest")
+            m_filter = FilterType::Nearest;
+        else
+            FACET_THROW_AT(props.location("filter_type"),
+                           "bitmap: filter_type must be bilinear or nearest, found \"{}\"", filter);
+        std::string wrap = props.get_string("wrap_mode", "repeat");
+        if (wrap == "repeat")
+            m_wrap = WrapMode::Repeat;
+        else if (wrap == "mirror")
+            m_wrap = WrapMode::Mirror;
+        else if (wrap == "clamp")
+            m_wrap = WrapMode::Clamp;
+        else
+            FACET_THROW_AT(props.location("wrap_mode"),
+                           "bitmap: wrap_mode must be repeat, mirror or clamp, found \"{}\"", wrap);
+        m_raw = props.get_bool("raw", false);
+        std::string format = props.get_string("format", "variant");
+        if (format != "variant" && format != "fp16" && format != "fp32")
+            FACET_THROW_AT(props.location("format"),
+                           "bitmap: format must be variant, fp16 or fp32, found \"{}\"", format);
+        props.get_bool("accel", true);
+
+        Transform to_uv = props.get_transform("to_uv", Transform());
+        const auto &m = to_uv.matrix.m;
+        m_uv_matrix[0] = m[0][0], m_uv_matrix[1] = m[0][1], m_uv_matrix[2] = m[0][3];
+        m_uv_matrix[3] = m[1][0], m_uv_matrix[4] = m[1][1], m_uv_matrix[5] = m[1][3];
+
+        m_path = file_resolver().resolve(m_filename);
+        Image image;
+        try {
+            image = read_image(m_path);
+        } catch (const Error &e) {
+            FACET_THROW_AT(props.location("filename"), "bitmap: {}", e.message());
+        }
+        if (image.width <= 0 || image.height <= 0 || image.channels <= 0)
+            FACET_THROW_AT(props.location("filename"), "bitmap: \"{}\" holds no pixels", m_path);
+        load_pixels(image, !m_raw && !is_linear_format(m_path));
+    }
+
+    Color3f eval(const SurfaceInteraction &si) const override {
+        Point2f uv = to_uv(si.uv);
+        if (m_channels == 1) return Color3f(lookup<1>(uv).r);
+        return lookup<3>(uv);
+    }
+
+    float eval_1(const SurfaceInteraction &si) const override {
+        Point2f uv = to_uv(si.uv);
+        if (m_channels == 1) return lookup<1>(uv).r;
+        return lookup<3>(uv).luminance();
+    }
+
+    Color3f mean() const override { return m_mean; }
+    float max() const override { return m_max; }
+
+    int width() const { return m_width; }
+    int height() const { return m_height; }
+
+    std::string to_string() const override {
+        static const char *filters[] = {"nearest", "bilinear"};
+        static const char *wraps[] = {"repeat", "mirror", "clamp"};
+        return fmt::format("Bitmap[\"{}\", {}x{}, {} channel{}, filter_type = {}, wrap_mode = {}, "
+                           "raw = {}, mean = [{}, {}, {}]]",
+                           m_filename, m_width, m_height, m_channels, m_channels == 1 ? "" : "s",
+                           filters[int(m_filter)], wraps[int(m_wrap)], m_raw, m_mean.r, m_mean.g,
+                           m_mean.b);
+    }
+
+private:
+    /// Keeps grey (1 channel) or RGB (3), drops alpha, decodes sRGB, computes mean and max.
+    void load_pixels(const Image &image, bool decode_srgb) {
+        m_width = image.width;
+        m_height = image.height;
+        m_channels = image.channels <= 2 ? 1 : 3;
+        size_t n = size_t(m_width) * size_t(m_height);
+        m_data.resize(n * size_t(m_channels));
+        double sum[3] = {0, 0, 0};
+        m_max = -Infinity;
+        for (size_t i = 0; i < n; ++i) {
+            for (int c = 0; c < m_channels; ++c) {
+                float v = image.data[i * size_t(image.channels) + size_t(c)];
+                if (decode_srgb) v = srgb_to_linear(v);
+                m_data[i * size_t(m_channels) + size_t(c)] = v;
+                sum[c] += double(v);
+                m_max = std::max(m_max, v);
+            }
+        }
+        if (m_channels == 1)
+            m_mean = Color3f(float(sum[0] / double(n)));
+        else
+            m_mean = Color3f(float(sum[0] / double(n)), float(sum[1] / double(n)),
+                             float(sum[2] / double(n)));
+    }
+
+    Point2f to_uv(const Point2f &uv) const {
+        return {m_uv_matrix[0] * uv.x + m_uv_matrix[1] * uv.y + m_uv_matrix[2],
+                m_uv_matrix[3] * uv.x + m_uv_matrix[4] * uv.y + m_uv_matrix[5]};
+    }
+
+    /// Pixel index i wrapped into [0, n).
+    int wrap(int i, int n) const {
+        switch (m_wrap) {
+        case WrapMode::Repeat: {
+            int r = i % n;
+            return r < 0 ? r + n : r;
+        }
+        case WrapMode::Mirror: {
+            int period = 2 * n, r = i % period;
+            if (r < 0) r += period;
+            return r < n ? r : period - 1 - r;
+        }
+        case WrapMode::Clamp:
+        default: return clamp(i, 0, n - 1);
+        }
+    }
+
+    /// Integer part of x, kept in a range where int arithmetic cannot overflow.
+    static int floor_to_int(float x) {
+        if (!(x == x)) return 0; // NaN
+        return int(std::floor(clamp(x, -1e8f, 1e8f)));
+    }
+
+    template <int C> Color3f pixel(int x, int y) const {
+        const float *p = m_data.data() + (size_t(y) * size_t(m_width) + size_t(x)) * C;
+        if constexpr (C == 1) return Color3f(p[0]);
+        else return Color3f(p[0], p[1], p[2]);
+    }
+
+    template <int C> Color3f lookup(const Point2f &uv) const {
+        float x = uv.x * float(m_width), y = uv.y * float(m_height);
+        if (m_filter == FilterType::Nearest)
+            return pixel<C>(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
+
+        // Bilinear between the four pixel centres around (x, y); centres sit at half-integers.
+        x -= 0.5f;
+        y -= 0.5f;
+        int x0 = floor_to_int(x), y0 = floor_to_int(y);
+        float fx = clamp(x - float(x0), 0.f, 1.f), fy = clamp(y - float(y0), 0.f, 1.f);
+        if (!std::isfinite(fx)) fx = 0.f;
+        if (!std::isfinite(fy)) fy = 0.f;
+        int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
+        int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
+        return (pixel<C>(xa, ya) * (1.f - fx) + pixel<C>(xb, ya) * fx) * (1.f - fy) +
+               (pixel<C>(xa, yb) * (1.f - fx) + pixel<C>(xb, yb) * fx) * fy;
+    }
+
+    std::string m_filename, m_path;
+    FilterType m_filter = FilterType::Bilinear;
+    WrapMode m_wrap = WrapMode::Repeat;
+    bool m_raw = false;
+    float m_uv_matrix[6] = {1, 0, 0, 0, 1, 0};
+    int m_width = 0, m_height = 0, m_channels = 3;
+    std::vector<float> m_data;
+    Color3f m_mean;
+    float m_max = 0.f;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::Bitmap, Texture, "bitmap", "Image texture read with OpenImageIO", DOC)
