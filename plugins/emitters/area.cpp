@@ -27,6 +27,7 @@ An area emitter must be nested in a shape (or referenced by one).
 #include <facet/properties.h>
 #include <facet/shape.h>
 #include <facet/texture.h>
+#include <facet/warp.h>
 
 #include <fmt/format.h>
 
@@ -61,6 +62,23 @@ public:
         const Shape &shape = require_shape();
         if (dot(ds.n, ds.d) >= 0.f) return 0.f;
         return shape.pdf_direction(ref, ds);
+    }
+
+    /// Emitted rays: a uniform point on the shape and a cosine-weighted direction on its front
+    /// side; the weight L·π/pdf_area is the power the ray carries per unit of the joint density.
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+        const Shape &shape = require_shape();
+        PositionSample ps = shape.sample_position(u_pos);
+        if (!(ps.pdf > 0.f)) return {Ray(), Color3f(0.f)};
+        Frame frame(ps.n);
+        Vector3f d = frame.to_world(warp::square_to_cosine_hemisphere(u_dir));
+        Interaction origin;
+        origin.p = ps.p;
+        origin.n = ps.n;
+        origin.t = 0.f;
+        DirectionSample at;
+        static_cast<PositionSample &>(at) = ps;
+        return {origin.spawn_ray(d), radiance_at(at) * (Pi / ps.pdf)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {

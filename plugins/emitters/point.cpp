@@ -21,6 +21,7 @@ angle θ with the direction to the light is `intensity`·cos θ/d². It cannot b
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
+#include <facet/warp.h>
 
 #include <fmt/format.h>
 
@@ -64,6 +65,17 @@ public:
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
     Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
+
+    /// Emitted rays: uniform directions; the weight is the total power per unit of the
+    /// direction density, 4π·intensity.
+    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
+        Vector3f d = warp::square_to_uniform_sphere(u_dir);
+        return {Ray(m_position, d), m_intensity * (4.f * Pi)};
+    }
+
+    float pdf_ray_direction(const Vector3f &d) const override {
+        return warp::square_to_uniform_sphere_pdf(d);
+    }
 
     std::string to_string() const override {
         return fmt::format("PointLight[position = ({}, {}, {}), intensity = ({}, {}, {})]",

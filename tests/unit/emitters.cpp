@@ -116,6 +116,26 @@ TEST(EmitterPoint, WeightIsIntensityOverDistanceSquared) {
     EXPECT_NEAR(ds2.d.y, -0.8f, 1e-6f);
 }
 
+TEST(EmitterPoint, SampleRay) {
+    // Emitted rays start at the light and carry its total power 4π·I divided evenly.
+    Properties props("point");
+    props.set_vector("position", Vector3f(1.f, -2.f, 0.5f));
+    props.set_color("intensity", Color3f(1.f, 2.f, 3.f));
+    auto e = make_emitter(props);
+    PCG32 rng(12);
+    Vector3f mean_d(0.f);
+    for (int i = 0; i < 10000; ++i) {
+        auto [ray, weight] = e->sample_ray(Point2f(rng.next_float(), rng.next_float()),
+                                           Point2f(rng.next_float(), rng.next_float()));
+        EXPECT_EQ(ray.o, Point3f(1.f, -2.f, 0.5f));
+        EXPECT_NEAR(norm(ray.d), 1.f, 1e-5f);
+        EXPECT_NEAR(e->pdf_ray_direction(ray.d), InvFourPi, 1e-7f);
+        expect_color_near(weight, Color3f(1.f, 2.f, 3.f) * (4.f * Pi), 1e-6f);
+        mean_d += ray.d / 10000.f;
+    }
+    EXPECT_LT(norm(mean_d), 0.03f); // isotropic
+}
+
 TEST(EmitterPoint, ToWorld) {
     Properties props("point");
     props.set_transform("to_world", Transform::translate(Vector3f(0.f, 5.f, 0.f)));
@@ -217,6 +237,32 @@ TEST(EmitterArea, RectangleIrradianceOffAxisTilted) {
         }
     double expected = sum * 4.0 / (double(m) * m);
     EXPECT_NEAR(est.mean[0], expected, 4.0 * est.sigma + 1e-5 * expected);
+}
+
+TEST(EmitterArea, SampleRayCarriesThePower) {
+    // A 2×2 square of radiance L emits Φ = π·L·A from its front side; every ray carries Φ.
+    Properties props("area");
+    props.set_color("radiance", Color3f(2.f, 1.f, 0.5f));
+    auto e = make_emitter(props);
+    Properties rect("rectangle");
+    rect.set_transform("to_world", Transform::translate(Vector3f(0.f, 0.f, 1.f)));
+    auto shape = make_shape(rect, e);
+    PCG32 rng(13);
+    double mean_cos = 0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+        auto [ray, weight] = e->sample_ray(Point2f(rng.next_float(), rng.next_float()),
+                                           Point2f(rng.next_float(), rng.next_float()));
+        expect_color_near(weight, Color3f(2.f, 1.f, 0.5f) * (Pi * 4.f), 1e-5f);
+        EXPECT_LE(std::abs(ray.o.x), 1.f + 1e-5f);
+        EXPECT_LE(std::abs(ray.o.y), 1.f + 1e-5f);
+        EXPECT_NEAR(ray.o.z, 1.f, 1e-3f);
+        EXPECT_GT(ray.o.z, 1.f); // offset to the emitting side
+        EXPECT_GT(ray.d.z, 0.f);
+        mean_cos += ray.d.z / n;
+    }
+    // Cosine-weighted directions: E[cos θ] = 2/3.
+    EXPECT_NEAR(mean_cos, 2.0 / 3.0, 7e-3); // 4 standard errors
 }
 
 TEST(EmitterArea, BackSideGivesNothing) {
