@@ -87,8 +87,10 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("AreaLight[radiance = {}, shape = {}]", m_radiance->to_string(),
-                           m_shape ? m_shape->to_string() : std::string("none"));
+        // Not the shape's to_string(): that one prints its emitter, i.e. this.
+        return fmt::format("AreaLight[radiance = {}, {}]", m_radiance->to_string(),
+                           m_shape ? fmt::format("on a shape of area {}", m_shape->surface_area())
+                                   : std::string("not attached to a shape"));
     }
 
 private:

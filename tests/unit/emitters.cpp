@@ -202,6 +202,9 @@ TEST(EmitterArea, RectangleIrradianceOnAxis) {
     auto e = make_emitter(props);
     auto shape = make_shape(Properties("rectangle"), e);
     ASSERT_EQ(e->shape(), shape.get());
+    // Shape and emitter describe each other without recursing forever.
+    EXPECT_FALSE(shape->to_string().empty());
+    EXPECT_FALSE(e->to_string().empty());
 
     const double h = 1.5;
     Interaction ref = reference(Point3f(0.f, 0.f, float(h)), Normal3f(0.f, 0.f, -1.f));
