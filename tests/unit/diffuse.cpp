@@ -7,6 +7,7 @@
 #include <facet/properties.h>
 #include <facet/random.h>
 #include <facet/warp.h>
+#include <facet/xml.h>
 
 #include <gtest/gtest.h>
 
@@ -86,6 +87,31 @@ TEST(BSDFEval, DiffuseValue) {
     auto [value, pdf] = bsdf->eval_pdf(BSDFContext(), si, wo);
     expect_color_near(value, bsdf->eval(BSDFContext(), si, wo), 1e-6f);
     EXPECT_EQ(pdf, bsdf->pdf(BSDFContext(), si, wo));
+}
+
+TEST(BSDFEval, DiffuseTexturedReflectance) {
+    auto bsdf = std::dynamic_pointer_cast<BSDF>(load_string(R"(
+        <bsdf version="3.0.0" type="diffuse">
+            <texture type="checkerboard" name="reflectance">
+                <rgb name="color0" value="0.1, 0.2, 0.3"/>
+                <rgb name="color1" value="0.7, 0.8, 0.9"/>
+            </texture>
+        </bsdf>)"));
+    ASSERT_TRUE(bsdf);
+    EXPECT_TRUE(has_flag(bsdf->flags(), BSDFFlags::SpatiallyVarying));
+    EXPECT_TRUE(has_flag(bsdf->flags(), BSDFFlags::DiffuseReflection));
+    BSDFContext ctx;
+    Vector3f wo = normalize(Vector3f(0.3f, 0.1f, 0.8f));
+    SurfaceInteraction si = interaction(Vector3f(0.f, 0.f, 1.f));
+    const std::pair<Point2f, Color3f> cases[] = {{Point2f(0.25f, 0.25f), Color3f(0.1f, 0.2f, 0.3f)},
+                                                 {Point2f(0.75f, 0.25f), Color3f(0.7f, 0.8f, 0.9f)},
+                                                 {Point2f(0.75f, 0.75f), Color3f(0.1f, 0.2f, 0.3f)}};
+    for (const auto &[uv, rho] : cases) {
+        si.uv = uv;
+        expect_color_near(bsdf->eval_diffuse_reflectance(si), rho, 1e-6f);
+        expect_color_near(bsdf->eval(ctx, si, wo), rho * (InvPi * wo.z), 1e-6f);
+        expect_color_near(bsdf->sample(ctx, si, 0.5f, Point2f(0.3f, 0.6f)).second, rho, 1e-6f);
+    }
 }
 
 TEST(BSDFSampling, DiffuseConsistency) {

@@ -8,6 +8,7 @@
 #include <facet/random.h>
 #include <facet/scene.h>
 #include <facet/shape.h>
+#include <facet/xml.h>
 
 #include <gtest/gtest.h>
 
@@ -266,6 +267,37 @@ TEST(EmitterArea, SampleRayCarriesThePower) {
     }
     // Cosine-weighted directions: E[cos θ] = 2/3.
     EXPECT_NEAR(mean_cos, 2.0 / 3.0, 7e-3); // 4 standard errors
+}
+
+TEST(EmitterArea, TexturedRadiance) {
+    // A checkerboard radiance: sampled points and hits see the value at their own uv.
+    auto e = std::dynamic_pointer_cast<Emitter>(load_string(R"(
+        <emitter version="3.0.0" type="area">
+            <texture type="checkerboard" name="radiance">
+                <rgb name="color0" value="1, 2, 3"/>
+                <rgb name="color1" value="5, 5, 5"/>
+            </texture>
+        </emitter>)"));
+    ASSERT_TRUE(e);
+    EXPECT_TRUE(has_flag(e->flags(), EmitterFlags::SpatiallyVarying));
+    auto shape = make_shape(Properties("rectangle"), e);
+    Interaction ref = reference(Point3f(0.f, 0.f, 2.f), Normal3f(0.f, 0.f, -1.f));
+    PCG32 rng(14);
+    int seen[2] = {0, 0};
+    for (int i = 0; i < 1000; ++i) {
+        auto [ds, weight] = e->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        bool first = (ds.uv.x > 0.5f) == (ds.uv.y > 0.5f);
+        ++seen[first ? 0 : 1];
+        Color3f expected = first ? Color3f(1.f, 2.f, 3.f) : Color3f(5.f);
+        expect_color_near(weight * ds.pdf, expected, 1e-5f);
+    }
+    EXPECT_GT(seen[0], 400);
+    EXPECT_GT(seen[1], 400);
+    SurfaceInteraction si;
+    si.t = 1.f;
+    si.wi = Vector3f(0.f, 0.f, 1.f);
+    si.uv = Point2f(0.8f, 0.1f);
+    expect_color_near(e->eval(si), Color3f(5.f), 1e-6f);
 }
 
 TEST(EmitterArea, BackSideGivesNothing) {
