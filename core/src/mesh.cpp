@@ -46,6 +46,15 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
             m_positions[3 * i + 1] = p.y;
             m_positions[3 * i + 2] = p.z;
         }
+        // A mirroring transform reverses the winding; reverse it back so the face normals keep
+        // pointing where the (inverse-transpose transformed) normals of the object point.
+        const auto &m = to_world.matrix.m;
+        double det = double(m[0][0]) * (double(m[1][1]) * m[2][2] - double(m[1][2]) * m[2][1]) -
+                     double(m[0][1]) * (double(m[1][0]) * m[2][2] - double(m[1][2]) * m[2][0]) +
+                     double(m[0][2]) * (double(m[1][0]) * m[2][1] - double(m[1][1]) * m[2][0]);
+        if (det < 0.0)
+            for (size_t f = 0; f < m_faces.size(); f += 3)
+                std::swap(m_faces[f + 1], m_faces[f + 2]);
     }
     if (face_normals) {
         m_normals.clear();

@@ -483,19 +483,37 @@ TEST(ShapeGeometry, SphereRejectsNonUniformScale) {
     EXPECT_NEAR(make_shape("sphere", rotated)->surface_area(), 16.f * Pi, 1e-3f);
 }
 
-TEST(ShapeGeometry, CubeNormalsPointOutwards) {
-    auto cube = std::dynamic_pointer_cast<Mesh>(make_shape("cube"));
-    const auto &f = cube->faces();
-    for (size_t t = 0; t < cube->face_count(); ++t) {
-        Point3f p0 = cube->vertex_position(f[3 * t]), p1 = cube->vertex_position(f[3 * t + 1]),
-                p2 = cube->vertex_position(f[3 * t + 2]);
-        Vector3f n = normalize(cross(p1 - p0, p2 - p0));
-        Point3f c = (p0 + p1 + p2) / 3.f;
-        EXPECT_GT(dot(n, c), 0.5f) << "triangle " << t;
-        Vector3f vn(cube->normals()[3 * f[3 * t]], cube->normals()[3 * f[3 * t] + 1],
-                    cube->normals()[3 * f[3 * t] + 2]);
-        expect_near_vec(vn, n, 1e-6f);
+TEST(ShapeGeometry, CubeNormalsPointOutwardsAlsoWhenMirrored) {
+    for (const Transform &tr : {Transform(), scale(-1, 2, 1)}) {
+        Properties props;
+        props.set_transform("to_world", tr);
+        auto cube = std::dynamic_pointer_cast<Mesh>(make_shape("cube", props));
+        SingleShape scene(cube);
+        const auto &f = cube->faces();
+        for (size_t t = 0; t < cube->face_count(); ++t) {
+            Point3f p0 = cube->vertex_position(f[3 * t]), p1 = cube->vertex_position(f[3 * t + 1]),
+                    p2 = cube->vertex_position(f[3 * t + 2]);
+            Vector3f n = normalize(cross(p1 - p0, p2 - p0));
+            Point3f c = (p0 + p1 + p2) / 3.f;
+            EXPECT_GT(dot(n, normalize(c)), 0.3f) << "triangle " << t;
+            Vector3f vn(cube->normals()[3 * f[3 * t]], cube->normals()[3 * f[3 * t] + 1],
+                        cube->normals()[3 * f[3 * t] + 2]);
+            expect_near_vec(vn, n, 1e-6f);
+            // Hit from outside: geometric and shading normal face the ray origin.
+            Point3f o = c + n * 3.f;
+            SurfaceInteraction si;
+            ASSERT_TRUE(scene.intersect(Ray(o, -n), si));
+            EXPECT_NEAR(dot(si.n, n), 1.f, 1e-5f);
+            EXPECT_NEAR(si.wi.z, 1.f, 1e-5f);
+        }
     }
+    // A mirrored rectangle keeps its normal along the transformed +z, as a disk does.
+    Properties props;
+    props.set_transform("to_world", scale(-1, 1, 1));
+    PositionSample ps = make_shape("rectangle", props)->sample_position(Point2f(0.5f, 0.5f));
+    expect_near_vec(ps.n, Vector3f(0, 0, 1), 1e-6f);
+    ps = make_shape("disk", props)->sample_position(Point2f(0.5f, 0.5f));
+    expect_near_vec(ps.n, Vector3f(0, 0, 1), 1e-6f);
 }
 
 // ---------------------------------------------------------------------------------------------
