@@ -35,6 +35,8 @@ most also as <name>_palik, plus Na_palik, Ni_palik and V_palik.
 
 namespace facet {
 
+static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
+
 class Conductor final : public BSDF {
 public:
     explicit Conductor(const Properties &props) {
@@ -43,7 +45,10 @@ public:
         m_eta = ior.eta;
         m_k = ior.k;
         m_specular_reflectance = props.texture("specular_reflectance", 1.f);
-        set_components({BSDFFlags::DeltaReflection | BSDFFlags::FrontSide});
+        BSDFFlags flags = BSDFFlags::DeltaReflection | BSDFFlags::FrontSide;
+        if (varies(m_eta) || varies(m_k) || varies(m_specular_reflectance))
+            flags |= BSDFFlags::SpatiallyVarying;
+        set_components({flags});
     }
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,

@@ -35,6 +35,8 @@ radiance through the change of solid angle); importance transport is not scaled.
 
 namespace facet {
 
+static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
+
 class Dielectric final : public BSDF {
 public:
     explicit Dielectric(const Properties &props) {
@@ -47,6 +49,8 @@ public:
             m_specular_transmittance = props.texture("specular_transmittance", 1.f);
 
         BSDFFlags sides = BSDFFlags::FrontSide | BSDFFlags::BackSide;
+        if (varies(m_specular_reflectance) || varies(m_specular_transmittance))
+            sides |= BSDFFlags::SpatiallyVarying;
         set_components({BSDFFlags::DeltaReflection | sides,
                         BSDFFlags::DeltaTransmission | sides | BSDFFlags::NonSymmetric});
     }

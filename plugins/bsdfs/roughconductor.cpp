@@ -42,6 +42,8 @@ reflects (wrap the BSDF in `twosided` for two-sided surfaces).
 
 namespace facet {
 
+static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
+
 class RoughConductor final : public BSDF {
 public:
     explicit RoughConductor(const Properties &props) {
@@ -54,6 +56,9 @@ public:
 
         BSDFFlags flags = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide;
         if (m_microfacet.is_anisotropic()) flags |= BSDFFlags::Anisotropic;
+        if (m_microfacet.is_spatially_varying() || varies(m_eta) || varies(m_k) ||
+            varies(m_specular_reflectance))
+            flags |= BSDFFlags::SpatiallyVarying;
         set_components({flags});
     }
 

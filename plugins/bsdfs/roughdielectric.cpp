@@ -43,6 +43,8 @@ scaled. Without visible-normal sampling, normals are drawn from a distribution w
 
 namespace facet {
 
+static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
+
 class RoughDielectric final : public BSDF {
 public:
     explicit RoughDielectric(const Properties &props) {
@@ -58,6 +60,9 @@ public:
 
         BSDFFlags common = BSDFFlags::FrontSide | BSDFFlags::BackSide;
         if (m_microfacet.is_anisotropic()) common |= BSDFFlags::Anisotropic;
+        if (m_microfacet.is_spatially_varying() || varies(m_specular_reflectance) ||
+            varies(m_specular_transmittance))
+            common |= BSDFFlags::SpatiallyVarying;
         set_components({BSDFFlags::GlossyReflection | common,
                         BSDFFlags::GlossyTransmission | common | BSDFFlags::NonSymmetric});
     }

@@ -31,6 +31,8 @@ and transmits the rest. Both sides of the surface behave alike.
 
 namespace facet {
 
+static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
+
 class ThinDielectric final : public BSDF {
 public:
     explicit ThinDielectric(const Properties &props) {
@@ -43,6 +45,8 @@ public:
             m_specular_transmittance = props.texture("specular_transmittance", 1.f);
 
         BSDFFlags sides = BSDFFlags::FrontSide | BSDFFlags::BackSide;
+        if (varies(m_specular_reflectance) || varies(m_specular_transmittance))
+            sides |= BSDFFlags::SpatiallyVarying;
         set_components({BSDFFlags::DeltaReflection | sides, BSDFFlags::Null | sides});
     }
 

@@ -145,6 +145,8 @@ TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
     auto textured = PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
     EXPECT_TRUE(has_flag(textured->flags(), BSDFFlags::GlossyReflection));
     EXPECT_FALSE(has_flag(textured->flags(), BSDFFlags::Anisotropic));
+    EXPECT_TRUE(has_flag(textured->flags(), BSDFFlags::SpatiallyVarying));
+    EXPECT_FALSE(has_flag(make_bsdf("roughconductor")->flags(), BSDFFlags::SpatiallyVarying));
     for (float u : {0.f, 0.5f, 1.f}) {
         auto plain = make_bsdf("roughconductor", {{"alpha", double(0.05f + 0.5f * u)}});
         SurfaceInteraction si = make_si(normalize(Vector3f(0.3f, -0.2f, 0.8f)));
