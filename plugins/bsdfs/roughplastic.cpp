@@ -55,6 +55,9 @@ Components: 0 = the glossy reflection of the coating (GlossyReflection), 1 = the
 
 #include <array>
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <tuple>
 #include <vector>
 
 namespace facet {
@@ -91,20 +94,40 @@ void gauss_legendre(int n, std::vector<double> &nodes, std::vector<double> &weig
 
 /**
  * Energy that a rough dielectric interface (relative IOR `eta`) reflects (`reflect` = true) or
- * transmits for light arriving from wi: the integral over the normals visible from wi of
- * F·G1(wo, m) or (1 − F)·G1(wo, m), i.e. the mean sample weight of the rough dielectric's lobe,
- * by an n × n Gauss–Legendre rule on the square of the visible-normal sampler.
+ * transmits for light arriving from wi = (sin θ, 0, cos θ): the integral over the normals visible
+ * from wi of F·G1(wo, m) or (1 − F)·G1(wo, m), i.e. the mean sample weight of the rough
+ * dielectric's lobe. An n × n Gauss–Legendre rule on the unit square of the visible-normal
+ * sampler (Heitz & d'Eon 2014) does the integral; the normal of each node is the one
+ * MicrofacetDistribution::sample() returns for wi (whose azimuth is 0), without its density.
  */
 double rough_interface_energy(const MicrofacetDistribution &distr, const Vector3f &wi, float eta,
                               bool reflect, const std::vector<double> &nodes,
                               const std::vector<double> &weights) {
+    const size_t n = nodes.size();
+    const float alpha = distr.alpha();
+    // Slopes of the α = 1 configuration seen from the stretched wi.
+    float cos_s = normalize(Vector3f(alpha * wi.x, alpha * wi.y, wi.z)).z;
+    auto node = [&](size_t i) { return float(0.5 * nodes[i] + 0.5); };
+    // Beckmann's visible slopes are separable (x̃ from the first number, ỹ a Gaussian of the
+    // second), so each axis is solved once per node instead of once per node pair.
+    std::vector<float> slope_x, slope_y;
+    bool separable = distr.type() == MicrofacetType::Beckmann;
+    if (separable) {
+        slope_x.resize(n);
+        slope_y.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+            slope_x[i] = distr.sample_visible_11(cos_s, Point2f(node(i), 0.5f)).x;
+            slope_y[i] = distr.sample_visible_11(cos_s, Point2f(0.5f, node(i))).y;
+        }
+    }
+
     double sum = 0.0;
-    size_t n = nodes.size();
     for (size_t a = 0; a < n; ++a) {
         for (size_t b = 0; b < n; ++b) {
-            Point2f u(float(0.5 * nodes[a] + 0.5), float(0.5 * nodes[b] + 0.5));
-            auto [m, pdf] = distr.sample(wi, u);
-            if (!(pdf > 0.f)) continue;
+            Point2f slope = separable ? Point2f(slope_x[a], slope_y[b])
+                                      : distr.sample_visible_11(cos_s, Point2f(node(a), node(b)));
+            Vector3f m = normalize(Vector3f(-alpha * slope.x, -alpha * slope.y, 1.f));
+            if (!is_finite(m)) continue;
             auto [F, cos_t, eta_it, eta_ti] = fresnel_dielectric(dot(wi, m), eta);
             float f;
             if (reflect) {
@@ -120,6 +143,46 @@ double rough_interface_energy(const MicrofacetDistribution &distr, const Vector3
         }
     }
     return sum;
+}
+
+/// The precomputed tables of one (distribution, α, η).
+struct CoatingTables {
+    std::array<float, TransmittanceRes> external_transmittance{};
+    float internal_reflectance = 0.f;
+};
+
+/**
+ * T(μ) for μ = 0, 1/63, ..., 1 and the internal reflectance 2·mean(R(μ, 1/η)·μ) (Gauss–Legendre
+ * with 32² nodes for a relative IOR above one, 128² for the TIR-prone one below).
+ */
+CoatingTables compute_tables(MicrofacetType type, float alpha, float eta) {
+    MicrofacetDistribution distr(type, alpha, true);
+    std::vector<double> nodes_ext, weights_ext, nodes_int, weights_int;
+    gauss_legendre(eta > 1.f ? 32 : 128, nodes_ext, weights_ext);
+    gauss_legendre(1.f / eta > 1.f ? 32 : 128, nodes_int, weights_int);
+    CoatingTables tables;
+    double internal = 0.0;
+    for (int j = 0; j < TransmittanceRes; ++j) {
+        float mu = std::max(1e-6f, float(j) / float(TransmittanceRes - 1));
+        Vector3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
+        double t = rough_interface_energy(distr, wi, eta, false, nodes_ext, weights_ext);
+        tables.external_transmittance[size_t(j)] = float(clamp(t, 0.0, 1.0));
+        internal += rough_interface_energy(distr, wi, 1.f / eta, true, nodes_int, weights_int) *
+                    double(mu);
+    }
+    tables.internal_reflectance = float(2.0 * internal / TransmittanceRes);
+    return tables;
+}
+
+/// Tables are shared by all instances with the same coating (scenes reuse materials a lot).
+const CoatingTables &coating_tables(MicrofacetType type, float alpha, float eta) {
+    static std::mutex mutex;
+    static std::map<std::tuple<int, float, float>, CoatingTables> cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto key = std::make_tuple(int(type), alpha, eta);
+    auto it = cache.find(key);
+    if (it == cache.end()) it = cache.emplace(key, compute_tables(type, alpha, eta)).first;
+    return it->second;
 }
 
 } // namespace
@@ -150,7 +213,9 @@ public:
         float s_mean = m_specular_reflectance ? m_specular_reflectance->mean().mean() : 1.f;
         m_specular_sampling_weight = d_mean + s_mean > 0.f ? s_mean / (d_mean + s_mean) : 0.5f;
 
-        precompute_tables();
+        const CoatingTables &tables = coating_tables(m_microfacet.type(), m_alpha, m_eta);
+        m_external_transmittance = tables.external_transmittance;
+        m_internal_reflectance = tables.internal_reflectance;
 
         BSDFFlags spec = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide;
         BSDFFlags diff = BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide;
@@ -259,26 +324,6 @@ public:
     }
 
 private:
-    /// T(μ) for μ = 0, 1/63, ..., 1 and the internal reflectance 2·mean(R(μ, 1/η)·μ), both by
-    /// Gauss–Legendre quadrature (32² nodes for η > 1, 128² for the TIR-prone η < 1).
-    void precompute_tables() {
-        // The integrals need the visible-normal sampler, whatever the user samples with.
-        MicrofacetDistribution distr(m_microfacet.type(), m_alpha, true);
-        std::vector<double> nodes_ext, weights_ext, nodes_int, weights_int;
-        gauss_legendre(m_eta > 1.f ? 32 : 128, nodes_ext, weights_ext);
-        gauss_legendre(1.f / m_eta > 1.f ? 32 : 128, nodes_int, weights_int);
-        double internal = 0.0;
-        for (int j = 0; j < TransmittanceRes; ++j) {
-            float mu = std::max(1e-6f, float(j) / float(TransmittanceRes - 1));
-            Vector3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
-            double t = rough_interface_energy(distr, wi, m_eta, false, nodes_ext, weights_ext);
-            m_external_transmittance[size_t(j)] = float(clamp(t, 0.0, 1.0));
-            internal += rough_interface_energy(distr, wi, 1.f / m_eta, true, nodes_int, weights_int) *
-                        double(mu);
-        }
-        m_internal_reflectance = float(2.0 * internal / TransmittanceRes);
-    }
-
     /// Probability of the glossy lobe: (1 − T_i)·w against T_i·(1 − w), or all-or-nothing when
     /// only one lobe is enabled.
     float specular_probability(float cos_i, bool has_specular, bool has_diffuse) const {

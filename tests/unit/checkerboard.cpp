@@ -1,0 +1,139 @@
+// The checkerboard texture: the 2 × 2 pattern over the unit square and its repetition, defaults,
+// to_uv, nested textures, mean/max/eval_1, errors, and use as a BSDF parameter.
+
+#include <facet/bsdf.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/texture.h>
+#include <facet/xml.h>
+
+#include <gtest/gtest.h>
+
+using namespace facet;
+
+namespace {
+
+SurfaceInteraction at_uv(float u, float v) {
+    SurfaceInteraction si;
+    si.uv = Point2f(u, v);
+    si.wi = Vector3f(0.f, 0.f, 1.f);
+    return si;
+}
+
+std::shared_ptr<Texture> make_checkerboard(Properties &props) {
+    props.set_plugin_name("checkerboard");
+    return PluginRegistry::instance().create_as<Texture>(ObjectType::Texture, props);
+}
+
+void expect_error(Properties &props, const std::string &fragment) {
+    try {
+        make_checkerboard(props);
+        ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+
+/// A texture that is u everywhere (to check that nested textures are evaluated at the point).
+class RampTexture final : public Texture {
+public:
+    Color3f eval(const SurfaceInteraction &si) const override { return Color3f(si.uv.x, 0.f, 1.f); }
+    Color3f mean() const override { return Color3f(0.5f, 0.f, 1.f); }
+    std::string to_string() const override { return "RampTexture"; }
+};
+
+} // namespace
+
+TEST(Checkerboard, DefaultPattern) {
+    Properties defaults;
+    auto tex = make_checkerboard(defaults);
+    // color0 = 0.4 where u and v are in the same half, color1 = 0.2 elsewhere.
+    EXPECT_EQ(tex->eval(at_uv(0.25f, 0.25f)), Color3f(0.4f));
+    EXPECT_EQ(tex->eval(at_uv(0.75f, 0.75f)), Color3f(0.4f));
+    EXPECT_EQ(tex->eval(at_uv(0.75f, 0.25f)), Color3f(0.2f));
+    EXPECT_EQ(tex->eval(at_uv(0.25f, 0.75f)), Color3f(0.2f));
+    // Repeats with period 1 in both directions, negative coordinates included.
+    for (float du : {-3.f, -1.f, 1.f, 2.f, 10.f})
+        for (float dv : {-2.f, 0.f, 5.f})
+            for (float u : {0.1f, 0.6f})
+                for (float v : {0.3f, 0.9f})
+                    EXPECT_EQ(tex->eval(at_uv(u + du, v + dv)), tex->eval(at_uv(u, v))) << u + du << "," << v + dv;
+    EXPECT_EQ(tex->eval(at_uv(-0.25f, 0.25f)), Color3f(0.2f));
+    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.1f, 0.1f)), 0.4f);
+    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.6f, 0.1f)), 0.2f);
+    EXPECT_NEAR(tex->mean().r, 0.3f, 1e-7f);
+    EXPECT_EQ(tex->max(), 0.4f);
+    EXPECT_TRUE(tex->is_spatially_varying());
+    EXPECT_NE(tex->to_string().find("Checkerboard"), std::string::npos);
+}
+
+TEST(Checkerboard, ColoursToUvAndNestedTextures) {
+    Properties props;
+    props.set_color("color0", Color3f(1.f, 0.f, 0.f));
+    props.set_object("color1", std::make_shared<RampTexture>());
+    props.set_transform("to_uv", Transform::scale(Vector3f(4.f, 4.f, 1.f)));
+    auto tex = make_checkerboard(props);
+    // 8 × 8 checks: uv (0.05, 0.05) -> (0.2, 0.2): color0; (0.15, 0.05) -> (0.6, 0.2): color1.
+    EXPECT_EQ(tex->eval(at_uv(0.05f, 0.05f)), Color3f(1.f, 0.f, 0.f));
+    EXPECT_EQ(tex->eval(at_uv(0.15f, 0.05f)), Color3f(0.15f, 0.f, 1.f)); // the ramp at u = 0.15
+    EXPECT_EQ(tex->eval(at_uv(0.3f, 0.3f)), Color3f(1.f, 0.f, 0.f));     // (1.2, 1.2)
+    EXPECT_EQ(tex->eval(at_uv(0.3f, 0.4f)), Color3f(0.3f, 0.f, 1.f));    // (1.2, 1.6)
+    EXPECT_EQ(tex->mean(), Color3f(0.75f, 0.f, 0.5f));
+    EXPECT_FLOAT_EQ(tex->max(), 1.f);
+
+    // Counting over a fine grid: half of the unit square is each colour.
+    Properties plain_props;
+    auto plain = make_checkerboard(plain_props);
+    int n = 200, count0 = 0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            count0 += plain->eval(at_uv((i + 0.5f) / n, (j + 0.5f) / n)) == Color3f(0.4f);
+    EXPECT_EQ(count0, n * n / 2);
+}
+
+TEST(Checkerboard, RejectsBadParameters) {
+    Properties bad_color;
+    bad_color.set_string("color0", "red");
+    expect_error(bad_color, "color0");
+    Properties bad_transform;
+    bad_transform.set_float("to_uv", 2.0);
+    expect_error(bad_transform, "to_uv");
+    Properties unknown;
+    unknown.set_float("scale", 2.0);
+    expect_error(unknown, "scale");
+
+    Properties all;
+    all.set_float("color0", 0.1);
+    make_checkerboard(all);
+    std::string doc = PluginRegistry::instance().descriptor("checkerboard", ObjectType::Texture).doc;
+    EXPECT_EQ(all.requested_names().size(), 3u);
+    for (const std::string &name : all.requested_names())
+        EXPECT_NE(doc.find("| " + name + " |"), std::string::npos) << name;
+}
+
+TEST(Checkerboard, WorksAsABSDFParameter) {
+    auto bsdf = std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="diffuse">
+        <texture type="checkerboard" name="reflectance">
+            <rgb name="color0" value="0.9, 0.9, 0.9"/>
+            <float name="color1" value="0.1"/>
+        </texture>
+    </bsdf>)"));
+    ASSERT_TRUE(bsdf);
+    EXPECT_TRUE(has_flag(bsdf->flags(), BSDFFlags::SpatiallyVarying));
+    Vector3f up(0.f, 0.f, 1.f);
+    EXPECT_NEAR(bsdf->eval(BSDFContext(), at_uv(0.2f, 0.2f), up).r, 0.9f * InvPi, 1e-6f);
+    EXPECT_NEAR(bsdf->eval(BSDFContext(), at_uv(0.7f, 0.2f), up).r, 0.1f * InvPi, 1e-6f);
+
+    // As a blend weight: weight 0 (color0) on one check, 1 (color1) on the other.
+    auto blend = std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="blendbsdf">
+        <texture type="checkerboard" name="weight">
+            <float name="color0" value="0"/>
+            <float name="color1" value="1"/>
+        </texture>
+        <bsdf type="diffuse"><float name="reflectance" value="0.2"/></bsdf>
+        <bsdf type="diffuse"><float name="reflectance" value="0.6"/></bsdf>
+    </bsdf>)"));
+    ASSERT_TRUE(blend);
+    EXPECT_NEAR(blend->eval(BSDFContext(), at_uv(0.2f, 0.2f), up).r, 0.2f * InvPi, 1e-6f);
+    EXPECT_NEAR(blend->eval(BSDFContext(), at_uv(0.2f, 0.7f), up).r, 0.6f * InvPi, 1e-6f);
+}
