@@ -23,6 +23,7 @@ public:
         PdfScaled,     ///< pdf() and the reported pdf are 5 % too large
         MissingCosine, ///< samples uniformly but claims a cosine density (weights stay eval/pdf)
         NanPdf,        ///< pdf() is NaN in a small region
+        NanWeight,     ///< sample() returns a NaN weight in a small region
         StrayBelow,    ///< one sample in 10^5 goes below the horizon, where the pdf is zero
         WrongWeight,   ///< the weight misses the reflectance
         Energy,        ///< reflects 20 % more than it receives
@@ -45,6 +46,7 @@ public:
         if (!(bs.pdf > 0.f)) return {bs, Color3f(0.f)};
         Color3f weight = eval(ctx, si, bs.wo) / bs.pdf;
         if (m_bug == Bug::WrongWeight) weight = Color3f(1.f);
+        if (m_bug == Bug::NanWeight && bs.wo.x > 0.95f) weight.g = std::numeric_limits<float>::quiet_NaN();
         return {bs, weight};
     }
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
@@ -208,6 +210,14 @@ TEST(Chi2BSDF, NaNPdfIsAnOutrightFailure) {
     Chi2Result r = run_lambert(TestLambert::Bug::NanPdf);
     EXPECT_FALSE(r.passed);
     EXPECT_TRUE(mentions(r, "non-finite")) << r.summary();
+}
+
+TEST(Chi2BSDF, NaNWeightIsAnOutrightFailure) {
+    Chi2Result r = run_lambert(TestLambert::Bug::NanWeight);
+    EXPECT_FALSE(r.passed);
+    EXPECT_TRUE(mentions(r, "non-finite weight")) << r.summary();
+    // The histogram and the pdf are right: only the weights give it away.
+    EXPECT_GT(r.p_value, 1e-3) << r.summary();
 }
 
 TEST(Chi2BSDF, SampleInZeroExpectationCellIsAnOutrightFailure) {
