@@ -38,7 +38,7 @@ SpectrumData grid_spectrum(const float *values) {
 }
 
 std::string lowercase(std::string s) {
-    for (char &c : s) c = char(std::tolower((unsigned char) c));
+    for (char &c : s) c = char(std::tolower((unsigned char)c));
     return s;
 }
 
@@ -78,7 +78,8 @@ ConductorIOR read_conductor_ior(const Properties &props) {
     if (result.material != "none" && (has_eta || has_k))
         FACET_THROW_AT(props.location(),
                        "give either material=\"{}\" or eta/k, not both (material = \"none\" "
-                       "uses eta and k)", result.material);
+                       "uses eta and k)",
+                       result.material);
     if (result.material == "none") {
         result.eta = props.texture("eta", 0.f, SpectrumKind::Unbounded);
         result.k = props.texture("k", 1.f, SpectrumKind::Unbounded);

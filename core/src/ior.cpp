@@ -10,6 +10,7 @@
 namespace facet {
 
 const std::vector<std::pair<std::string, float>> &ior_table() {
+    // clang-format off
     static const std::vector<std::pair<std::string, float>> table = {
         {"vacuum", 1.0f},
         {"helium", 1.000036f},
@@ -35,12 +36,13 @@ const std::vector<std::pair<std::string, float>> &ior_table() {
         {"pet", 1.5750f},
         {"diamond", 2.419f},
     };
+    // clang-format on
     return table;
 }
 
 float lookup_ior(const std::string &name) {
     std::string lower = name;
-    for (char &c : lower) c = char(std::tolower((unsigned char) c));
+    for (char &c : lower) c = char(std::tolower((unsigned char)c));
     std::vector<std::string> names;
     for (const auto &[n, value] : ior_table()) {
         if (n == lower) return value;

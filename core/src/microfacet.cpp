@@ -17,7 +17,8 @@ MicrofacetDistribution::MicrofacetDistribution(const Properties &props, float de
                                    params.alpha_v()->mean().mean(), params.sample_visible());
 }
 
-std::pair<Vector3f, float> MicrofacetDistribution::sample(const Vector3f &wi, const Point2f &u) const {
+std::pair<Vector3f, float> MicrofacetDistribution::sample(const Vector3f &wi,
+                                                          const Point2f &u) const {
     return m_sample_visible ? sample_visible_normals(wi, u) : sample_all(u);
 }
 
@@ -37,9 +38,8 @@ std::pair<Vector3f, float> MicrofacetDistribution::sample_all(const Point2f &u) 
     float cos_phi = std::cos(phi), sin_phi = std::sin(phi);
 
     // Elevation: inverse of the radial CDF of D·cos θ for the effective α of this azimuth.
-    float tan_theta_2 = m_type == MicrofacetType::Beckmann
-                            ? -alpha_2 * std::log1p(-u.x)
-                            : alpha_2 * u.x / (1.f - u.x);
+    float tan_theta_2 = m_type == MicrofacetType::Beckmann ? -alpha_2 * std::log1p(-u.x)
+                                                           : alpha_2 * u.x / (1.f - u.x);
     float cos_theta = 1.f / std::sqrt(1.f + tan_theta_2);
     float sin_theta = safe_sqrt(1.f - cos_theta * cos_theta);
 
@@ -128,8 +128,8 @@ MicrofacetParameters::MicrofacetParameters(MicrofacetType type, std::shared_ptr<
 
 std::string MicrofacetParameters::to_string() const {
     return fmt::format("distribution = {}, alpha_u = {}, alpha_v = {}, sample_visible = {}",
-                       microfacet_type_name(m_type), m_alpha_u->to_string(),
-                       m_alpha_v->to_string(), m_sample_visible);
+                       microfacet_type_name(m_type), m_alpha_u->to_string(), m_alpha_v->to_string(),
+                       m_sample_visible);
 }
 
 MicrofacetParameters read_microfacet(const Properties &props, float default_alpha,
@@ -141,14 +141,16 @@ MicrofacetParameters read_microfacet(const Properties &props, float default_alph
     else if (name == "ggx")
         type = MicrofacetType::GGX;
     else
-        FACET_THROW_AT(props.has("distribution") ? props.location("distribution") : props.location(),
+        FACET_THROW_AT(props.has("distribution") ? props.location("distribution")
+                                                 : props.location(),
                        "distribution must be beckmann or ggx, found \"{}\"", name);
 
     bool has_alpha = props.has("alpha"), has_u = props.has("alpha_u"), has_v = props.has("alpha_v");
     if (has_alpha && (has_u || has_v))
         FACET_THROW_AT(props.location(), "give either alpha or both alpha_u and alpha_v, not both");
     if (has_u != has_v)
-        FACET_THROW_AT(props.location(), "alpha_u and alpha_v must be given together (found only {})",
+        FACET_THROW_AT(props.location(),
+                       "alpha_u and alpha_v must be given together (found only {})",
                        has_u ? "alpha_u" : "alpha_v");
 
     auto read = [&](const char *param) {
@@ -161,9 +163,11 @@ MicrofacetParameters read_microfacet(const Properties &props, float default_alph
             if (!(value >= 0.f) || !std::isfinite(value))
                 FACET_THROW_AT(loc, "{} must be a roughness >= 0, found {}", param, value);
             if (value == 0.f)
-                FACET_LOG(Warn, "{}{} = 0 is clamped to {}; a smooth plugin (conductor, dielectric) "
-                          "renders this case exactly", loc.valid() ? loc.to_string() + ": " : "",
-                          param, MicrofacetDistribution::MinAlpha);
+                FACET_LOG(Warn,
+                          "{}{} = 0 is clamped to {}; a smooth plugin (conductor, dielectric) "
+                          "renders this case exactly",
+                          loc.valid() ? loc.to_string() + ": " : "", param,
+                          MicrofacetDistribution::MinAlpha);
         }
         return tex;
     };

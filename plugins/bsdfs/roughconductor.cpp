@@ -63,10 +63,12 @@ public:
     }
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                          float /*sample1*/, const Point2f &sample2) const override {
+                                          float /*sample1*/,
+                                          const Point2f &sample2) const override {
         BSDFSample bs;
         float cos_i = Frame::cos_theta(si.wi);
-        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f) return {bs, Color3f(0.f)};
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f)
+            return {bs, Color3f(0.f)};
 
         MicrofacetDistribution distr = m_microfacet.at(si);
         auto [m, pdf_m] = distr.sample(si.wi, sample2);

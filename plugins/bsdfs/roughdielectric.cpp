@@ -145,9 +145,8 @@ private:
         return distr;
     }
 
-    template <bool Eval, bool Pdf>
-    std::pair<Color3f, float> eval_pdf_impl(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                            const Vector3f &wo) const {
+    template <bool Eval, bool Pdf> std::pair<Color3f, float>
+    eval_pdf_impl(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const {
         float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
         if (cos_i == 0.f || cos_o == 0.f) return {Color3f(0.f), 0.f};
         bool reflect_lobe = cos_i * cos_o > 0.f;
@@ -181,8 +180,7 @@ private:
                     // Walter eq. 21 times |cos θo|, with the η² radiance compression.
                     float scale = ctx.mode == TransportMode::Radiance ? sqr(1.f / eta) : 1.f;
                     value = Color3f(std::abs(scale * (1.f - F) * D * G * eta * eta * wi_dot_m *
-                                             wo_dot_m /
-                                             (cos_i * sqr(wi_dot_m + eta * wo_dot_m))));
+                                             wo_dot_m / (cos_i * sqr(wi_dot_m + eta * wo_dot_m))));
                     if (m_specular_transmittance) value *= m_specular_transmittance->eval(si);
                 }
             }
@@ -190,9 +188,8 @@ private:
 
         float pdf = 0.f;
         if (Pdf) {
-            float dm_dwo = reflect_lobe
-                               ? 1.f / (4.f * wo_dot_m)
-                               : eta * eta * wo_dot_m / sqr(wi_dot_m + eta * wo_dot_m);
+            float dm_dwo = reflect_lobe ? 1.f / (4.f * wo_dot_m)
+                                        : eta * eta * wo_dot_m / sqr(wi_dot_m + eta * wo_dot_m);
             MicrofacetDistribution sample_distr = sampling_distribution(distr, cos_i);
             pdf = sample_distr.pdf(si.wi * sign(cos_i), m);
             if (has_reflection && has_transmission) pdf *= reflect_lobe ? F : 1.f - F;
@@ -209,4 +206,5 @@ private:
 } // namespace facet
 
 FACET_EXPORT_PLUGIN(facet::RoughDielectric, BSDF, "roughdielectric",
-                    "Rough dielectric interface with a Beckmann or GGX microfacet distribution", DOC)
+                    "Rough dielectric interface with a Beckmann or GGX microfacet distribution",
+                    DOC)

@@ -51,7 +51,8 @@ public:
     }
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                          float sample1, const Point2f & /*sample2*/) const override {
+                                          float sample1,
+                                          const Point2f & /*sample2*/) const override {
         bool has_reflection = ctx.is_enabled(BSDFFlags::DeltaReflection, 0);
         bool has_transmission = ctx.is_enabled(BSDFFlags::Null, 1);
         BSDFSample bs;
@@ -107,7 +108,8 @@ public:
     std::string to_string() const override {
         return fmt::format("ThinDielectric[eta = {}, specular_reflectance = {}, "
                            "specular_transmittance = {}]",
-                           m_eta, m_specular_reflectance ? m_specular_reflectance->to_string() : "1",
+                           m_eta,
+                           m_specular_reflectance ? m_specular_reflectance->to_string() : "1",
                            m_specular_transmittance ? m_specular_transmittance->to_string() : "1");
     }
 

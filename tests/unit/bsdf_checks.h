@@ -36,7 +36,8 @@ inline std::shared_ptr<BSDF> make_bsdf(const std::string &plugin, const Params &
 }
 
 /// Expects creating the BSDF to throw a facet::Error whose message contains `fragment`.
-inline void expect_error(const std::string &plugin, const Params &params, const std::string &fragment) {
+inline void expect_error(const std::string &plugin, const Params &params,
+                         const std::string &fragment) {
     try {
         make_bsdf(plugin, params);
         ADD_FAILURE() << plugin << ": expected an error containing \"" << fragment << "\"";
@@ -136,7 +137,8 @@ inline Color3f furnace(const BSDF &bsdf, const BSDFContext &ctx, const Vector3f 
 
 /// Runs the project's chi-square test; on failure prints the summary and writes the observed and
 /// expected tables and a heat map next to the test binary.
-inline void expect_chi2(const Chi2Adapter &adapter, const std::string &name, Chi2Options opts = {}) {
+inline void expect_chi2(const Chi2Adapter &adapter, const std::string &name,
+                        Chi2Options opts = {}) {
     Chi2Result result = run_chi2(adapter, opts);
     EXPECT_TRUE(result.passed) << name << "\n" << result.summary();
     if (!result.passed) {

@@ -22,7 +22,10 @@ void expect_color_near(const Color3f &a, const Color3f &b, float rel, const std:
 TEST(ConductorData, RGBValuesOfMeasuredMetals) {
     // RGB η, k of the luxpop data as published for RGB renderers (CIE 1931 integration without
     // illuminant); ours resample to the 5 nm CIE grid first, hence 1 %.
-    struct Ref { const char *name; Color3f eta, k; };
+    struct Ref {
+        const char *name;
+        Color3f eta, k;
+    };
     const Ref refs[] = {
         {"Cu", {0.200438f, 0.924033f, 1.10221f}, {3.91295f, 2.45285f, 2.14219f}},
         {"Au", {0.143119f, 0.374957f, 1.44248f}, {3.98316f, 2.38572f, 1.60322f}},
@@ -99,8 +102,8 @@ TEST(Conductor, MeasuredMaterialWeightIsItsFresnelReflectance) {
     for (float cos_i : {1.f, 0.7f, 0.3f, 0.05f}) {
         SurfaceInteraction si = make_si(Vector3f(std::sqrt(1.f - cos_i * cos_i), 0.f, cos_i));
         auto [bs, weight] = bsdf->sample(BSDFContext(), si, 0.5f, Point2f(0.5f));
-        expect_color_near(weight, fresnel_conductor(cos_i, eta, k) * Color3f(1.f, 0.5f, 0.25f), 1e-5f,
-                          "gold");
+        expect_color_near(weight, fresnel_conductor(cos_i, eta, k) * Color3f(1.f, 0.5f, 0.25f),
+                          1e-5f, "gold");
     }
     // Gold: red reflects far better than blue at normal incidence.
     Color3f F = fresnel_conductor(1.f, eta, k);
@@ -114,10 +117,12 @@ TEST(Conductor, EtaAndKAsNumbersRGBAndSpectra) {
     EXPECT_NEAR(numbers->sample(BSDFContext(), si, 0.5f, Point2f(0.5f)).second.g,
                 fresnel_dielectric(si.wi.z, 1.5f).F, 2e-5f);
 
-    auto rgb = make_bsdf("conductor", {{"eta", Color3f(0.2f, 0.9f, 1.1f)}, {"k", Color3f(3.9f, 2.4f, 2.1f)}});
-    expect_color_near(rgb->sample(BSDFContext(), si, 0.5f, Point2f(0.5f)).second,
-                      fresnel_conductor(si.wi.z, Color3f(0.2f, 0.9f, 1.1f), Color3f(3.9f, 2.4f, 2.1f)),
-                      1e-6f, "rgb");
+    auto rgb = make_bsdf("conductor",
+                         {{"eta", Color3f(0.2f, 0.9f, 1.1f)}, {"k", Color3f(3.9f, 2.4f, 2.1f)}});
+    expect_color_near(
+        rgb->sample(BSDFContext(), si, 0.5f, Point2f(0.5f)).second,
+        fresnel_conductor(si.wi.z, Color3f(0.2f, 0.9f, 1.1f), Color3f(3.9f, 2.4f, 2.1f)), 1e-6f,
+        "rgb");
 
     // Spectra are unbounded quantities: no D65 weighting, no clamping to 1.
     SpectrumData eta_s = parse_spectrum_pairs("400:1.5, 500:1.0, 600:0.4, 700:0.2");
@@ -134,7 +139,8 @@ TEST(Conductor, RejectsBadParameters) {
     expect_error("conductor", {{"material", std::string("Cu")}, {"eta", 1.0}},
                  "give either material=\"Cu\" or eta/k, not both");
     expect_error("conductor", {{"material", std::string("Au")}, {"k", 3.0}}, "not both");
-    expect_error("conductor", {{"material", std::string("Gold")}}, "unknown conductor material \"Gold\"");
+    expect_error("conductor", {{"material", std::string("Gold")}},
+                 "unknown conductor material \"Gold\"");
     expect_error("conductor", {{"material", std::string("Agg")}}, "did you mean \"Ag\"");
     expect_error("conductor", {{"eta", std::string("high")}}, "eta");
     expect_error("conductor", {{"alpha", 0.1}}, "alpha");

@@ -27,7 +27,8 @@ TEST(Dielectric, CreationAndFlags) {
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DeltaTransmission | sides | BSDFFlags::NonSymmetric);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1));
     EXPECT_NE(bsdf->to_string().find("Dielectric"), std::string::npos);
-    expect_documented("dielectric", {{"specular_reflectance", 0.5}, {"specular_transmittance", 0.5}});
+    expect_documented("dielectric",
+                      {{"specular_reflectance", 0.5}, {"specular_transmittance", 0.5}});
 }
 
 TEST(Dielectric, DefaultsAreBK7InAir) {
@@ -193,7 +194,8 @@ TEST(Dielectric, WhiteFurnaceConservesEnergy) {
         }
     }
     // Tints scale each lobe: F·r + (1 − F)·t in expectation (exact: each weight is r or t).
-    auto tinted = make_bsdf("dielectric", {{"specular_reflectance", 0.5}, {"specular_transmittance", 0.25}});
+    auto tinted =
+        make_bsdf("dielectric", {{"specular_reflectance", 0.5}, {"specular_transmittance", 0.25}});
     Vector3f wi = normalize(Vector3f(0.5f, 0.f, 0.5f));
     float F = fresnel_dielectric(wi.z, 1.5046f / 1.000277f).F;
     Color3f albedo = furnace(*tinted, BSDFContext(TransportMode::Importance), wi, 200000);

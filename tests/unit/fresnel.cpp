@@ -64,9 +64,11 @@ TEST(Fresnel, MatchesTheLectureFormulas) {
         for (int i = 0; i <= 50; ++i) {
             double cos_i = i / 50.0;
             // From outside: η1 = 1, η2 = η. From inside: η1 = η, η2 = 1.
-            EXPECT_NEAR(fresnel_dielectric(float(cos_i), eta).F, lecture_fresnel(cos_i, 1.0, eta), 2e-5)
+            EXPECT_NEAR(fresnel_dielectric(float(cos_i), eta).F, lecture_fresnel(cos_i, 1.0, eta),
+                        2e-5)
                 << "eta " << eta << " cos " << cos_i;
-            EXPECT_NEAR(fresnel_dielectric(-float(cos_i), eta).F, lecture_fresnel(cos_i, eta, 1.0), 2e-5)
+            EXPECT_NEAR(fresnel_dielectric(-float(cos_i), eta).F, lecture_fresnel(cos_i, eta, 1.0),
+                        2e-5)
                 << "eta " << eta << " cos " << -cos_i;
         }
     }
@@ -138,7 +140,8 @@ TEST(Fresnel, ConductorClosedForms) {
     float expected = (sqr(eta - 1.f) + k * k) / (sqr(eta + 1.f) + k * k);
     EXPECT_NEAR(fresnel_conductor(1.f, eta, k), expected, 1e-5f);
     // η = 0, k = 1 is a perfect mirror at every angle; grazing reflects everything.
-    for (float c : {1.f, 0.7f, 0.2f, 1e-3f}) EXPECT_NEAR(fresnel_conductor(c, 0.f, 1.f), 1.f, 1e-5f);
+    for (float c : {1.f, 0.7f, 0.2f, 1e-3f})
+        EXPECT_NEAR(fresnel_conductor(c, 0.f, 1.f), 1.f, 1e-5f);
     EXPECT_NEAR(fresnel_conductor(1e-5f, 1.3f, 2.f), 1.f, 1e-3f);
     Color3f F = fresnel_conductor(0.5f, Color3f(0.2f, 1.f, 1.5f), Color3f(3.f, 2.f, 0.f));
     EXPECT_EQ(F.g, fresnel_conductor(0.5f, 1.f, 2.f));
@@ -148,8 +151,10 @@ TEST(Fresnel, ConductorClosedForms) {
 TEST(Fresnel, ReflectAndRefractAboutAMicronormal) {
     PCG32 rng(11);
     for (int i = 0; i < 1000; ++i) {
-        Vector3f wi = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
-        Vector3f m = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f wi =
+            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f m =
+            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
         if (dot(wi, m) <= 1e-3f) continue;
         Vector3f r = reflect(wi, m);
         EXPECT_NEAR(norm(r), 1.f, 1e-5f);

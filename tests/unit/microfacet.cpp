@@ -41,7 +41,7 @@ struct Config {
 };
 
 const Config CONFIGS[] = {
-    {MicrofacetType::Beckmann, 0.1f, 0.1f}, {MicrofacetType::Beckmann, 0.5f, 0.5f},
+    {MicrofacetType::Beckmann, 0.1f, 0.1f},  {MicrofacetType::Beckmann, 0.5f, 0.5f},
     {MicrofacetType::Beckmann, 0.3f, 0.08f}, {MicrofacetType::GGX, 0.1f, 0.1f},
     {MicrofacetType::GGX, 0.5f, 0.5f},       {MicrofacetType::GGX, 0.05f, 0.4f},
 };
@@ -56,7 +56,8 @@ double beckmann_g1_exact(double a) {
     return 2.0 / (1.0 + std::erf(a) + std::exp(-a * a) / (a * std::sqrt(M_PI)));
 }
 
-Properties microfacet_props(std::initializer_list<std::pair<std::string, Properties::Value>> entries) {
+Properties
+microfacet_props(std::initializer_list<std::pair<std::string, Properties::Value>> entries) {
     Properties props("roughconductor");
     for (const auto &[name, value] : entries) props.set(name, value);
     return props;
@@ -77,9 +78,8 @@ TEST(Microfacet, DistributionIntegratesToOneInProjectedArea) {
     // ∫ D(m) cos θm dω = 1: the microfacets' projected area is the macro surface's.
     for (const Config &c : CONFIGS) {
         MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v);
-        double integral = integrate_hemisphere([&](const Vector3f &m) {
-            return double(distr.eval(m)) * m.z;
-        });
+        double integral =
+            integrate_hemisphere([&](const Vector3f &m) { return double(distr.eval(m)) * m.z; });
         EXPECT_NEAR(integral, 1.0, 2e-3) << name_of(c);
     }
 }
@@ -99,7 +99,8 @@ TEST(Microfacet, LectureBeckmannFormula) {
     MicrofacetDistribution distr(MicrofacetType::Beckmann, 0.3f);
     for (int i = 0; i < 20; ++i) {
         float theta = 0.07f * i, phi = 0.4f * i;
-        Vector3f h(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+        Vector3f h(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                   std::cos(theta));
         double t = std::tan(theta), c = std::cos(theta), m2 = 0.09;
         double expected = std::exp(-t * t / m2) / (M_PI * m2 * c * c * c * c);
         EXPECT_NEAR(distr.eval(h), expected, 1e-4 * expected + 1e-6) << "theta " << theta;
@@ -116,7 +117,8 @@ TEST(Microfacet, SmithG1MatchesTheLecture) {
         Vector3f v(float(std::sin(theta)), 0.f, float(std::cos(theta)));
         double a = 1.0 / (alpha * std::tan(theta));
         // The lecture's rational approximation (Walter), exactly.
-        double rational = a < 1.6 ? (3.535 * a + 2.181 * a * a) / (1 + 2.276 * a + 2.577 * a * a) : 1.0;
+        double rational =
+            a < 1.6 ? (3.535 * a + 2.181 * a * a) / (1 + 2.276 * a + 2.577 * a * a) : 1.0;
         EXPECT_NEAR(beckmann.smith_g1(v, m), rational, 2e-5) << "theta " << i;
         // Which is within 0.35 % of the exact Smith function, used to normalise visible normals.
         EXPECT_NEAR(beckmann.smith_g1(v, m), beckmann_g1_exact(a), 0.0035 * beckmann_g1_exact(a))
@@ -141,7 +143,8 @@ TEST(Microfacet, AnisotropicMaskingUsesTheProjectedRoughness) {
     for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::GGX}) {
         MicrofacetDistribution aniso(type, 0.1f, 0.6f);
         for (int i = 0; i < 100; ++i) {
-            Vector3f v = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+            Vector3f v =
+                warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
             float alpha = aniso.project_roughness(v);
             float phi = std::atan2(v.y, v.x);
             EXPECT_NEAR(sqr(alpha), sqr(std::cos(phi) * 0.1f) + sqr(std::sin(phi) * 0.6f), 1e-5f);
@@ -158,9 +161,8 @@ TEST(Microfacet, VisibleNormalDensityIntegratesToOne) {
         MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, true);
         for (float theta_deg : {0.f, 30.f, 60.f, 85.f}) {
             Vector3f wi = direction_from_angles(theta_deg, 40.f);
-            double integral = integrate_hemisphere([&](const Vector3f &m) {
-                return double(distr.pdf(wi, m));
-            });
+            double integral =
+                integrate_hemisphere([&](const Vector3f &m) { return double(distr.pdf(wi, m)); });
             EXPECT_NEAR(integral, 1.0, 2e-3) << name_of(c) << " theta " << theta_deg;
         }
     }
@@ -173,7 +175,8 @@ TEST(Microfacet, SampleReturnsItsPdf) {
             MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, visible);
             int ok = 0;
             for (int i = 0; i < 2000; ++i) {
-                Vector3f wi = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+                Vector3f wi =
+                    warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
                 auto [m, pdf] = distr.sample(wi, Point2f(rng.next_float(), rng.next_float()));
                 if (pdf == 0.f) continue;
                 ASSERT_TRUE(is_finite(m));
@@ -197,7 +200,8 @@ void chi2_matrix(const char *type, bool visible) {
     opts.res = 32;
     opts.test_count = 8;
     int run = 0;
-    for (auto [au, av] : {std::pair{0.125f, 0.125f}, std::pair{0.5f, 0.5f}, std::pair{0.3f, 0.08f}}) {
+    for (auto [au, av] :
+         {std::pair{0.125f, 0.125f}, std::pair{0.5f, 0.5f}, std::pair{0.3f, 0.08f}}) {
         for (float angle : {15.f, 30.f, 80.f}) {
             if (au != av && angle == 30.f) continue;
             MicrofacetAdapter adapter(type, au, av, visible, direction_from_angles(angle, 25.f));
@@ -205,8 +209,9 @@ void chi2_matrix(const char *type, bool visible) {
             Chi2Result result = run_chi2(adapter, opts);
             EXPECT_TRUE(result.passed) << result.summary();
             if (!result.passed)
-                write_chi2_heatmap(fmt::format("microfacet_{}_{}_{}_{}_{}.png", type, visible, au,
-                                               av, angle), result);
+                write_chi2_heatmap(
+                    fmt::format("microfacet_{}_{}_{}_{}_{}.png", type, visible, au, av, angle),
+                    result);
         }
     }
 }
@@ -261,7 +266,8 @@ TEST(MicrofacetParameters, ReadsMitsubaParameters) {
     EXPECT_TRUE(aniso.unqueried().empty());
 
     // Equal alpha_u and alpha_v are isotropic.
-    EXPECT_FALSE(read_microfacet(microfacet_props({{"alpha_u", 0.3}, {"alpha_v", 0.3}})).is_anisotropic());
+    EXPECT_FALSE(
+        read_microfacet(microfacet_props({{"alpha_u", 0.3}, {"alpha_v", 0.3}})).is_anisotropic());
 
     // The plain-number constructor.
     MicrofacetDistribution direct(microfacet_props({{"alpha", 0.25}}));

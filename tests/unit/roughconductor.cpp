@@ -15,7 +15,9 @@ namespace {
 /// A roughness that varies over the surface: 0.05 + 0.5·u.
 class RampTexture final : public Texture {
 public:
-    Color3f eval(const SurfaceInteraction &si) const override { return Color3f(0.05f + 0.5f * si.uv.x); }
+    Color3f eval(const SurfaceInteraction &si) const override {
+        return Color3f(0.05f + 0.5f * si.uv.x);
+    }
     Color3f mean() const override { return Color3f(0.3f); }
     std::string to_string() const override { return "RampTexture"; }
 };
@@ -32,11 +34,19 @@ std::vector<Config> configs() {
         {"BeckmannAnisoVisible", {{"alpha_u", 0.2}, {"alpha_v", 0.05}}},
         {"BeckmannAnisoAll", {{"alpha_u", 0.2}, {"alpha_v", 0.05}, {"sample_visible", false}}},
         {"GGXVisible", {{"distribution", std::string("ggx")}, {"alpha", 0.3}}},
-        {"GGXAllNormals", {{"distribution", std::string("ggx")}, {"alpha", 0.3}, {"sample_visible", false}}},
-        {"GGXAnisoVisible", {{"distribution", std::string("ggx")}, {"alpha_u", 0.05}, {"alpha_v", 0.4},
-                             {"material", std::string("Cu")}}},
-        {"GGXAnisoAll", {{"distribution", std::string("ggx")}, {"alpha_u", 0.05}, {"alpha_v", 0.4},
-                         {"sample_visible", false}, {"material", std::string("Au")}}},
+        {"GGXAllNormals",
+         {{"distribution", std::string("ggx")}, {"alpha", 0.3}, {"sample_visible", false}}},
+        {"GGXAnisoVisible",
+         {{"distribution", std::string("ggx")},
+          {"alpha_u", 0.05},
+          {"alpha_v", 0.4},
+          {"material", std::string("Cu")}}},
+        {"GGXAnisoAll",
+         {{"distribution", std::string("ggx")},
+          {"alpha_u", 0.05},
+          {"alpha_v", 0.4},
+          {"sample_visible", false},
+          {"material", std::string("Au")}}},
     };
 }
 
@@ -47,13 +57,17 @@ TEST(RoughConductor, CreationAndFlags) {
     ASSERT_EQ(bsdf->component_count(), 1u);
     EXPECT_EQ(bsdf->flags(), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide);
     auto aniso = make_bsdf("roughconductor", {{"alpha_u", 0.1}, {"alpha_v", 0.3}});
-    EXPECT_EQ(aniso->flags(), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Anisotropic);
+    EXPECT_EQ(aniso->flags(),
+              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Anisotropic);
     auto equal = make_bsdf("roughconductor", {{"alpha_u", 0.2}, {"alpha_v", 0.2}});
     EXPECT_FALSE(has_flag(equal->flags(), BSDFFlags::Anisotropic));
     EXPECT_NE(bsdf->to_string().find("RoughConductor"), std::string::npos);
     EXPECT_NE(bsdf->to_string().find("beckmann"), std::string::npos);
     expect_documented("roughconductor", {{"alpha", 0.1}});
-    expect_documented("roughconductor", {{"alpha_u", 0.1}, {"alpha_v", 0.2}, {"eta", 0.2}, {"k", 3.0},
+    expect_documented("roughconductor", {{"alpha_u", 0.1},
+                                         {"alpha_v", 0.2},
+                                         {"eta", 0.2},
+                                         {"k", 3.0},
                                          {"specular_reflectance", 0.5}});
 }
 
@@ -62,11 +76,14 @@ TEST(RoughConductor, RejectsBadParameters) {
                  "distribution must be beckmann or ggx");
     expect_error("roughconductor", {{"alpha", 0.1}, {"alpha_u", 0.1}, {"alpha_v", 0.1}},
                  "either alpha or both alpha_u and alpha_v");
-    expect_error("roughconductor", {{"alpha_u", 0.1}}, "alpha_u and alpha_v must be given together");
-    expect_error("roughconductor", {{"alpha_v", 0.1}}, "alpha_u and alpha_v must be given together");
+    expect_error("roughconductor", {{"alpha_u", 0.1}},
+                 "alpha_u and alpha_v must be given together");
+    expect_error("roughconductor", {{"alpha_v", 0.1}},
+                 "alpha_u and alpha_v must be given together");
     expect_error("roughconductor", {{"alpha", -0.2}}, "alpha must be a roughness >= 0");
     expect_error("roughconductor", {{"material", std::string("Cu")}, {"eta", 0.2}}, "not both");
-    expect_error("roughconductor", {{"material", std::string("Copper")}}, "unknown conductor material");
+    expect_error("roughconductor", {{"material", std::string("Copper")}},
+                 "unknown conductor material");
     expect_error("roughconductor", {{"sample_visible", std::string("yes")}}, "sample_visible");
     expect_error("roughconductor", {{"int_ior", 1.5}}, "int_ior");
 }
@@ -75,12 +92,14 @@ TEST(RoughConductor, EvalClosedFormAtNormalIncidence) {
     // wi = wo = n: h = n, D = 1/(π α²), G = 1, so f·cos θo = F(1)/(4π α²).
     for (const char *distribution : {"beckmann", "ggx"}) {
         auto bsdf = make_bsdf("roughconductor", {{"distribution", std::string(distribution)},
-                                                 {"alpha", 0.3}, {"material", std::string("Al")}});
+                                                 {"alpha", 0.3},
+                                                 {"material", std::string("Al")}});
         SurfaceInteraction si = make_si(Vector3f(0.f, 0.f, 1.f));
         auto [eta, k] = conductor_eta_k("Al");
         Color3f expected = fresnel_conductor(1.f, eta, k) / (4.f * Pi * 0.09f);
         Color3f value = bsdf->eval(BSDFContext(), si, Vector3f(0.f, 0.f, 1.f));
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(value[c], expected[c], 1e-5f * expected[c]) << distribution;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(value[c], expected[c], 1e-5f * expected[c]) << distribution;
     }
 }
 
@@ -108,8 +127,10 @@ TEST(RoughConductor, Reciprocity) {
 
 TEST(RoughConductor, BackSideIsBlack) {
     auto bsdf = make_bsdf("roughconductor");
-    Vector3f below = normalize(Vector3f(0.2f, 0.1f, -0.6f)), above = normalize(Vector3f(-0.2f, 0.1f, 0.6f));
-    EXPECT_TRUE(bsdf->sample(BSDFContext(), make_si(below), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
+    Vector3f below = normalize(Vector3f(0.2f, 0.1f, -0.6f)),
+             above = normalize(Vector3f(-0.2f, 0.1f, 0.6f));
+    EXPECT_TRUE(
+        bsdf->sample(BSDFContext(), make_si(below), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
     EXPECT_TRUE(bsdf->eval(BSDFContext(), make_si(below), above).is_black());
     EXPECT_TRUE(bsdf->eval(BSDFContext(), make_si(above), below).is_black());
     EXPECT_EQ(bsdf->pdf(BSDFContext(), make_si(above), below), 0.f);
@@ -117,7 +138,8 @@ TEST(RoughConductor, BackSideIsBlack) {
     delta_only.type_mask = uint32_t(BSDFFlags::Delta);
     EXPECT_TRUE(bsdf->eval(delta_only, make_si(above), above).is_black());
     EXPECT_EQ(bsdf->pdf(delta_only, make_si(above), above), 0.f);
-    EXPECT_TRUE(bsdf->sample(delta_only, make_si(above), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
+    EXPECT_TRUE(
+        bsdf->sample(delta_only, make_si(above), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
 }
 
 TEST(RoughConductor, WhiteFurnaceAtMostOne) {
@@ -135,7 +157,8 @@ TEST(RoughConductor, WhiteFurnaceAtMostOne) {
             EXPECT_LE(albedo.max(), 1.f + 5e-3f) << c.name << " wi " << wi;
         }
     }
-    auto smooth = make_bsdf("roughconductor", {{"distribution", std::string("ggx")}, {"alpha", 0.05}});
+    auto smooth =
+        make_bsdf("roughconductor", {{"distribution", std::string("ggx")}, {"alpha", 0.05}});
     EXPECT_NEAR(furnace(*smooth, BSDFContext(), Vector3f(0.f, 0.f, 1.f), 20000).r, 1.f, 5e-3f);
 }
 
@@ -153,9 +176,11 @@ TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
         si.uv = Point2f(u, 0.5f);
         Vector3f wo = normalize(Vector3f(-0.4f, 0.1f, 0.7f));
         EXPECT_NEAR(textured->eval(BSDFContext(), si, wo).r, plain->eval(BSDFContext(), si, wo).r,
-                    1e-5f * plain->eval(BSDFContext(), si, wo).r) << u;
+                    1e-5f * plain->eval(BSDFContext(), si, wo).r)
+            << u;
         EXPECT_NEAR(textured->pdf(BSDFContext(), si, wo), plain->pdf(BSDFContext(), si, wo),
-                    1e-5f * plain->pdf(BSDFContext(), si, wo)) << u;
+                    1e-5f * plain->pdf(BSDFContext(), si, wo))
+            << u;
         auto [bs_t, w_t] = textured->sample(BSDFContext(), si, 0.5f, Point2f(0.3f, 0.7f));
         auto [bs_p, w_p] = plain->sample(BSDFContext(), si, 0.5f, Point2f(0.3f, 0.7f));
         EXPECT_EQ(bs_t.wo, bs_p.wo);
@@ -165,8 +190,9 @@ TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
     Properties aniso("roughconductor");
     aniso.set_object("alpha_u", std::make_shared<RampTexture>());
     aniso.set_float("alpha_v", 0.1);
-    EXPECT_TRUE(has_flag(PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, aniso)->flags(),
-                         BSDFFlags::Anisotropic));
+    EXPECT_TRUE(
+        has_flag(PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, aniso)->flags(),
+                 BSDFFlags::Anisotropic));
 }
 
 // Chi-square tests: Mitsuba's roughconductor configurations (wi = normalize(1, 1, 1)) and GGX
@@ -190,7 +216,8 @@ TEST(BSDFSampling, RoughConductorBeckmannSharp) {
     chi2_config({{"alpha", 0.05}}, WI, 0, "beckmann_sharp", 48);
 }
 TEST(BSDFSampling, RoughConductorAnisoBeckmann) {
-    chi2_config({{"alpha_u", 0.2}, {"alpha_v", 0.05}, {"sample_visible", false}}, WI, 1, "aniso_beckmann_all");
+    chi2_config({{"alpha_u", 0.2}, {"alpha_v", 0.05}, {"sample_visible", false}}, WI, 1,
+                "aniso_beckmann_all");
     chi2_config({{"alpha_u", 0.2}, {"alpha_v", 0.05}}, WI, 2, "aniso_beckmann_visible");
 }
 TEST(BSDFSampling, RoughConductorGGX) {

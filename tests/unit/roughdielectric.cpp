@@ -21,13 +21,21 @@ std::vector<Config> configs() {
     return {
         {"BeckmannVisible", {{"alpha", 0.3}}},
         {"BeckmannAllNormals", {{"alpha", 0.3}, {"sample_visible", false}}},
-        {"BeckmannAnisoVisible", {{"alpha_u", 0.4}, {"alpha_v", 0.1}, {"int_ior", std::string("diamond")}}},
+        {"BeckmannAnisoVisible",
+         {{"alpha_u", 0.4}, {"alpha_v", 0.1}, {"int_ior", std::string("diamond")}}},
         {"GGXVisible", {{"distribution", std::string("ggx")}, {"alpha", 0.2}}},
-        {"GGXAllNormals", {{"distribution", std::string("ggx")}, {"alpha", 0.2}, {"sample_visible", false}}},
-        {"GGXAnisoAll", {{"distribution", std::string("ggx")}, {"alpha_u", 0.05}, {"alpha_v", 0.5},
-                         {"sample_visible", false}}},
-        {"DenserOutside", {{"distribution", std::string("ggx")}, {"alpha", 0.4}, {"int_ior", 1.0},
-                           {"ext_ior", 1.5}}},
+        {"GGXAllNormals",
+         {{"distribution", std::string("ggx")}, {"alpha", 0.2}, {"sample_visible", false}}},
+        {"GGXAnisoAll",
+         {{"distribution", std::string("ggx")},
+          {"alpha_u", 0.05},
+          {"alpha_v", 0.5},
+          {"sample_visible", false}}},
+        {"DenserOutside",
+         {{"distribution", std::string("ggx")},
+          {"alpha", 0.4},
+          {"int_ior", 1.0},
+          {"ext_ior", 1.5}}},
     };
 }
 
@@ -39,8 +47,8 @@ BSDFContext make_ctx(TransportMode mode, uint32_t component = uint32_t(-1)) {
 
 float relative_eta(const BSDF &bsdf) {
     // η_it for light arriving from outside at normal incidence.
-    auto [bs, w] = bsdf.sample(make_ctx(TransportMode::Importance, 1), make_si(Vector3f(0.f, 0.f, 1.f)),
-                               0.5f, Point2f(0.5f, 0.5f));
+    auto [bs, w] = bsdf.sample(make_ctx(TransportMode::Importance, 1),
+                               make_si(Vector3f(0.f, 0.f, 1.f)), 0.5f, Point2f(0.5f, 0.5f));
     return bs.eta;
 }
 
@@ -57,8 +65,9 @@ TEST(RoughDielectric, CreationAndFlags) {
     EXPECT_TRUE(has_flag(aniso->flags(1), BSDFFlags::Anisotropic));
     EXPECT_NE(bsdf->to_string().find("RoughDielectric"), std::string::npos);
     EXPECT_NEAR(relative_eta(*bsdf), 1.5046f / 1.000277f, 1e-5f);
-    expect_documented("roughdielectric", {{"alpha", 0.1}, {"specular_reflectance", 0.5},
-                                          {"specular_transmittance", 0.5}});
+    expect_documented(
+        "roughdielectric",
+        {{"alpha", 0.1}, {"specular_reflectance", 0.5}, {"specular_transmittance", 0.5}});
     expect_documented("roughdielectric", {{"alpha_u", 0.1}, {"alpha_v", 0.2}});
 }
 
@@ -204,12 +213,15 @@ TEST(RoughDielectric, WhiteFurnaceAtMostOne) {
         }
     }
     // Nearly smooth glass keeps almost all the energy: only masking loses some.
-    auto smooth = make_bsdf("roughdielectric", {{"distribution", std::string("ggx")}, {"alpha", 0.02}});
+    auto smooth =
+        make_bsdf("roughdielectric", {{"distribution", std::string("ggx")}, {"alpha", 0.02}});
     for (float z : {1.f, -1.f}) {
-        Color3f albedo = furnace(*smooth, BSDFContext(TransportMode::Importance), Vector3f(0.f, 0.f, z), 20000);
+        Color3f albedo =
+            furnace(*smooth, BSDFContext(TransportMode::Importance), Vector3f(0.f, 0.f, z), 20000);
         EXPECT_NEAR(albedo.r, 1.f, 5e-3f) << z;
         // Radiance mode with the η² compensation is the same energy.
-        Color3f radiance = furnace(*smooth, BSDFContext(TransportMode::Radiance), Vector3f(0.f, 0.f, z), 20000);
+        Color3f radiance =
+            furnace(*smooth, BSDFContext(TransportMode::Radiance), Vector3f(0.f, 0.f, z), 20000);
         EXPECT_NEAR(radiance.r, albedo.r, 1e-4f) << z;
     }
 }
@@ -233,20 +245,22 @@ void chi2_config(const Params &params, const Vector3f &wi, uint32_t seed, const 
 
 TEST(BSDFSampling, RoughDielectricBeckmann) {
     chi2_config({{"alpha", 0.5}}, Vector3f(0.8f, 0.3f, 0.05f), 4, "grazing");
-    chi2_config({{"alpha", 0.5}, {"sample_visible", false}}, Vector3f(0.5f, 0.f, 0.5f), 1, "beckmann_all");
+    chi2_config({{"alpha", 0.5}, {"sample_visible", false}}, Vector3f(0.5f, 0.f, 0.5f), 1,
+                "beckmann_all");
     chi2_config({{"alpha", 0.5}}, Vector3f(0.5f, 0.f, 0.5f), 2, "beckmann_visible");
 }
 TEST(BSDFSampling, RoughDielectricGGX) {
-    Params ggx_all = {{"distribution", std::string("ggx")}, {"alpha", 0.5}, {"sample_visible", false}};
+    Params ggx_all = {
+        {"distribution", std::string("ggx")}, {"alpha", 0.5}, {"sample_visible", false}};
     chi2_config(ggx_all, Vector3f(0.5f, 0.f, 0.5f), 3, "ggx_all");
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.5}}, Vector3f(0.5f, 0.5f, 0.001f), 2,
-                "ggx_visible_grazing");
+    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.5}},
+                Vector3f(0.5f, 0.5f, 0.001f), 2, "ggx_visible_grazing");
 }
 TEST(BSDFSampling, RoughDielectricFromInside) {
     chi2_config({{"alpha", 0.5}}, Vector3f(0.2f, -0.6f, -0.5f), 5, "inside");
     chi2_config({{"alpha", 0.5}}, Vector3f(0.8f, 0.3f, -0.05f), 8, "inside_tir");
-    chi2_config({{"alpha", 0.5}, {"ext_ior", 1.5}, {"int_ior", 1.0}}, Vector3f(0.2f, -0.6f, 0.5f), 6,
-                "denser_outside");
+    chi2_config({{"alpha", 0.5}, {"ext_ior", 1.5}, {"int_ior", 1.0}}, Vector3f(0.2f, -0.6f, 0.5f),
+                6, "denser_outside");
 }
 TEST(BSDFSampling, RoughDielectricSingleLobe) {
     Params aniso = {{"alpha_u", 0.5}, {"alpha_v", 0.2}};

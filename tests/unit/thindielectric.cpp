@@ -15,7 +15,8 @@ TEST(ThinDielectric, CreationAndFlags) {
     EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | sides);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::Null | sides);
     EXPECT_NE(bsdf->to_string().find("ThinDielectric"), std::string::npos);
-    expect_documented("thindielectric", {{"specular_reflectance", 0.5}, {"specular_transmittance", 0.5}});
+    expect_documented("thindielectric",
+                      {{"specular_reflectance", 0.5}, {"specular_transmittance", 0.5}});
 }
 
 TEST(ThinDielectric, RejectsBadParameters) {
@@ -67,7 +68,8 @@ TEST(ThinDielectric, TransmissionPassesStraightThroughOnBothSides) {
 }
 
 TEST(ThinDielectric, SingleLobeContextsCarryTheirFraction) {
-    auto bsdf = make_bsdf("thindielectric", {{"int_ior", 1.5}, {"ext_ior", 1.0},
+    auto bsdf = make_bsdf("thindielectric", {{"int_ior", 1.5},
+                                             {"ext_ior", 1.0},
                                              {"specular_reflectance", 0.5},
                                              {"specular_transmittance", 0.8}});
     Vector3f wi = normalize(Vector3f(0.6f, 0.3f, -0.5f));

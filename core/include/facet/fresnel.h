@@ -35,9 +35,12 @@ inline FresnelResult fresnel_dielectric(float cos_i, float eta) {
     float r_p = (ct - eta_it * ci) / (ct + eta_it * ci);
     float F = 0.5f * (r_s * r_s + r_p * r_p);
 
-    if (eta == 1.f) F = 0.f;             // index-matched: no interface
-    else if (ci == 0.f) F = 1.f;         // grazing incidence (0/0 in r_p otherwise)
-    else if (cos_t_2 <= 0.f) F = 1.f;    // total internal reflection
+    if (eta == 1.f)
+        F = 0.f; // index-matched: no interface
+    else if (ci == 0.f)
+        F = 1.f; // grazing incidence (0/0 in r_p otherwise)
+    else if (cos_t_2 <= 0.f)
+        F = 1.f; // total internal reflection
 
     return {F, outside ? -ct : ct, eta_it, eta_ti};
 }
@@ -69,7 +72,9 @@ inline Color3f fresnel_conductor(float cos_i, const Color3f &eta, const Color3f 
 inline Vector3f reflect(const Vector3f &wi) { return {-wi.x, -wi.y, wi.z}; }
 
 /// Mirror direction about the (micro)normal m.
-inline Vector3f reflect(const Vector3f &wi, const Vector3f &m) { return m * (2.f * dot(wi, m)) - wi; }
+inline Vector3f reflect(const Vector3f &wi, const Vector3f &m) {
+    return m * (2.f * dot(wi, m)) - wi;
+}
 
 /// Refracted direction about the shading normal, with cos_t and eta_ti from fresnel_dielectric().
 inline Vector3f refract(const Vector3f &wi, float cos_t, float eta_ti) {
@@ -88,8 +93,7 @@ inline Vector3f refract(const Vector3f &wi, const Vector3f &m, float cos_t, floa
  * d'Eon & Irving (η ≥ 1).
  */
 inline float fresnel_diffuse_reflectance(float eta) {
-    if (eta < 1.f)
-        return 0.0636f / eta + eta * (-1.4399f * eta + 0.7099f) + 0.6681f;
+    if (eta < 1.f) return 0.0636f / eta + eta * (-1.4399f * eta + 0.7099f) + 0.6681f;
     float x = 1.f / eta;
     // Horner form of 0.919317 − 3.4793x + 6.75335x² − 7.80989x³ + 4.98554x⁴ − 1.36881x⁵.
     return 0.919317f +

@@ -18,7 +18,8 @@ float lookup_ior(const std::string &name);
 
 /**
  * Reads an IOR parameter that is either a number or a material name, e.g. `int_ior`:
- * absent -> the IOR of `default_name`; zero, negative or unknown values are errors (with the entry's location).
+ * absent -> the IOR of `default_name`; zero, negative or unknown values are errors (with the
+ * entry's location).
  */
 float read_ior(const Properties &props, const std::string &param, const std::string &default_name);
 

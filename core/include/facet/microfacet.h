@@ -73,8 +73,8 @@ public:
         // A microfacet seen from its back side is masked.
         if (dot(v, m) * Frame::cos_theta(v) <= 0.f) return 0.f;
         float xy_alpha_2 = sqr(m_alpha_u * v.x) + sqr(m_alpha_v * v.y);
-        if (xy_alpha_2 == 0.f) return 1.f;                         // normal incidence
-        float tan_theta_alpha_2 = xy_alpha_2 / sqr(v.z);          // α²·tan²θ along v's azimuth
+        if (xy_alpha_2 == 0.f) return 1.f;               // normal incidence
+        float tan_theta_alpha_2 = xy_alpha_2 / sqr(v.z); // α²·tan²θ along v's azimuth
         if (m_type == MicrofacetType::Beckmann) {
             float a = 1.f / std::sqrt(tan_theta_alpha_2);
             if (a >= 1.6f) return 1.f;
@@ -160,7 +160,8 @@ public:
 
     /// The distribution at `si` (roughness textures evaluated with eval_1).
     MicrofacetDistribution at(const SurfaceInteraction &si) const {
-        if (m_constant) return MicrofacetDistribution(m_type, m_const_u, m_const_v, m_sample_visible);
+        if (m_constant)
+            return MicrofacetDistribution(m_type, m_const_u, m_const_v, m_sample_visible);
         return MicrofacetDistribution(m_type, m_alpha_u->eval_1(si), m_alpha_v->eval_1(si),
                                       m_sample_visible);
     }
