@@ -183,7 +183,9 @@ TEST(Microfacet, SampleReturnsItsPdf) {
                 EXPECT_NEAR(norm(m), 1.f, 1e-5f);
                 EXPECT_GT(m.z, 0.f);
                 EXPECT_NEAR(pdf, distr.pdf(wi, m), 1e-4f * pdf) << name_of(c);
-                if (visible) EXPECT_GT(dot(wi, m), 0.f) << name_of(c);
+                if (visible) {
+                    EXPECT_GT(dot(wi, m), 0.f) << name_of(c);
+                }
                 ++ok;
             }
             EXPECT_GT(ok, 1990) << name_of(c) << (visible ? " visible" : " all");
