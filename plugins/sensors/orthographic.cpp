@@ -10,6 +10,8 @@ larger or smaller region, as in Mitsuba.
 | to_world  | transform | identity    | Camera-to-world transform (scale sets the view)|
 | near_clip | float     | 0.01        | Near clipping distance (local units)           |
 | far_clip  | float     | 10000       | Far clipping distance (local units)            |
+| shutter_open | float  | 0           | Accepted for compatibility (still images)      |
+| shutter_close| float  | 0           | Accepted for compatibility (>= shutter_open)   |
 | (film)    | film      | hdrfilm     | Nested film                                    |
 | (sampler) | sampler   | independent | Nested sampler                                 |
 

@@ -15,6 +15,8 @@ frame and field of view are those of `perspective` (looks down local +Z, +X is l
 | focal_length    | string    | 50mm               | 35 mm equivalent focal length; not with `fov`             |
 | near_clip       | float     | 0.01               | Near clipping distance                                    |
 | far_clip        | float     | 10000              | Far clipping distance                                     |
+| shutter_open    | float     | 0                  | Accepted for compatibility; facet renders still images    |
+| shutter_close   | float     | 0                  | Accepted for compatibility (>= shutter_open)              |
 | (film)          | film      | hdrfilm            | Nested film                                               |
 | (sampler)       | sampler   | independent        | Nested sampler                                            |
 
