@@ -18,10 +18,9 @@ int plugins_main(int argc, char **argv);
 int bench_main(int argc, char **argv);
 int compare_main(int argc, char **argv);
 
-/// Implemented in chi2_cmd.cpp and new_plugin_cmd.cpp. Weak, so that `facet` still links (and
-/// says "not available") in a tree without them.
-int chi2_main(int argc, char **argv) __attribute__((weak));
-int new_plugin_main(int argc, char **argv) __attribute__((weak));
+/// `facet chi2` (chi2_cmd.cpp) and `facet new-plugin` (new_plugin_cmd.cpp).
+int chi2_main(int argc, char **argv);
+int new_plugin_main(int argc, char **argv);
 
 namespace facet::cli {
 

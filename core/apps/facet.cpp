@@ -23,7 +23,8 @@ Usage:
   facet bench <scene.xml> [options]    path tracer samples/s and rays/s against plain Embree
   facet compare ours.exr ref_mean.exr ref_var_xyz.exr --spp N
                                        statistical comparison with a reference render
-  facet chi2 ...                       chi-square test of a BSDF or emitter plugin
+  facet chi2 bsdf|emitter|microfacet ...
+                                       chi-square test of a plugin's sampling against its pdf
   facet new-plugin ...                 start a plugin of your own from the template
 
 Run `facet <command> --help` for the options of a command.
@@ -70,10 +71,7 @@ int run(int argc, char **argv) {
         {"compare", compare_main}, {"chi2", chi2_main},             {"new-plugin", new_plugin_main},
     };
     for (const Command &cmd : commands) {
-        if (first != cmd.name) continue;
-        if (!cmd.run)
-            throw facet::Error(fmt::format("the '{}' command is not available in this build", first));
-        return cmd.run(argc - 1, argv + 1);
+        if (first == cmd.name) return cmd.run(argc - 1, argv + 1);
     }
 
     // `facet scene.xml ...` and `facet -D spp=4 scene.xml` are short for `facet render ...`.

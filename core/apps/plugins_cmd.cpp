@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <string>
 #include <vector>
@@ -28,7 +29,8 @@ const ObjectType KINDS[] = {
 
 /// "bsdf" or "bsdfs" (also "BSDF") names a kind.
 ObjectType kind_from_word(std::string word) {
-    std::transform(word.begin(), word.end(), word.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(word.begin(), word.end(), word.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     for (ObjectType kind : KINDS)
         if (word == object_type_name(kind) || word == object_type_folder(kind)) return kind;
     return ObjectType::Unknown;
@@ -91,8 +93,11 @@ int plugins_main(int argc, char **argv) {
                         hint.empty() ? "" : fmt::format("; did you mean \"{}\"?", hint));
         }
         const PluginDescriptor &desc = registry.descriptor(what);
+        std::string doc = desc.doc ? desc.doc : "";
+        doc.erase(0, doc.find_first_not_of("\n"));
+        doc.erase(doc.find_last_not_of("\n") + 1);
         fmt::print("{} ({}): {}\n\n{}\n", desc.name, object_type_name(desc.kind),
-                   desc.description ? desc.description : "", desc.doc ? desc.doc : "");
+                   desc.description ? desc.description : "", doc);
         return 0;
     }
 
@@ -109,7 +114,8 @@ int plugins_main(int argc, char **argv) {
     }
     if (first) {
         std::string where;
-        for (const std::string &dir : registry.search_path()) where += (where.empty() ? "" : ", ") + dir;
+        for (const std::string &dir : registry.search_path())
+            where += (where.empty() ? "" : ", ") + dir;
         fmt::print("No {}plugins found (search path: {})\n",
                    only == ObjectType::Unknown ? "" : fmt::format("{} ", object_type_name(only)),
                    where.empty() ? "empty" : where);
