@@ -10,7 +10,7 @@
 
 /// Measured complex IORs (η + i·k) of conductors, by the names of Mitsuba's data/ior files
 /// ("Cu", "Au", "Al", "Cu_palik", ...). The spectra are embedded (generated from the measured
-/// data by scripts/gen_conductor_table.py) and converted to RGB on request.
+/// data by core/scripts/gen_conductor_table.py) and converted to RGB on request.
 namespace facet {
 
 /// Names of all embedded materials, sorted, plus "none" (the ideal mirror: η = 0, k = 1).

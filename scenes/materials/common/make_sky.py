@@ -4,7 +4,7 @@
 Usage: make_sky.py OUTPUT.hdr [WIDTH]
 
 The top row is straight up (+Y), u turns around +Y starting at -Z, as facet's envmap reads it.
-The sky blends from a pale horizon to a deeper zenith blue, a warm sun disk sits 35 degrees
+The sky blends from a pale horizon to a deeper zenith blue, a warm sun disk (4 degrees in radius) sits 35 degrees
 above the horizon, and the ground below the horizon is a dim grey-brown. Only the standard
 library is used; the file is uncompressed (flat scanlines), which every RGBE reader accepts.
 """
@@ -28,8 +28,8 @@ def sky(d):
     sun_elev, sun_az = math.radians(35.0), math.radians(130.0)
     sun = (math.sin(sun_az) * math.cos(sun_elev), math.sin(sun_elev), -math.cos(sun_az) * math.cos(sun_elev))
     cos_sun = x * sun[0] + y * sun[1] + z * sun[2]
-    if cos_sun > math.cos(math.radians(2.5)):
-        return (900.0, 780.0, 600.0)
+    if cos_sun > math.cos(math.radians(4.0)):
+        return (300.0, 260.0, 200.0)
     if y < 0.0:
         t = min(1.0, -y * 4.0)
         return (0.30 - 0.12 * t, 0.27 - 0.11 * t, 0.22 - 0.09 * t)
