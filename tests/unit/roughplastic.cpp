@@ -139,6 +139,16 @@ TEST(RoughPlastic, TransmittanceMatchesTheRoughDielectric) {
         float d_normal = plastic->eval(component_ctx(1), make_si(up), up).r;
         EXPECT_GT(T_normal, 0.9f);
         EXPECT_LT(T_normal, 1.f - 0.03f); // at least the smooth F(0) = 4 % is reflected
+        // The glossy lobe is chosen with probability (1 − T)·w / ((1 − T)·w + T·(1 − w)), where
+        // w = 1/(1 + 0.5) for the default reflectances.
+        float w = 1.f / 1.5f, p_spec = (1.f - T_normal) * w / ((1.f - T_normal) * w + T_normal * (1.f - w));
+        int n = 10000, glossy = 0;
+        for (int i = 0; i < n; ++i) {
+            auto [bs, weight] = plastic->sample(BSDFContext(), make_si(up), (float(i) + 0.5f) / float(n),
+                                                Point2f(0.3f, 0.7f));
+            glossy += bs.sampled_component == 0;
+        }
+        EXPECT_NEAR(float(glossy) / float(n), p_spec, 2e-3f) << distribution;
         for (float theta : {30.f, 60.f, 75.f, 85.f}) {
             Vector3f wi = direction_from_angles(theta, 0.f);
             float T = furnace(*dielectric, transmission, wi, 40000).r;
