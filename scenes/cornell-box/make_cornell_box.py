@@ -5,16 +5,16 @@ The room spans x in [-1, 1], y in [0, 2] (y is up) and z in [-1, 1]; it is open 
 the camera stands. Every face is wound counter-clockwise seen from the side its normal points to,
 so all normals face into the room (the light's faces down). Run it from anywhere:
 
-    python3 scripts/make_cornell_box.py
+    python3 scenes/cornell-box/make_cornell_box.py
 
-It only uses the Python standard library; its output is committed next to scene.xml.
+It only uses the Python standard library; its output (meshes/*.obj) is committed.
 """
 
 import math
 import os
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-OUT = os.path.join(HERE, "..", "scenes", "cornell-box", "meshes")
+OUT = os.path.join(HERE, "meshes")
 
 
 def sub(a, b):
@@ -79,7 +79,7 @@ def write_obj(name, triangles, comment):
     path = os.path.join(OUT, name + ".obj")
     with open(path, "w", newline="\n") as f:
         f.write(f"# facet Cornell box: {comment}\n")
-        f.write("# Written by scripts/make_cornell_box.py\n")
+        f.write("# Written by make_cornell_box.py\n")
         for v in vertices:
             f.write("v {:.6f} {:.6f} {:.6f}\n".format(*v))
         for face in faces:
