@@ -1,4 +1,7 @@
+#include <facet/logger.h>
 #include <facet/resolver.h>
+
+#include <cstdio>
 
 #include <filesystem>
 
@@ -25,6 +28,19 @@ void FileResolver::append(const std::string &dir) { m_dirs.push_back(dir); }
 FileResolver &file_resolver() {
     static FileResolver resolver;
     return resolver;
+}
+
+std::string read_file(const std::string &path, const std::string &what) {
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) FACET_THROW("{}: cannot open \"{}\"", what, path);
+    std::string data;
+    char buf[1 << 16];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0) data.append(buf, n);
+    bool failed = std::ferror(f) != 0;
+    std::fclose(f);
+    if (failed) FACET_THROW("{}: error while reading \"{}\"", what, path);
+    return data;
 }
 
 } // namespace facet

@@ -28,6 +28,7 @@ sample of either kind is needed.
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/integrator.h>
+#include <facet/mis.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/sampler.h>
@@ -38,27 +39,6 @@ sample of either kind is needed.
 namespace facet {
 
 namespace {
-
-/// Power heuristic (β = 2) for the strategy with density `a` against one with density `b`.
-inline float mis_weight(float a, float b) {
-    a *= a;
-    b *= b;
-    float w = a / (a + b);
-    return std::isfinite(w) ? w : 0.f;
-}
-
-/// Record of the emitter point `si` as seen from `ref`, for Scene::pdf_emitter_direction.
-inline DirectionSample direction_to(const SurfaceInteraction &si, const Interaction &ref) {
-    DirectionSample ds;
-    ds.p = si.p;
-    ds.n = si.n;
-    ds.uv = si.uv;
-    Vector3f d = si.p - ref.p;
-    ds.dist = norm(d);
-    ds.d = ds.dist > 0.f ? d / ds.dist : Vector3f(0.f);
-    ds.emitter = si.emitter();
-    return ds;
-}
 
 uint32_t read_count(const Properties &props, const char *name, int64_t def) {
     int64_t v = props.get_int(name, def);

@@ -22,6 +22,7 @@ bounces, Russian roulette ends paths whose throughput has become small.
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/integrator.h>
+#include <facet/mis.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/sampler.h>
@@ -32,31 +33,6 @@ bounces, Russian roulette ends paths whose throughput has become small.
 #include <limits>
 
 namespace facet {
-
-namespace {
-
-/// Power heuristic (β = 2) for the strategy with density `a` against one with density `b`.
-inline float mis_weight(float a, float b) {
-    a *= a;
-    b *= b;
-    float w = a / (a + b);
-    return std::isfinite(w) ? w : 0.f;
-}
-
-/// Record of the emitter point `si` as seen from `ref`, for Scene::pdf_emitter_direction.
-inline DirectionSample direction_to(const SurfaceInteraction &si, const Interaction &ref) {
-    DirectionSample ds;
-    ds.p = si.p;
-    ds.n = si.n;
-    ds.uv = si.uv;
-    Vector3f d = si.p - ref.p;
-    ds.dist = norm(d);
-    ds.d = ds.dist > 0.f ? d / ds.dist : Vector3f(0.f);
-    ds.emitter = si.emitter();
-    return ds;
-}
-
-} // namespace
 
 class PathIntegrator final : public SamplingIntegrator {
 public:

@@ -38,22 +38,6 @@ namespace facet {
 namespace {
 
 /// The whole file in memory; parsing then walks it with pointers (no stream per token).
-std::string read_file(const std::string &path) {
-    std::FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f)
-        FACET_THROW("obj: cannot open \"{}\"", path);
-    std::string data;
-    char buf[1 << 16];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0)
-        data.append(buf, n);
-    bool failed = std::ferror(f) != 0;
-    std::fclose(f);
-    if (failed)
-        FACET_THROW("obj: error while reading \"{}\"", path);
-    return data;
-}
-
 class ObjParser {
 public:
     ObjParser(const std::string &path, const std::string &data) : m_path(path), m_data(data) {}
@@ -216,7 +200,7 @@ public:
         m_name = filename;
 
         std::string path = file_resolver().resolve(filename);
-        std::string data = read_file(path);
+        std::string data = read_file(path, "obj");
         ObjParser parser(filename, data);
         parser.parse();
         if (parser.faces.empty())

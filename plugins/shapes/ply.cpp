@@ -172,22 +172,6 @@ private:
     size_t m_line;
 };
 
-std::string read_file(const std::string &path) {
-    std::FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f)
-        FACET_THROW("ply: cannot open \"{}\"", path);
-    std::string data;
-    char buf[1 << 16];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0)
-        data.append(buf, n);
-    bool failed = std::ferror(f) != 0;
-    std::fclose(f);
-    if (failed)
-        FACET_THROW("ply: error while reading \"{}\"", path);
-    return data;
-}
-
 std::vector<std::string> split_words(const std::string &line) {
     std::vector<std::string> words;
     size_t i = 0;
@@ -216,7 +200,7 @@ public:
         Transform to_world = props.get_transform("to_world", Transform());
         m_name = filename;
 
-        std::string data = read_file(file_resolver().resolve(filename));
+        std::string data = read_file(file_resolver().resolve(filename), "ply");
         load(filename, data, flip_tex_coords);
         initialize(to_world, face_normals, flip_normals);
         if (!face_normals && !has_vertex_normals())

@@ -19,6 +19,9 @@ private:
     std::vector<std::string> m_dirs;
 };
 
+/// Whole file as bytes; throws facet::Error "<what>: cannot open \"path\"" (or a read error).
+std::string read_file(const std::string &path, const std::string &what);
+
 /// The process-wide resolver that plugins use for their file names. The scene loader sets it up
 /// (scene folder, <path> entries) while a scene loads.
 FileResolver &file_resolver();
