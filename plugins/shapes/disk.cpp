@@ -30,6 +30,7 @@ Texture coordinates are polar: u = r (distance to the centre), v = φ/2π.
 #include <facet/plugin.h>
 #include <facet/shape.h>
 #include <facet/transform.h>
+#include <facet/user_geometry.h>
 #include <facet/warp.h>
 
 namespace facet {
@@ -65,15 +66,13 @@ public:
     BoundingBox3f bbox() const override { return m_bbox; }
     float surface_area() const override { return m_area; }
 
-    RTCGeometry embree_geometry(RTCDevice device) const override {
-        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(geom, 1);
-        rtcSetGeometryUserData(geom, const_cast<Disk *>(this));
-        rtcSetGeometryBoundsFunction(geom, &Disk::embree_bounds, nullptr);
-        rtcSetGeometryIntersectFunction(geom, &Disk::embree_intersect);
-        rtcSetGeometryOccludedFunction(geom, &Disk::embree_occluded);
-        rtcCommitGeometry(geom);
-        return geom;
+    RTCGeometry embree_geometry(RTCDevice device) const override { return make_user_geometry(device, this); }
+
+    /// Embree callback (facet/user_geometry.h): keeps the object-space (x, y) of the hit as uv.
+    bool intersect_user(const Point3f &o, const Vector3f &d, float tnear, float tfar, UserHit &h) const {
+        if (!hit(o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar, h.t, h.uv.x, h.uv.y)) return false;
+        h.ng = m_normal;
+        return true;
     }
 
     /// `uv` holds the object-space (x, y) of the hit, stored by the intersection callback.
@@ -148,61 +147,6 @@ private:
         x = float(px);
         y = float(py);
         return true;
-    }
-
-    static void embree_bounds(const RTCBoundsFunctionArguments *args) {
-        const Disk *disk = static_cast<const Disk *>(args->geometryUserPtr);
-        const BoundingBox3f &box = disk->m_bbox;
-        float eps = (max_component(abs(box.min)) + max_component(abs(box.max))) * 1e-6f;
-        RTCBounds *b = args->bounds_o;
-        b->lower_x = box.min.x - eps;
-        b->lower_y = box.min.y - eps;
-        b->lower_z = box.min.z - eps;
-        b->upper_x = box.max.x + eps;
-        b->upper_y = box.max.y + eps;
-        b->upper_z = box.max.z + eps;
-    }
-
-    static void embree_intersect(const RTCIntersectFunctionNArguments *args) {
-        const Disk *disk = static_cast<const Disk *>(args->geometryUserPtr);
-        const unsigned n = args->N;
-        RTCRayN *ray = RTCRayHitN_RayN(args->rayhit, n);
-        RTCHitN *hit = RTCRayHitN_HitN(args->rayhit, n);
-        for (unsigned i = 0; i < n; ++i) {
-            if (!args->valid[i])
-                continue;
-            float t, x, y;
-            if (!disk->hit(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                           RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                           RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                           RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), t, x, y))
-                continue;
-            RTCRayN_tfar(ray, n, i) = t;
-            RTCHitN_Ng_x(hit, n, i) = disk->m_normal.x;
-            RTCHitN_Ng_y(hit, n, i) = disk->m_normal.y;
-            RTCHitN_Ng_z(hit, n, i) = disk->m_normal.z;
-            RTCHitN_u(hit, n, i) = x;
-            RTCHitN_v(hit, n, i) = y;
-            RTCHitN_primID(hit, n, i) = args->primID;
-            RTCHitN_geomID(hit, n, i) = args->geomID;
-            RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
-        }
-    }
-
-    static void embree_occluded(const RTCOccludedFunctionNArguments *args) {
-        const Disk *disk = static_cast<const Disk *>(args->geometryUserPtr);
-        const unsigned n = args->N;
-        RTCRayN *ray = args->ray;
-        for (unsigned i = 0; i < n; ++i) {
-            if (!args->valid[i])
-                continue;
-            float t, x, y;
-            if (disk->hit(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                          RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                          RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                          RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), t, x, y))
-                RTCRayN_tfar(ray, n, i) = -Infinity;
-        }
     }
 
     Transform m_to_world, m_to_object;

@@ -29,6 +29,7 @@ cone of directions it subtends, so its light is sampled without waste at any dis
 #include <facet/plugin.h>
 #include <facet/shape.h>
 #include <facet/transform.h>
+#include <facet/user_geometry.h>
 #include <facet/warp.h>
 
 namespace facet {
@@ -60,15 +61,14 @@ public:
 
     float surface_area() const override { return 4.f * Pi * m_radius * m_radius; }
 
-    RTCGeometry embree_geometry(RTCDevice device) const override {
-        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(geom, 1);
-        rtcSetGeometryUserData(geom, const_cast<Sphere *>(this));
-        rtcSetGeometryBoundsFunction(geom, &Sphere::embree_bounds, nullptr);
-        rtcSetGeometryIntersectFunction(geom, &Sphere::embree_intersect);
-        rtcSetGeometryOccludedFunction(geom, &Sphere::embree_occluded);
-        rtcCommitGeometry(geom);
-        return geom;
+    RTCGeometry embree_geometry(RTCDevice device) const override { return make_user_geometry(device, this); }
+
+    /// Embree callback (facet/user_geometry.h): nearest hit in [tnear, tfar].
+    bool intersect_user(const Point3f &o, const Vector3f &d, float tnear, float tfar, UserHit &hit) const {
+        if (!nearest_hit(o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar, hit.t)) return false;
+        hit.ng = o + d * hit.t - m_center;
+        hit.uv = Point2f(0.f);
+        return true;
     }
 
     void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
@@ -277,66 +277,6 @@ private:
             return true;
         }
         return false;
-    }
-
-    static void embree_bounds(const RTCBoundsFunctionArguments *args) {
-        const Sphere *sphere = static_cast<const Sphere *>(args->geometryUserPtr);
-        BoundingBox3f box = sphere->bbox();
-        // A little slack for the rounding of the box corners.
-        float eps = (max_component(abs(box.min)) + max_component(abs(box.max))) * 1e-6f;
-        RTCBounds *b = args->bounds_o;
-        b->lower_x = box.min.x - eps;
-        b->lower_y = box.min.y - eps;
-        b->lower_z = box.min.z - eps;
-        b->upper_x = box.max.x + eps;
-        b->upper_y = box.max.y + eps;
-        b->upper_z = box.max.z + eps;
-    }
-
-    static void embree_intersect(const RTCIntersectFunctionNArguments *args) {
-        const Sphere *sphere = static_cast<const Sphere *>(args->geometryUserPtr);
-        const unsigned n = args->N;
-        RTCRayN *ray = RTCRayHitN_RayN(args->rayhit, n);
-        RTCHitN *hit = RTCRayHitN_HitN(args->rayhit, n);
-        for (unsigned i = 0; i < n; ++i) {
-            if (!args->valid[i])
-                continue;
-            float t;
-            if (!sphere->nearest_hit(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                                     RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                                     RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                                     RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), t))
-                continue;
-            RTCRayN_tfar(ray, n, i) = t;
-            Point3f p(RTCRayN_org_x(ray, n, i) + t * RTCRayN_dir_x(ray, n, i),
-                      RTCRayN_org_y(ray, n, i) + t * RTCRayN_dir_y(ray, n, i),
-                      RTCRayN_org_z(ray, n, i) + t * RTCRayN_dir_z(ray, n, i));
-            Vector3f ng = p - sphere->m_center;
-            RTCHitN_Ng_x(hit, n, i) = ng.x;
-            RTCHitN_Ng_y(hit, n, i) = ng.y;
-            RTCHitN_Ng_z(hit, n, i) = ng.z;
-            RTCHitN_u(hit, n, i) = 0.f;
-            RTCHitN_v(hit, n, i) = 0.f;
-            RTCHitN_primID(hit, n, i) = args->primID;
-            RTCHitN_geomID(hit, n, i) = args->geomID;
-            RTCHitN_instID(hit, n, i, 0) = args->context->instID[0];
-        }
-    }
-
-    static void embree_occluded(const RTCOccludedFunctionNArguments *args) {
-        const Sphere *sphere = static_cast<const Sphere *>(args->geometryUserPtr);
-        const unsigned n = args->N;
-        RTCRayN *ray = args->ray;
-        for (unsigned i = 0; i < n; ++i) {
-            if (!args->valid[i])
-                continue;
-            float t;
-            if (sphere->nearest_hit(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i),
-                                    RTCRayN_org_z(ray, n, i), RTCRayN_dir_x(ray, n, i),
-                                    RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i),
-                                    RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), t))
-                RTCRayN_tfar(ray, n, i) = -Infinity;
-        }
     }
 
     Transform m_to_world, m_to_object;
