@@ -66,14 +66,21 @@ def box(center_x, center_z, size_x, size_z, height, angle_deg):
 
 
 def write_obj(name, triangles, comment):
+    """Vertices are shared only between triangles of the same plane: a renderer that smooths
+    normals over shared vertices (facet and Mitsuba do when a file has none) then still sees
+    flat faces, and the boxes keep their sharp edges."""
     vertices, indices, faces = [], {}, []
     for tri in triangles:
+        n = cross(sub(tri[1], tri[0]), sub(tri[2], tri[0]))
+        length = math.sqrt(dot(n, n))
+        plane = tuple(round(x / length, 4) for x in n)
         face = []
         for v in tri:
-            key = tuple(round(x, 6) for x in v)
+            position = tuple(round(x, 6) for x in v)
+            key = (position, plane)
             if key not in indices:
                 indices[key] = len(vertices) + 1
-                vertices.append(key)
+                vertices.append(position)
             face.append(indices[key])
         faces.append(face)
     path = os.path.join(OUT, name + ".obj")
