@@ -81,7 +81,7 @@ public:
         // ---- Emitters seen directly ----
         if (!m_hide_emitters) {
             if (!hit)
-                return environment(scene, ray, si, 0.f, true);
+                return environment_mis(scene, ray, si, 0.f, true);
             if (const Emitter *emitter = si.emitter()) result += emitter->eval(si);
         }
         if (!hit) return result;
@@ -116,8 +116,9 @@ public:
             Ray bsdf_ray = si.spawn_ray(si.to_world(bs.wo));
             SurfaceInteraction si_bsdf;
             if (!scene.ray_intersect(bsdf_ray, si_bsdf)) {
-                result += bsdf_weight * environment(scene, bsdf_ray, si, bs.pdf * m_frac_bsdf,
-                                                    delta) * m_weight_bsdf;
+                result += bsdf_weight * environment_mis(scene, bsdf_ray, si, bs.pdf * m_frac_bsdf,
+                                                                  delta, m_frac_emitter) *
+                          m_weight_bsdf;
                 continue;
             }
             const Emitter *emitter = si_bsdf.emitter();
@@ -141,33 +142,6 @@ public:
     }
 
 private:
-    /// Radiance of the environment along a ray that left the scene; with MIS (not `delta`) each
-    /// infinite emitter is weighted against its own emitter-sampling density.
-    Color3f environment(const Scene &scene, const Ray &ray, const Interaction &ref,
-                        float bsdf_pdf, bool delta) const {
-        const auto &emitters = scene.environment_emitters();
-        if (emitters.empty()) return Color3f(0.f);
-        SurfaceInteraction miss; // t = Infinity, identity shading frame
-        miss.wi = -ray.d;
-        DirectionSample ds;
-        ds.d = ray.d;
-        ds.dist = Infinity;
-        ds.p = ref.p + ray.d;
-        ds.n = -ray.d;
-        Color3f result(0.f);
-        for (const auto &emitter : emitters) {
-            Color3f L = emitter->eval(miss);
-            if (L.is_black()) continue;
-            float w = 1.f;
-            if (!delta) {
-                ds.emitter = emitter.get();
-                w = mis_weight(bsdf_pdf, scene.pdf_emitter_direction(ref, ds) * m_frac_emitter);
-            }
-            result += L * w;
-        }
-        return result;
-    }
-
     uint32_t m_emitter_samples, m_bsdf_samples;
     float m_frac_emitter, m_frac_bsdf, m_weight_emitter, m_weight_bsdf;
     bool m_hide_emitters;

@@ -73,7 +73,7 @@ public:
             // ---- Emission found by the previous BSDF sample (or by the camera ray) ----
             if (!hit) {
                 if (count_emission)
-                    result += throughput * environment(scene, ray, prev_si, prev_bsdf_pdf,
+                    result += throughput * environment_mis(scene, ray, prev_si, prev_bsdf_pdf,
                                                        prev_bsdf_delta);
                 break;
             }
@@ -143,34 +143,6 @@ public:
     }
 
 private:
-    /// Radiance of the environment along a ray that left the scene. With MIS, each infinite
-    /// emitter is weighted against the density with which emitter sampling picks it and this
-    /// direction, since an emitter sample only ever carries the radiance of its own emitter.
-    static Color3f environment(const Scene &scene, const Ray &ray, const Interaction &prev,
-                               float prev_bsdf_pdf, bool prev_bsdf_delta) {
-        const auto &emitters = scene.environment_emitters();
-        if (emitters.empty()) return Color3f(0.f);
-        SurfaceInteraction miss; // t = Infinity, identity shading frame
-        miss.wi = -ray.d;
-        DirectionSample ds;
-        ds.d = ray.d;
-        ds.dist = Infinity;
-        ds.p = prev.p + ray.d;
-        ds.n = -ray.d;
-        Color3f result(0.f);
-        for (const auto &emitter : emitters) {
-            Color3f L = emitter->eval(miss);
-            if (L.is_black()) continue;
-            float w = 1.f;
-            if (!prev_bsdf_delta) {
-                ds.emitter = emitter.get();
-                w = mis_weight(prev_bsdf_pdf, scene.pdf_emitter_direction(prev, ds));
-            }
-            result += L * w;
-        }
-        return result;
-    }
-
     uint32_t m_max_depth;
     uint32_t m_rr_depth;
     bool m_hide_emitters;

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <facet/emitter.h>
 #include <facet/interaction.h>
+#include <facet/scene.h>
 
 #include <cmath>
 
@@ -27,6 +29,36 @@ inline DirectionSample direction_to(const SurfaceInteraction &si, const Interact
     ds.d = ds.dist > 0.f ? d / ds.dist : Vector3f(0.f);
     ds.emitter = si.emitter();
     return ds;
+}
+
+/// Radiance of the infinite emitters along `ray`, which left the scene from `ref` after a BSDF
+/// sample of density `bsdf_pdf`. Each emitter is weighted against the density with which emitter
+/// sampling picks it and this direction (times `emitter_fraction`, the share of emitter samples
+/// when several strategies are mixed), since an emitter sample only ever carries its own
+/// emitter's radiance. After a delta lobe (`delta`) nothing is weighted.
+inline Color3f environment_mis(const Scene &scene, const Ray &ray, const Interaction &ref,
+                               float bsdf_pdf, bool delta, float emitter_fraction = 1.f) {
+    const auto &emitters = scene.environment_emitters();
+    if (emitters.empty()) return Color3f(0.f);
+    SurfaceInteraction miss; // t = Infinity, identity shading frame
+    miss.wi = -ray.d;
+    DirectionSample ds;
+    ds.d = ray.d;
+    ds.dist = Infinity;
+    ds.p = ref.p + ray.d;
+    ds.n = -ray.d;
+    Color3f result(0.f);
+    for (const auto &emitter : emitters) {
+        Color3f L = emitter->eval(miss);
+        if (L.is_black()) continue;
+        float w = 1.f;
+        if (!delta) {
+            ds.emitter = emitter.get();
+            w = mis_weight(bsdf_pdf, scene.pdf_emitter_direction(ref, ds) * emitter_fraction);
+        }
+        result += L * w;
+    }
+    return result;
 }
 
 } // namespace facet
