@@ -16,7 +16,7 @@ constexpr double LambdaMin = 360.0, LambdaMax = 830.0;
 constexpr int IntegrationSteps = 1000;
 /// Integral of the CIE 1931 y-bar curve (Mitsuba's CIE_Y_integral).
 constexpr double CieYIntegral = 106.7502593994140625;
-/// Quadrature weight of one step for unweighted spectra (shared/REFERENCE.md 1.6).
+/// Quadrature weight of one step for unweighted spectra (as Mitsuba's RGB variants integrate them).
 constexpr double StepWeight = (LambdaMax - LambdaMin) / (CieYIntegral * IntegrationSteps);
 
 inline double step_wavelength(int i) {

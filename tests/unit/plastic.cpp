@@ -20,7 +20,7 @@ BSDFContext component_ctx(uint32_t component) {
 /// Polypropylene in air, the defaults.
 const float DefaultEta = 1.49f / 1.000277f;
 
-/// The diffuse lobe's f·cos θo written out (REFERENCE 3.3).
+/// The diffuse lobe's f·cos θo written out (Mitsuba's plastic model).
 float diffuse_closed_form(float rho, float eta, const Vector3f &wi, const Vector3f &wo,
                           bool nonlinear = false) {
     float fdr = fresnel_diffuse_reflectance(1.f / eta);

@@ -51,7 +51,7 @@ std::string error_of(const std::function<void()> &f) {
 } // namespace
 
 TEST(Perspective, Default50mmLens) {
-    // 50 mm on 36x24 mm measured along the diagonal (REFERENCE.md 1.6).
+    // 50 mm on 36x24 mm measured along the diagonal (Mitsuba's focal_length convention).
     EXPECT_NEAR(measured_x_fov(*camera(64, 64)), 34.022, 1e-3);
     EXPECT_NEAR(measured_x_fov(*camera(200, 120)), 40.711, 1e-3);
     Properties p;

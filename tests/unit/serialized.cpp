@@ -27,7 +27,7 @@ template <typename T> void put(std::vector<uint8_t> &out, T v) {
     out.insert(out.end(), bytes, bytes + sizeof(T));
 }
 
-/// Writes meshes in the serialized layout (shared/REFERENCE.md section 8 describes it).
+/// Writes meshes in the serialized layout (Mitsuba's format, versions 3 and 4).
 std::vector<uint8_t> write_serialized(const std::vector<TestMesh> &meshes, uint16_t version, bool dbl) {
     std::vector<uint8_t> file;
     std::vector<uint64_t> offsets;

@@ -1,4 +1,4 @@
-// Spectrum parsing and conversion to RGB (CIE 1931, D65, REFERENCE 1.6 conventions).
+// Spectrum parsing and conversion to RGB (CIE 1931, D65, the conventions of Mitsuba's RGB variants).
 #include <facet/logger.h>
 #include <facet/spectrum.h>
 

@@ -7,7 +7,7 @@
 
 namespace facet {
 
-/// How a spectrum is turned into RGB (shared/REFERENCE.md 1.6).
+/// How a spectrum is turned into RGB (as in Mitsuba 3's RGB variants).
 enum class SpectrumKind {
     Reflectance, ///< weighted by D65, clamped to [0, 1]
     Emission,    ///< unweighted, clamped to >= 0; a uniform value c becomes c·xyz_to_srgb(1,1,1)

@@ -18,7 +18,7 @@ struct LoadOptions {
     std::vector<std::string> search_path;
 };
 
-/// Loads a Mitsuba 3 XML file (shared/REFERENCE.md section 1). The root may be a <scene> or any
+/// Loads a Mitsuba 3 XML file (the whole grammar: objects, properties, transforms, ref, default, include, alias, path). The root may be a <scene> or any
 /// object tag. Errors are facet::Error with file:line:col.
 std::shared_ptr<Object> load_file(const std::string &path, const LoadOptions &opts = {});
 /// The same for XML text; locations read "string:line:col".
