@@ -35,7 +35,8 @@ struct Command {
     int (*run)(int, char **);
 };
 
-/// One line: a multi-line message (a list of unused properties, say) is joined with "; ".
+/// One line: a multi-line message (a list of unused properties, say) is joined with "; " (just
+/// a space after a line that ends in ':', and list dashes dropped).
 std::string one_line(const std::string &msg) {
     std::string out;
     bool pending_separator = false;
@@ -47,7 +48,11 @@ std::string one_line(const std::string &msg) {
         }
         if (pending_separator) {
             if (c == ' ' || c == '\t') continue;
-            out += "; ";
+            if (c == '-' && i + 1 < msg.size() && msg[i + 1] == ' ') {
+                ++i; // "  - item" list lines
+                continue;
+            }
+            out += out.back() == ':' ? " " : "; ";
             pending_separator = false;
         }
         out += c;

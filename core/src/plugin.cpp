@@ -233,6 +233,11 @@ void check_unqueried(const Properties &props, ObjectType kind, bool lenient) {
     std::string msg = fmt::format("Found {} unreferenced propert{} in {} plugin of type \"{}\":",
                                   unused.size(), unused.size() == 1 ? "y" : "ies",
                                   object_type_name(kind), props.plugin_name());
+    // Parameters the plugin asked for but did not get: the likely intended names of typos.
+    std::vector<std::string> missing;
+    const std::vector<std::string> requested = props.requested_names(); // has() may append
+    for (const auto &r : requested)
+        if (!props.has(r)) missing.push_back(r);
     for (const auto &name : unused) {
         std::string entry = props.entry_to_string(name);
         const Location &loc = props.location(name);
@@ -240,6 +245,8 @@ void check_unqueried(const Properties &props, ObjectType kind, bool lenient) {
         size_t colon = entry.find("\": ");
         if (loc.valid() && colon != std::string::npos)
             entry = entry.substr(0, colon + 1) + " (" + loc.to_string() + ")" + entry.substr(colon + 1);
+        std::string suggestion = closest_name(name, missing);
+        if (!suggestion.empty()) entry += fmt::format(" (did you mean \"{}\"?)", suggestion);
         msg += "\n  - " + entry;
     }
     if (!lenient) throw Error(props.location(), msg);

@@ -297,6 +297,8 @@ TEST_F(XmlTest, TypoInParameterIsAnUnqueriedError) {
     EXPECT_TRUE(contains(e.message(), "Found 1 unreferenced property in bsdf plugin of type \"test_strict\""))
         << e.what();
     EXPECT_TRUE(contains(e.message(), "\"alpah\" (string:2:4)")) << e.what();
+    // The parameter the plugin asked for and did not get is offered as the intended name.
+    EXPECT_TRUE(contains(e.message(), "did you mean \"alpha\"?")) << e.what();
 
     // Lenient: a warning instead.
     LoadOptions lenient;
