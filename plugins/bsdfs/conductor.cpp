@@ -35,8 +35,6 @@ most also as <name>_palik, plus Na_palik, Ni_palik and V_palik.
 
 namespace facet {
 
-static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
-
 class Conductor final : public BSDF {
 public:
     explicit Conductor(const Properties &props) {

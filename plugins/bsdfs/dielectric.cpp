@@ -35,8 +35,6 @@ radiance through the change of solid angle); importance transport is not scaled.
 
 namespace facet {
 
-static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
-
 class Dielectric final : public BSDF {
 public:
     explicit Dielectric(const Properties &props) {

@@ -42,8 +42,6 @@ reflects (wrap the BSDF in `twosided` for two-sided surfaces).
 
 namespace facet {
 
-static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
-
 class RoughConductor final : public BSDF {
 public:
     explicit RoughConductor(const Properties &props) {

@@ -43,8 +43,6 @@ scaled. Without visible-normal sampling, normals are drawn from a distribution w
 
 namespace facet {
 
-static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
-
 class RoughDielectric final : public BSDF {
 public:
     explicit RoughDielectric(const Properties &props) {

@@ -31,8 +31,6 @@ and transmits the rest. Both sides of the surface behave alike.
 
 namespace facet {
 
-static bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
-
 class ThinDielectric final : public BSDF {
 public:
     explicit ThinDielectric(const Properties &props) {

@@ -12,36 +12,6 @@ using namespace bsdf_checks;
 
 namespace {
 
-BSDFContext component_ctx(uint32_t component) {
-    BSDFContext ctx;
-    ctx.component = component;
-    return ctx;
-}
-
-std::shared_ptr<BSDF> make_blend(const std::vector<std::shared_ptr<BSDF>> &nested, const Params &params = {}) {
-    Properties props = make_props("blendbsdf", params);
-    for (size_t i = 0; i < nested.size(); ++i) props.set_object("_arg_" + std::to_string(i), nested[i]);
-    return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
-}
-
-void expect_blend_error(const std::vector<std::shared_ptr<BSDF>> &nested, const Params &params,
-                        const std::string &fragment) {
-    try {
-        make_blend(nested, params);
-        ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
-    } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
-}
-
-/// Weight that varies over the surface: u.
-class RampTexture final : public Texture {
-public:
-    Color3f eval(const SurfaceInteraction &si) const override { return Color3f(si.uv.x); }
-    Color3f mean() const override { return Color3f(0.5f); }
-    std::string to_string() const override { return "RampTexture"; }
-};
-
 std::shared_ptr<BSDF> rough_conductor(double alpha = 0.2) {
     return make_bsdf("roughconductor", {{"alpha", alpha}});
 }
@@ -49,7 +19,7 @@ std::shared_ptr<BSDF> rough_conductor(double alpha = 0.2) {
 } // namespace
 
 TEST(BlendBSDF, CreationAndFlags) {
-    auto bsdf = make_blend({make_bsdf("plastic"), rough_conductor()}, {{"weight", 0.3}});
+    auto bsdf = make_nested("blendbsdf", {make_bsdf("plastic"), rough_conductor()}, {{"weight", 0.3}});
     ASSERT_EQ(bsdf->component_count(), 3u);
     EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
@@ -72,13 +42,13 @@ TEST(BlendBSDF, CreationAndFlags) {
 
 TEST(BlendBSDF, RejectsBadParameters) {
     auto d = make_bsdf("diffuse");
-    expect_blend_error({}, {}, "exactly two nested BSDFs, found 0");
-    expect_blend_error({d}, {}, "exactly two nested BSDFs, found 1");
-    expect_blend_error({d, d, d}, {}, "found a third");
-    expect_blend_error({d, d}, {{"weight", 1.5}}, "weight must be in [0, 1], found 1.5");
-    expect_blend_error({d, d}, {{"weight", -0.5}}, "weight must be in [0, 1]");
-    expect_blend_error({d, d}, {{"weight", std::string("half")}}, "weight");
-    expect_blend_error({d, d}, {{"opacity", 0.5}}, "opacity");
+    expect_nested_error("blendbsdf", {}, {}, "exactly two nested BSDFs, found 0");
+    expect_nested_error("blendbsdf", {d}, {}, "exactly two nested BSDFs, found 1");
+    expect_nested_error("blendbsdf", {d, d, d}, {}, "found a third");
+    expect_nested_error("blendbsdf", {d, d}, {{"weight", 1.5}}, "weight must be in [0, 1], found 1.5");
+    expect_nested_error("blendbsdf", {d, d}, {{"weight", -0.5}}, "weight must be in [0, 1]");
+    expect_nested_error("blendbsdf", {d, d}, {{"weight", std::string("half")}}, "weight");
+    expect_nested_error("blendbsdf", {d, d}, {{"opacity", 0.5}}, "opacity");
 }
 
 TEST(BlendBSDF, ExtremeWeightsSelectOneBSDF) {
@@ -86,7 +56,7 @@ TEST(BlendBSDF, ExtremeWeightsSelectOneBSDF) {
     auto second = rough_conductor(0.1);
     PCG32 rng(3);
     for (double w : {0.0, 1.0}) {
-        auto bsdf = make_blend({first, second}, {{"weight", w}});
+        auto bsdf = make_nested("blendbsdf", {first, second}, {{"weight", w}});
         const auto &only = w == 0.0 ? first : second;
         for (int i = 0; i < 200; ++i) {
             Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -106,7 +76,7 @@ TEST(BlendBSDF, ExtremeWeightsSelectOneBSDF) {
 TEST(BlendBSDF, EvalAndPdfAreBlended) {
     auto first = make_bsdf("diffuse", {{"reflectance", Color3f(0.9f, 0.5f, 0.1f)}});
     auto second = rough_conductor(0.3);
-    auto bsdf = make_blend({first, second}, {{"weight", 0.35}});
+    auto bsdf = make_nested("blendbsdf", {first, second}, {{"weight", 0.35}});
     PCG32 rng(4);
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -123,7 +93,7 @@ TEST(BlendBSDF, EvalAndPdfAreBlended) {
 TEST(BlendBSDF, DeltaSamplesKeepTheirWeight) {
     // A delta lobe of one BSDF: probability scaled by its selection probability, weight unchanged.
     auto plastic = make_bsdf("plastic");
-    auto bsdf = make_blend({make_bsdf("diffuse"), plastic}, {{"weight", 0.5}});
+    auto bsdf = make_nested("blendbsdf", {make_bsdf("diffuse"), plastic}, {{"weight", 0.5}});
     SurfaceInteraction si = make_si(direction_from_angles(70.f, 0.f));
     // sample1 = 0.01 picks the second BSDF (u = 0.02), which then takes its mirror lobe.
     auto [bs, weight] = bsdf->sample(BSDFContext(), si, 0.01f, Point2f(0.3f, 0.3f));
@@ -138,7 +108,7 @@ TEST(BlendBSDF, DeltaSamplesKeepTheirWeight) {
 TEST(BlendBSDF, ComponentsAreRouted) {
     auto first = make_bsdf("plastic");
     auto second = rough_conductor(0.3);
-    auto bsdf = make_blend({first, second}, {{"weight", 0.25}});
+    auto bsdf = make_nested("blendbsdf", {first, second}, {{"weight", 0.25}});
     SurfaceInteraction si = make_si(direction_from_angles(45.f, 0.f));
     Vector3f wo = direction_from_angles(45.f, 180.f);
     // Component 2 is the conductor's component 0, weighted by 0.25, with its own pdf.
@@ -179,17 +149,17 @@ TEST(BlendBSDF, TexturedWeightIsEvaluatedPerPoint) {
 
 TEST(BlendBSDF, SampleWeightMatchesEvalPdf) {
     std::vector<std::shared_ptr<BSDF>> bsdfs = {
-        make_blend({make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
-        make_blend({make_bsdf("roughdielectric", {{"alpha", 0.5}}), make_bsdf("diffuse")}, {{"weight", 0.6}}),
-        make_blend({rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})}, {{"weight", 0.5}}),
-        make_blend({make_bsdf("plastic"), make_bsdf("roughplastic", {{"alpha", 0.1}})}, {{"weight", 0.8}}),
+        make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
+        make_nested("blendbsdf", {make_bsdf("roughdielectric", {{"alpha", 0.5}}), make_bsdf("diffuse")}, {{"weight", 0.6}}),
+        make_nested("blendbsdf", {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})}, {{"weight", 0.5}}),
+        make_nested("blendbsdf", {make_bsdf("plastic"), make_bsdf("roughplastic", {{"alpha", 0.1}})}, {{"weight", 0.8}}),
     };
     for (const auto &bsdf : bsdfs)
         EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 5), 500) << bsdf->to_string();
 }
 
 TEST(BlendBSDF, ReciprocityAndFurnace) {
-    auto bsdf = make_blend({make_bsdf("roughplastic", {{"alpha", 0.2}}), rough_conductor(0.3)}, {{"weight", 0.4}});
+    auto bsdf = make_nested("blendbsdf", {make_bsdf("roughplastic", {{"alpha", 0.2}}), rough_conductor(0.3)}, {{"weight", 0.4}});
     PCG32 rng(9);
     for (int i = 0; i < 300; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -198,10 +168,10 @@ TEST(BlendBSDF, ReciprocityAndFurnace) {
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(f_io[c], f_oi[c], 1e-4f * std::max(f_io[c], f_oi[c]) + 1e-7f);
     }
     // Two white diffuse BSDFs blend to a white one; mixed ones stay below one.
-    auto white = make_blend({make_bsdf("diffuse", {{"reflectance", 1.0}}), make_bsdf("diffuse", {{"reflectance", 1.0}})},
+    auto white = make_nested("blendbsdf", {make_bsdf("diffuse", {{"reflectance", 1.0}}), make_bsdf("diffuse", {{"reflectance", 1.0}})},
                             {{"weight", 0.2}});
     EXPECT_NEAR(furnace(*white, BSDFContext(), direction_from_angles(30.f, 0.f), 20000).r, 1.f, 1e-4f);
-    auto glass = make_blend({make_bsdf("roughdielectric", {{"alpha", 0.3}}), rough_conductor(0.3)}, {{"weight", 0.5}});
+    auto glass = make_nested("blendbsdf", {make_bsdf("roughdielectric", {{"alpha", 0.3}}), rough_conductor(0.3)}, {{"weight", 0.5}});
     for (float theta : {10.f, 60.f, 120.f})
         EXPECT_LE(furnace(*glass, BSDFContext(), direction_from_angles(theta, 0.f), 20000).max(), 1.f + 5e-3f);
 }
@@ -230,20 +200,20 @@ void chi2_blend(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32_t 
 } // namespace
 
 TEST(BSDFSampling, BlendDiffuseRoughConductor) {
-    chi2_blend(make_blend({make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
+    chi2_blend(make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
                direction_from_angles(50.f, 0.f), 0, "diffuse_roughconductor");
 }
 TEST(BSDFSampling, BlendRoughConductorRoughDielectric) {
-    chi2_blend(make_blend({rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})}, {{"weight", 0.5}}),
+    chi2_blend(make_nested("blendbsdf", {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})}, {{"weight", 0.5}}),
                direction_from_angles(30.f, 45.f), 1, "roughconductor_roughdielectric");
 }
 TEST(BSDFSampling, BlendWithDeltaLobes) {
-    chi2_blend(make_blend({make_bsdf("plastic"), make_bsdf("roughplastic", {{"distribution", std::string("ggx")},
+    chi2_blend(make_nested("blendbsdf", {make_bsdf("plastic"), make_bsdf("roughplastic", {{"distribution", std::string("ggx")},
                                                                              {"alpha", 0.3}})},
                           {{"weight", 0.6}}),
                direction_from_angles(20.f, 0.f), 2, "plastic_roughplastic");
 }
 TEST(BSDFSampling, BlendSecondComponent) {
-    chi2_blend(make_blend({make_bsdf("diffuse"), rough_conductor(0.3)}, {{"weight", 0.7}}),
+    chi2_blend(make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.3)}, {{"weight", 0.7}}),
                direction_from_angles(65.f, 0.f), 3, "second_component", component_ctx(1));
 }

@@ -8,6 +8,7 @@
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/random.h>
+#include <facet/texture.h>
 #include <facet/warp.h>
 
 #include <gtest/gtest.h>
@@ -46,6 +47,41 @@ inline void expect_error(const std::string &plugin, const Params &params,
             << plugin << ": message \"" << e.what() << "\" lacks \"" << fragment << "\"";
     }
 }
+
+/// A BSDF built around nested BSDFs (twosided, mask, blendbsdf), passed as `_arg_N` children.
+inline std::shared_ptr<BSDF> make_nested(const std::string &plugin,
+                                         const std::vector<std::shared_ptr<BSDF>> &nested,
+                                         const Params &params = {}) {
+    Properties props = make_props(plugin, params);
+    for (size_t i = 0; i < nested.size(); ++i) props.set_object("_arg_" + std::to_string(i), nested[i]);
+    return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
+}
+
+/// expect_error() for a BSDF with nested BSDFs.
+inline void expect_nested_error(const std::string &plugin, const std::vector<std::shared_ptr<BSDF>> &nested,
+                                const Params &params, const std::string &fragment) {
+    try {
+        make_nested(plugin, nested, params);
+        ADD_FAILURE() << plugin << ": expected an error containing \"" << fragment << "\"";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+
+/// A context that enables only component `component`.
+inline BSDFContext component_ctx(uint32_t component, TransportMode mode = TransportMode::Radiance) {
+    BSDFContext ctx(mode);
+    ctx.component = component;
+    return ctx;
+}
+
+/// A texture that varies over the surface: its value is u.
+class RampTexture final : public Texture {
+public:
+    Color3f eval(const SurfaceInteraction &si) const override { return Color3f(si.uv.x); }
+    Color3f mean() const override { return Color3f(0.5f); }
+    std::string to_string() const override { return "RampTexture"; }
+};
 
 inline SurfaceInteraction make_si(const Vector3f &wi) {
     SurfaceInteraction si;

@@ -9,16 +9,6 @@
 using namespace facet;
 using namespace bsdf_checks;
 
-namespace {
-
-BSDFContext component_ctx(uint32_t component, TransportMode mode = TransportMode::Radiance) {
-    BSDFContext ctx(mode);
-    ctx.component = component;
-    return ctx;
-}
-
-} // namespace
-
 TEST(Dielectric, CreationAndFlags) {
     auto bsdf = make_bsdf("dielectric");
     ASSERT_EQ(bsdf->component_count(), 2u);

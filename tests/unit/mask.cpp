@@ -11,42 +11,12 @@ using namespace bsdf_checks;
 
 namespace {
 
-BSDFContext component_ctx(uint32_t component) {
-    BSDFContext ctx;
-    ctx.component = component;
-    return ctx;
-}
-
-std::shared_ptr<BSDF> make_mask(const std::vector<std::shared_ptr<BSDF>> &nested, const Params &params = {}) {
-    Properties props = make_props("mask", params);
-    for (size_t i = 0; i < nested.size(); ++i) props.set_object("_arg_" + std::to_string(i), nested[i]);
-    return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
-}
-
-void expect_mask_error(const std::vector<std::shared_ptr<BSDF>> &nested, const Params &params,
-                       const std::string &fragment) {
-    try {
-        make_mask(nested, params);
-        ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
-    } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
-}
-
-/// Opacity that varies over the surface: u.
-class RampTexture final : public Texture {
-public:
-    Color3f eval(const SurfaceInteraction &si) const override { return Color3f(si.uv.x); }
-    Color3f mean() const override { return Color3f(0.5f); }
-    std::string to_string() const override { return "RampTexture"; }
-};
-
 std::shared_ptr<BSDF> rough_conductor() { return make_bsdf("roughconductor", {{"alpha", 0.3}}); }
 
 } // namespace
 
 TEST(Mask, CreationAndFlags) {
-    auto bsdf = make_mask({make_bsdf("plastic")});
+    auto bsdf = make_nested("mask", {make_bsdf("plastic")});
     ASSERT_EQ(bsdf->component_count(), 3u);
     EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
@@ -66,17 +36,17 @@ TEST(Mask, CreationAndFlags) {
 }
 
 TEST(Mask, RejectsBadParameters) {
-    expect_mask_error({}, {}, "mask needs a nested BSDF");
+    expect_nested_error("mask", {}, {}, "mask needs a nested BSDF");
     auto d = make_bsdf("diffuse");
-    expect_mask_error({d, d}, {}, "exactly one nested BSDF");
-    expect_mask_error({d}, {{"opacity", 1.5}}, "opacity must be in [0, 1], found 1.5");
-    expect_mask_error({d}, {{"opacity", -0.1}}, "opacity must be in [0, 1]");
-    expect_mask_error({d}, {{"opacity", std::string("half")}}, "opacity");
-    expect_mask_error({d}, {{"alpha", 0.5}}, "alpha");
+    expect_nested_error("mask", {d, d}, {}, "exactly one nested BSDF");
+    expect_nested_error("mask", {d}, {{"opacity", 1.5}}, "opacity must be in [0, 1], found 1.5");
+    expect_nested_error("mask", {d}, {{"opacity", -0.1}}, "opacity must be in [0, 1]");
+    expect_nested_error("mask", {d}, {{"opacity", std::string("half")}}, "opacity");
+    expect_nested_error("mask", {d}, {{"alpha", 0.5}}, "alpha");
 }
 
 TEST(Mask, OpacityZeroIsPureNullTransmission) {
-    auto bsdf = make_mask({rough_conductor()}, {{"opacity", 0.0}});
+    auto bsdf = make_nested("mask", {rough_conductor()}, {{"opacity", 0.0}});
     PCG32 rng(2);
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, false), wo = random_direction(rng, false);
@@ -96,7 +66,7 @@ TEST(Mask, OpacityZeroIsPureNullTransmission) {
 
 TEST(Mask, OpacityOneIsTheNestedBSDF) {
     auto nested = rough_conductor();
-    auto bsdf = make_mask({nested}, {{"opacity", 1.0}});
+    auto bsdf = make_nested("mask", {nested}, {{"opacity", 1.0}});
     PCG32 rng(3);
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -116,7 +86,7 @@ TEST(Mask, OpacityOneIsTheNestedBSDF) {
 
 TEST(Mask, EvalAndPdfScaleWithOpacity) {
     auto nested = make_bsdf("roughplastic", {{"alpha", 0.2}});
-    auto bsdf = make_mask({nested}, {{"opacity", 0.3}});
+    auto bsdf = make_nested("mask", {nested}, {{"opacity", 0.3}});
     PCG32 rng(4);
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -143,7 +113,7 @@ TEST(Mask, EvalAndPdfScaleWithOpacity) {
 
 TEST(Mask, SinglePartContexts) {
     auto nested = rough_conductor();
-    auto bsdf = make_mask({nested}, {{"opacity", 0.25}});
+    auto bsdf = make_nested("mask", {nested}, {{"opacity", 0.25}});
     SurfaceInteraction si = make_si(direction_from_angles(40.f, 30.f));
     // Pass-through alone (component 1): always taken, weight 1 − opacity.
     auto [bs, weight] = bsdf->sample(component_ctx(1), si, 0.1f, Point2f(0.3f, 0.6f));
@@ -188,7 +158,7 @@ TEST(Mask, TexturedOpacityIsEvaluatedPerPoint) {
 TEST(Mask, SampleWeightMatchesEvalPdf) {
     for (auto nested : {rough_conductor(), make_bsdf("plastic"), make_bsdf("roughplastic"),
                         make_bsdf("roughdielectric", {{"alpha", 0.3}})}) {
-        auto bsdf = make_mask({nested}, {{"opacity", 0.6}});
+        auto bsdf = make_nested("mask", {nested}, {{"opacity", 0.6}});
         EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 4), 300) << nested->to_string();
     }
 }
@@ -196,10 +166,10 @@ TEST(Mask, SampleWeightMatchesEvalPdf) {
 TEST(Mask, WhiteFurnace) {
     // Pass-through carries 1 − opacity, the nested BSDF opacity × its albedo.
     auto nested = make_bsdf("diffuse", {{"reflectance", 0.8}});
-    auto bsdf = make_mask({nested}, {{"opacity", 0.4}});
+    auto bsdf = make_nested("mask", {nested}, {{"opacity", 0.4}});
     Color3f albedo = furnace(*bsdf, BSDFContext(), direction_from_angles(35.f, 0.f), 40000);
     EXPECT_NEAR(albedo.r, 0.6f + 0.4f * 0.8f, 0.01f);
-    auto glass = make_mask({make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"opacity", 0.5}});
+    auto glass = make_nested("mask", {make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"opacity", 0.5}});
     for (float theta : {10.f, 60.f, 120.f})
         EXPECT_LE(furnace(*glass, BSDFContext(), direction_from_angles(theta, 0.f), 20000).max(),
                   1.f + 5e-3f) << theta;
@@ -217,7 +187,7 @@ TEST(Mask, LoadsFromXml) {
 namespace {
 void chi2_mask(const std::shared_ptr<BSDF> &nested, double opacity, const Vector3f &wi, uint32_t seed,
                const std::string &name, const BSDFContext &ctx = {}) {
-    BSDFAdapter adapter(make_mask({nested}, {{"opacity", opacity}}), wi, ctx);
+    BSDFAdapter adapter(make_nested("mask", {nested}, {{"opacity", opacity}}), wi, ctx);
     Chi2Options opts;
     opts.samples = 200000;
     opts.seed = seed;

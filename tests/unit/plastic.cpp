@@ -11,12 +11,6 @@ using namespace bsdf_checks;
 
 namespace {
 
-BSDFContext component_ctx(uint32_t component) {
-    BSDFContext ctx;
-    ctx.component = component;
-    return ctx;
-}
-
 /// Polypropylene in air, the defaults.
 const float DefaultEta = 1.49f / 1.000277f;
 

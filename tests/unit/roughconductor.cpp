@@ -13,13 +13,13 @@ using namespace bsdf_checks;
 namespace {
 
 /// A roughness that varies over the surface: 0.05 + 0.5·u.
-class RampTexture final : public Texture {
+class RoughnessRamp final : public Texture {
 public:
     Color3f eval(const SurfaceInteraction &si) const override {
         return Color3f(0.05f + 0.5f * si.uv.x);
     }
     Color3f mean() const override { return Color3f(0.3f); }
-    std::string to_string() const override { return "RampTexture"; }
+    std::string to_string() const override { return "RoughnessRamp"; }
 };
 
 struct Config {
@@ -164,7 +164,7 @@ TEST(RoughConductor, WhiteFurnaceAtMostOne) {
 
 TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
     Properties props("roughconductor");
-    props.set_object("alpha", std::make_shared<RampTexture>());
+    props.set_object("alpha", std::make_shared<RoughnessRamp>());
     auto textured = PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
     EXPECT_TRUE(has_flag(textured->flags(), BSDFFlags::GlossyReflection));
     EXPECT_FALSE(has_flag(textured->flags(), BSDFFlags::Anisotropic));
@@ -188,7 +188,7 @@ TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
     }
     // Separate textures for alpha_u and alpha_v make it anisotropic.
     Properties aniso("roughconductor");
-    aniso.set_object("alpha_u", std::make_shared<RampTexture>());
+    aniso.set_object("alpha_u", std::make_shared<RoughnessRamp>());
     aniso.set_float("alpha_v", 0.1);
     EXPECT_TRUE(
         has_flag(PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, aniso)->flags(),

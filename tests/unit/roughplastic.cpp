@@ -12,12 +12,6 @@ using namespace bsdf_checks;
 
 namespace {
 
-BSDFContext component_ctx(uint32_t component) {
-    BSDFContext ctx;
-    ctx.component = component;
-    return ctx;
-}
-
 const float DefaultEta = 1.49f / 1.000277f;
 
 struct Config {

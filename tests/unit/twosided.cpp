@@ -12,29 +12,6 @@ using namespace bsdf_checks;
 
 namespace {
 
-BSDFContext component_ctx(uint32_t component) {
-    BSDFContext ctx;
-    ctx.component = component;
-    return ctx;
-}
-
-std::shared_ptr<BSDF> make_twosided(const std::vector<std::shared_ptr<BSDF>> &nested,
-                                    const Params &params = {}) {
-    Properties props = make_props("twosided", params);
-    for (size_t i = 0; i < nested.size(); ++i) props.set_object("_arg_" + std::to_string(i), nested[i]);
-    return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
-}
-
-void expect_twosided_error(const std::vector<std::shared_ptr<BSDF>> &nested, const Params &params,
-                           const std::string &fragment) {
-    try {
-        make_twosided(nested, params);
-        ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
-    } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
-}
-
 Vector3f mirror(const Vector3f &v) { return {v.x, v.y, -v.z}; }
 
 std::shared_ptr<BSDF> rough_conductor(double alpha) {
@@ -45,7 +22,7 @@ std::shared_ptr<BSDF> rough_conductor(double alpha) {
 
 TEST(TwoSided, CreationAndFlags) {
     auto diffuse = make_bsdf("diffuse");
-    auto one = make_twosided({diffuse});
+    auto one = make_nested("twosided", {diffuse});
     ASSERT_EQ(one->component_count(), 2u);
     EXPECT_EQ(one->flags(0), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(one->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::BackSide);
@@ -53,7 +30,7 @@ TEST(TwoSided, CreationAndFlags) {
     EXPECT_NE(one->to_string().find("TwoSided"), std::string::npos);
     EXPECT_NE(one->to_string().find("Diffuse"), std::string::npos);
 
-    auto two = make_twosided({make_bsdf("plastic"), rough_conductor(0.2)});
+    auto two = make_nested("twosided", {make_bsdf("plastic"), rough_conductor(0.2)});
     ASSERT_EQ(two->component_count(), 3u);
     EXPECT_EQ(two->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(two->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
@@ -61,7 +38,7 @@ TEST(TwoSided, CreationAndFlags) {
     EXPECT_NE(two->to_string().find("back"), std::string::npos);
 
     // A front-and-back BSDF has its side flags replaced per half.
-    auto glass = make_twosided({make_bsdf("dielectric")}, {{"allow_transmission", true}});
+    auto glass = make_nested("twosided", {make_bsdf("dielectric")}, {{"allow_transmission", true}});
     ASSERT_EQ(glass->component_count(), 4u);
     EXPECT_EQ(glass->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(glass->flags(3), BSDFFlags::DeltaTransmission | BSDFFlags::BackSide | BSDFFlags::NonSymmetric);
@@ -76,13 +53,13 @@ TEST(TwoSided, CreationAndFlags) {
 }
 
 TEST(TwoSided, RejectsBadNesting) {
-    expect_twosided_error({}, {}, "twosided needs a nested BSDF");
+    expect_nested_error("twosided", {}, {}, "twosided needs a nested BSDF");
     auto d = make_bsdf("diffuse");
-    expect_twosided_error({d, d, d}, {}, "at most two nested BSDFs");
-    expect_twosided_error({make_bsdf("dielectric")}, {}, "unless allow_transmission is true");
-    expect_twosided_error({d, make_bsdf("roughdielectric")}, {}, "transmits light");
-    expect_twosided_error({d}, {{"allow_transmission", std::string("yes")}}, "allow_transmission");
-    expect_twosided_error({d}, {{"reflectance", 0.3}}, "reflectance");
+    expect_nested_error("twosided", {d, d, d}, {}, "at most two nested BSDFs");
+    expect_nested_error("twosided", {make_bsdf("dielectric")}, {}, "unless allow_transmission is true");
+    expect_nested_error("twosided", {d, make_bsdf("roughdielectric")}, {}, "transmits light");
+    expect_nested_error("twosided", {d}, {{"allow_transmission", std::string("yes")}}, "allow_transmission");
+    expect_nested_error("twosided", {d}, {{"reflectance", 0.3}}, "reflectance");
     // A nested object that is not a BSDF is not silently ignored.
     Properties props("twosided");
     props.set_object("_arg_0", d);
@@ -94,7 +71,7 @@ TEST(TwoSided, BackSideIsTheMirroredFrontSide) {
     PCG32 rng(3);
     for (auto nested : {make_bsdf("diffuse", {{"reflectance", Color3f(0.2f, 0.5f, 0.7f)}}),
                         rough_conductor(0.3), make_bsdf("plastic"), make_bsdf("roughplastic")}) {
-        auto bsdf = make_twosided({nested});
+        auto bsdf = make_nested("twosided", {nested});
         for (int i = 0; i < 300; ++i) {
             Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
             SurfaceInteraction front = make_si(wi), back = make_si(mirror(wi));
@@ -128,7 +105,7 @@ TEST(TwoSided, BackSideIsTheMirroredFrontSide) {
 TEST(TwoSided, SecondBSDFOnTheBack) {
     auto front = make_bsdf("diffuse", {{"reflectance", 0.8}});
     auto back = rough_conductor(0.2);
-    auto bsdf = make_twosided({front, back});
+    auto bsdf = make_nested("twosided", {front, back});
     PCG32 rng(4);
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -144,7 +121,7 @@ TEST(TwoSided, SecondBSDFOnTheBack) {
 
 TEST(TwoSided, ComponentIndicesAreShifted) {
     // Components: 0, 1 = plastic's mirror and diffuse lobes (front); 2 = roughconductor (back).
-    auto bsdf = make_twosided({make_bsdf("plastic"), rough_conductor(0.3)});
+    auto bsdf = make_nested("twosided", {make_bsdf("plastic"), rough_conductor(0.3)});
     Vector3f wi = direction_from_angles(40.f, 10.f), wo = direction_from_angles(35.f, 200.f);
     SurfaceInteraction front = make_si(wi), back = make_si(mirror(wi));
     // Front components do not answer from the back, and the other way round.
@@ -169,11 +146,11 @@ TEST(TwoSided, ComponentIndicesAreShifted) {
 
 TEST(TwoSided, SampleWeightMatchesEvalPdf) {
     std::vector<std::shared_ptr<BSDF>> bsdfs = {
-        make_twosided({make_bsdf("diffuse")}),
-        make_twosided({rough_conductor(0.1)}),
-        make_twosided({make_bsdf("roughplastic", {{"distribution", std::string("ggx")}, {"alpha", 0.3}}),
+        make_nested("twosided", {make_bsdf("diffuse")}),
+        make_nested("twosided", {rough_conductor(0.1)}),
+        make_nested("twosided", {make_bsdf("roughplastic", {{"distribution", std::string("ggx")}, {"alpha", 0.3}}),
                        make_bsdf("plastic")}),
-        make_twosided({make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"allow_transmission", true}}),
+        make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"allow_transmission", true}}),
     };
     for (const auto &bsdf : bsdfs) {
         EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 5), 1000) << bsdf->to_string();
@@ -184,7 +161,7 @@ TEST(TwoSided, SampleWeightMatchesEvalPdf) {
 
 TEST(TwoSided, ReciprocityOnBothSides) {
     PCG32 rng(8);
-    auto bsdf = make_twosided({rough_conductor(0.3), make_bsdf("roughplastic")});
+    auto bsdf = make_nested("twosided", {rough_conductor(0.3), make_bsdf("roughplastic")});
     for (int i = 0; i < 300; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
         if (i % 2) {
@@ -199,12 +176,12 @@ TEST(TwoSided, ReciprocityOnBothSides) {
 }
 
 TEST(TwoSided, WhiteFurnaceOnBothSides) {
-    auto bsdf = make_twosided({make_bsdf("diffuse", {{"reflectance", 1.0}})});
+    auto bsdf = make_nested("twosided", {make_bsdf("diffuse", {{"reflectance", 1.0}})});
     for (float theta : {0.f, 50.f, 130.f, 180.f}) {
         Color3f albedo = furnace(*bsdf, BSDFContext(), direction_from_angles(theta, 30.f), 20000);
         EXPECT_NEAR(albedo.r, 1.f, 1e-5f) << theta;
     }
-    auto mirror_ish = make_twosided({make_bsdf("roughconductor", {{"alpha", 0.2}})});
+    auto mirror_ish = make_nested("twosided", {make_bsdf("roughconductor", {{"alpha", 0.2}})});
     for (float theta : {20.f, 160.f}) {
         Color3f albedo = furnace(*mirror_ish, BSDFContext(), direction_from_angles(theta, 30.f), 20000);
         EXPECT_LE(albedo.max(), 1.f + 5e-3f) << theta;
@@ -236,16 +213,16 @@ void chi2_twosided(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32
 } // namespace
 
 TEST(BSDFSampling, TwoSidedFromTheBack) {
-    chi2_twosided(make_twosided({rough_conductor(0.3)}), normalize(Vector3f(0.3f, 0.2f, -0.7f)), 0,
+    chi2_twosided(make_nested("twosided", {rough_conductor(0.3)}), normalize(Vector3f(0.3f, 0.2f, -0.7f)), 0,
                   "roughconductor_back");
-    chi2_twosided(make_twosided({make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
+    chi2_twosided(make_nested("twosided", {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
                   direction_from_angles(120.f, 40.f), 1, "roughplastic_back");
 }
 TEST(BSDFSampling, TwoSidedBackComponent) {
-    chi2_twosided(make_twosided({make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
+    chi2_twosided(make_nested("twosided", {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
                   direction_from_angles(140.f, 40.f), 2, "back_diffuse_component", component_ctx(2));
 }
 TEST(BSDFSampling, TwoSidedTransmission) {
-    chi2_twosided(make_twosided({make_bsdf("roughdielectric", {{"alpha", 0.4}})}, {{"allow_transmission", true}}),
+    chi2_twosided(make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.4}})}, {{"allow_transmission", true}}),
                   direction_from_angles(150.f, 0.f), 3, "roughdielectric_back");
 }

@@ -4,6 +4,8 @@
 #include <facet/interaction.h>
 #include <facet/object.h>
 
+#include <memory>
+
 namespace facet {
 
 /// A spatially varying quantity, evaluated at a surface interaction (usually by its uv).
@@ -18,6 +20,9 @@ public:
     virtual float max() const { return mean().max(); }
     virtual bool is_spatially_varying() const { return true; }
 };
+
+/// True for a texture that is present and varies over the surface (sets BSDFFlags::SpatiallyVarying).
+inline bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
 
 /// The texture behind a plain number, rgb or spectrum parameter.
 class ConstantTexture final : public Texture {
