@@ -113,7 +113,8 @@ EmbreeLoop embree_loop(const Scene &scene, const std::vector<Hit> &hits, uint64_
             [](uint64_t a, uint64_t b) { return a + b; });
     });
     EmbreeLoop result;
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.hits = hit_count;
     return result;
 }
@@ -149,8 +150,9 @@ int bench_main(int argc, char **argv) {
     std::atomic<bool> cancel{false};
     ropts.cancel = &cancel;
 
-    fmt::print("bench {}: {}x{} pixels, {} spp, {} thread{}\n", opts.scene, sensor.film().crop_size().x,
-               sensor.film().crop_size().y, spp, threads, threads == 1 ? "" : "s");
+    fmt::print("bench {}: {}x{} pixels, {} spp, {} thread{}\n", opts.scene,
+               sensor.film().crop_size().x, sensor.film().crop_size().y, spp, threads,
+               threads == 1 ? "" : "s");
     std::fflush(stdout);
 
     install_interrupt_handler(&cancel);

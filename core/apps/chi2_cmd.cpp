@@ -39,8 +39,10 @@ void add_common(CLI::App &app, CommonOptions &o) {
     app.add_option("--seed", o.seed, "Seed; sample i uses a PCG32 seeded from tea_hash(i, seed)");
     app.add_option("--tests", o.tests,
                    "Number of tests run together: the level is Sidak-corrected (default 1)");
-    app.add_option("--significance", o.significance, "Family-wise significance level (default 0.01)");
-    app.add_option("--ires", o.ires, "Simpson points per axis and cell of the fixed rule (default 7)");
+    app.add_option("--significance", o.significance,
+                   "Family-wise significance level (default 0.01)");
+    app.add_option("--ires", o.ires,
+                   "Simpson points per axis and cell of the fixed rule (default 7)");
     app.add_flag("--adaptive", o.adaptive, "Integrate the pdf with adaptive Simpson (the default)");
     app.add_flag("--fixed", o.fixed,
                  "Integrate the pdf with the fixed Simpson rule on --ires points (faster, but "
@@ -48,7 +50,8 @@ void add_common(CLI::App &app, CommonOptions &o) {
     app.add_option("--out", o.out,
                    "Write the heat map (PNG) and tables here, also when the test passes "
                    "(failures always go to ./chi2-failures)");
-    app.add_option("-a", o.plugin_dirs, "Add folders to the plugin search path (';' separates several)");
+    app.add_option("-a", o.plugin_dirs,
+                   "Add folders to the plugin search path (';' separates several)");
     app.add_flag("-q,--quiet", o.quiet, "Print only the verdict line");
 }
 
@@ -60,7 +63,8 @@ std::vector<float> parse_floats(const std::string &text, size_t count, const cha
         try {
             size_t used = 0;
             values.push_back(std::stof(item, &used));
-            if (item.find_first_not_of(" \t", used) != std::string::npos) throw std::invalid_argument("");
+            if (item.find_first_not_of(" \t", used) != std::string::npos)
+                throw std::invalid_argument("");
         } catch (const std::exception &) {
             FACET_THROW("{} \"{}\": expected {} comma-separated numbers", what, text, count);
         }
@@ -81,7 +85,8 @@ void add_plugin_dirs(const std::vector<std::string> &values) {
         size_t start = 0;
         while (start <= value.size()) {
             size_t end = std::min(value.find(';', start), value.size());
-            if (end > start) PluginRegistry::instance().add_search_dir(value.substr(start, end - start));
+            if (end > start)
+                PluginRegistry::instance().add_search_dir(value.substr(start, end - start));
             start = end + 1;
         }
     }
@@ -93,7 +98,7 @@ std::string slug(const std::string &kind, const std::string &name, const std::st
     for (unsigned char c : everything) h = (h ^ c) * 16777619u;
     std::string base = kind + "-" + name;
     for (char &c : base)
-        if (!std::isalnum((unsigned char) c) && c != '-' && c != '_') c = '_';
+        if (!std::isalnum((unsigned char)c) && c != '-' && c != '_') c = '_';
     return fmt::format("{}-{:08x}", base.substr(0, 48), h);
 }
 
@@ -150,14 +155,16 @@ int chi2_main(int argc, char **argv) {
     std::vector<std::string> bsdf_params;
     float theta = 30.f, phi = 0.f;
     int component = -1;
-    CLI::App *bsdf = app.add_subcommand("bsdf", "Test a BSDF: facet chi2 bsdf <name> [key=value ...]");
+    CLI::App *bsdf =
+        app.add_subcommand("bsdf", "Test a BSDF: facet chi2 bsdf <name> [key=value ...]");
     bsdf->add_option("name", bsdf_name, "BSDF plugin name");
     bsdf->add_option("params", bsdf_params,
                      "Parameters key=value (type inferred: number -> float, true/false -> boolean, "
                      "r,g,b -> rgb, else string) or type:key=value (e.g. integer:n=3)");
     bsdf->add_option("--xml", xml, "The BSDF as XML text or an .xml file (instead of a name)");
     bsdf->add_option("--wi", wi_text, "Incident direction x,y,z in the local frame (normalised)");
-    auto theta_opt = bsdf->add_option("--theta", theta, "Incident polar angle in degrees (default 30)");
+    auto theta_opt =
+        bsdf->add_option("--theta", theta, "Incident polar angle in degrees (default 30)");
     bsdf->add_option("--phi", phi, "Incident azimuth in degrees (default 0)");
     bsdf->add_option("--component", component, "Test only this component (lobe) index");
     bsdf->add_option("--mode", mode, "Transport mode: radiance (default) or importance");
@@ -168,12 +175,14 @@ int chi2_main(int argc, char **argv) {
     std::string emitter_name, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
     std::vector<std::string> emitter_params;
     CLI::App *emitter = app.add_subcommand(
-        "emitter", "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
+        "emitter",
+        "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
     emitter->add_option("name", emitter_name, "Emitter plugin name")->required();
     emitter->add_option("params", emitter_params, "Parameters, as for bsdf");
     emitter->add_option("--ref", ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
-    emitter->add_option("--shape", shape,
-                        "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
+    emitter->add_option(
+        "--shape", shape,
+        "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
     add_common(*emitter, eo);
 
     // microfacet
@@ -181,7 +190,8 @@ int chi2_main(int argc, char **argv) {
     std::string distr_name, visible_text = "true";
     float alpha = 0.1f, alpha_v = -1.f, m_theta = 30.f, m_phi = 0.f;
     CLI::App *micro = app.add_subcommand(
-        "microfacet", "Test microfacet normal sampling: facet chi2 microfacet beckmann|ggx --alpha a");
+        "microfacet",
+        "Test microfacet normal sampling: facet chi2 microfacet beckmann|ggx --alpha a");
     micro->add_option("type", distr_name, "beckmann or ggx")->required();
     micro->add_option("--alpha", alpha, "Roughness (alpha_u when --alpha-v is given; default 0.1)");
     micro->add_option("--alpha-v", alpha_v, "Roughness along v (default: --alpha)");

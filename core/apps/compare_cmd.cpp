@@ -25,8 +25,7 @@ constexpr double MinVariance = 1e-4;
 
 /// Linear Rec.709 to CIE XYZ (D65).
 std::array<double, 3> rgb_to_xyz(double r, double g, double b) {
-    return {0.412453 * r + 0.357580 * g + 0.180423 * b,
-            0.212671 * r + 0.715160 * g + 0.072169 * b,
+    return {0.412453 * r + 0.357580 * g + 0.180423 * b, 0.212671 * r + 0.715160 * g + 0.072169 * b,
             0.019334 * r + 0.119193 * g + 0.950227 * b};
 }
 
@@ -66,8 +65,8 @@ int compare_main(int argc, char **argv) {
         if (other->width != ours.width || other->height != ours.height)
             FACET_THROW("image sizes differ: \"{}\" is {}x{}, \"{}\" is {}x{} (render at the "
                         "reference's resolution)",
-                        ours_path, ours.width, ours.height,
-                        other == &mean ? mean_path : var_path, other->width, other->height);
+                        ours_path, ours.width, ours.height, other == &mean ? mean_path : var_path,
+                        other->width, other->height);
     }
     const char *const rgb_names[3] = {"R", "G", "B"};
     const char *const xyz_names[3] = {"X", "Y", "Z"};
@@ -114,8 +113,8 @@ int compare_main(int argc, char **argv) {
     fmt::print("pixel-channels with p > alpha: {:.3f}% (X {:.3f}%, Y {:.3f}%, Z {:.3f}%), "
                "required {:.2f}%\n",
                100.0 * fraction, 100.0 * double(passed[0]) / double(pixels),
-               100.0 * double(passed[1]) / double(pixels), 100.0 * double(passed[2]) / double(pixels),
-               100.0 * PassFraction);
+               100.0 * double(passed[1]) / double(pixels),
+               100.0 * double(passed[2]) / double(pixels), 100.0 * PassFraction);
     if (non_finite) fmt::print("non-finite values: {}\n", non_finite);
     fmt::print("mean brightness (Y): ours {:.6g}, reference {:.6g}, relative difference {:+.3f}%\n",
                sum_ours / double(pixels), sum_ref / double(pixels), 100.0 * brightness);

@@ -122,7 +122,8 @@ FACET_EXPORT_PLUGIN(facet::@CLASS@, BSDF, "@NAME@", "A BSDF plugin (so far a Lam
 )CPP";
 
 std::string substitute(std::string text, const std::string &key, const std::string &value) {
-    for (size_t at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size()))
+    for (size_t at = text.find(key); at != std::string::npos;
+         at = text.find(key, at + value.size()))
         text.replace(at, key.size(), value);
     return text;
 }
@@ -136,7 +137,7 @@ std::string class_name(const std::string &name) {
             upper = true;
             continue;
         }
-        out += upper ? char(std::toupper((unsigned char) c)) : c;
+        out += upper ? char(std::toupper((unsigned char)c)) : c;
         upper = false;
     }
     return out;
@@ -164,12 +165,14 @@ int new_plugin_main(int argc, char **argv) {
 
     if (kind != "bsdf")
         FACET_THROW("facet new-plugin: no template for \"{}\" plugins (templates: bsdf)", kind);
-    bool valid = !name.empty() && std::islower((unsigned char) name[0]);
+    bool valid = !name.empty() && std::islower((unsigned char)name[0]);
     for (char c : name)
-        valid = valid && (std::islower((unsigned char) c) || std::isdigit((unsigned char) c) || c == '_');
+        valid =
+            valid && (std::islower((unsigned char)c) || std::isdigit((unsigned char)c) || c == '_');
     if (!valid)
         FACET_THROW("plugin name \"{}\": use lower-case letters, digits and '_', starting with a "
-                    "letter (it is the XML type and the file name)", name);
+                    "letter (it is the XML type and the file name)",
+                    name);
 
     fs::path folder = dir.empty() ? fs::path(name) : fs::path(dir);
     fs::path cmake_file = folder / "CMakeLists.txt", source_file = folder / (name + ".cpp");
@@ -179,7 +182,8 @@ int new_plugin_main(int argc, char **argv) {
     fs::create_directories(folder);
 
     std::string cmake = substitute(CMAKE_TEMPLATE, "@NAME@", name);
-    std::string source = substitute(substitute(BSDF_TEMPLATE, "@NAME@", name), "@CLASS@", class_name(name));
+    std::string source =
+        substitute(substitute(BSDF_TEMPLATE, "@NAME@", name), "@CLASS@", class_name(name));
     write_file(cmake_file, cmake);
     write_file(source_file, source);
 

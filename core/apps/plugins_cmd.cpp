@@ -20,10 +20,17 @@ using namespace facet;
 
 /// The kinds in the order a scene usually introduces them.
 const ObjectType KINDS[] = {
-    ObjectType::Integrator, ObjectType::Sensor,  ObjectType::Film,
-    ObjectType::Sampler,    ObjectType::ReconstructionFilter,
-    ObjectType::Shape,      ObjectType::BSDF,    ObjectType::Texture,
-    ObjectType::Emitter,    ObjectType::Medium,  ObjectType::PhaseFunction,
+    ObjectType::Integrator,
+    ObjectType::Sensor,
+    ObjectType::Film,
+    ObjectType::Sampler,
+    ObjectType::ReconstructionFilter,
+    ObjectType::Shape,
+    ObjectType::BSDF,
+    ObjectType::Texture,
+    ObjectType::Emitter,
+    ObjectType::Medium,
+    ObjectType::PhaseFunction,
     ObjectType::Volume,
 };
 
@@ -89,8 +96,8 @@ int plugins_main(int argc, char **argv) {
         std::vector<std::string> names = registry.available();
         if (std::find(names.begin(), names.end(), what) == names.end()) {
             std::string hint = closest_name(what, names);
-            FACET_THROW("no plugin or plugin kind named \"{}\"{} (`facet plugins` lists them)", what,
-                        hint.empty() ? "" : fmt::format("; did you mean \"{}\"?", hint));
+            FACET_THROW("no plugin or plugin kind named \"{}\"{} (`facet plugins` lists them)",
+                        what, hint.empty() ? "" : fmt::format("; did you mean \"{}\"?", hint));
         }
         const PluginDescriptor &desc = registry.descriptor(what);
         std::string doc = desc.doc ? desc.doc : "";

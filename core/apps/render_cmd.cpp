@@ -74,8 +74,7 @@ std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
     }
     for (const std::string &define : opts.defines) {
         size_t eq = define.find('=');
-        if (eq == std::string::npos)
-            FACET_THROW("-D expects key=value, got \"{}\"", define);
+        if (eq == std::string::npos) FACET_THROW("-D expects key=value, got \"{}\"", define);
         if (eq == 0) FACET_THROW("-D \"{}\" has no parameter name before '='", define);
         load.params[define.substr(0, eq)] = define.substr(eq + 1);
     }

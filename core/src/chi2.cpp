@@ -24,7 +24,9 @@ namespace facet {
 namespace {
 
 /// ln Γ(a) + the prefactor x^a e^-x / Γ(a) of both expansions, in logarithms to avoid overflow.
-double gamma_prefactor(double a, double x) { return std::exp(a * std::log(x) - x - std::lgamma(a)); }
+double gamma_prefactor(double a, double x) {
+    return std::exp(a * std::log(x) - x - std::lgamma(a));
+}
 
 /// P(a, x) by its power series, good for x < a + 1.
 double gamma_p_series(double a, double x) {
@@ -151,8 +153,8 @@ struct Findings {
         uint64_t index;
         std::string text;
     };
-    std::vector<Example> examples;    ///< outright failures
-    std::vector<Example> mismatches;  ///< weight or pdf inconsistencies
+    std::vector<Example> examples;   ///< outright failures
+    std::vector<Example> mismatches; ///< weight or pdf inconsistencies
     uint64_t bad_direction = 0, nonfinite_weight = 0, bad_pdf = 0, weight_mismatch = 0,
              pdf_mismatch = 0, adapter_problem = 0;
     double max_pdf_error = 0.0, max_weight_error = 0.0;
@@ -167,8 +169,12 @@ struct Findings {
     }
 };
 
-std::string color_str(const Color3f &c) { return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", c.r, c.g, c.b); }
-std::string vec_str(const Vector3f &v) { return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z); }
+std::string color_str(const Color3f &c) {
+    return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", c.r, c.g, c.b);
+}
+std::string vec_str(const Vector3f &v) {
+    return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z);
+}
 
 /// Relative difference of two values, 0 when both are 0.
 double rel_diff(double a, double b) {
@@ -237,9 +243,9 @@ template <typename F> double simpson(F &&f, double a, double b, int n) {
 
 /// Adaptive Simpson on [a, b] given the values at a, the midpoint and b. Subdivides at least
 /// `min_depth` times and at most `depth` times.
-template <typename F>
-double adaptive_simpson(F &f, double a, double b, double fa, double fm, double fb, double whole,
-                        double tol, int depth, int min_depth) {
+template <typename F> double adaptive_simpson(F &f, double a, double b, double fa, double fm,
+                                              double fb, double whole, double tol, int depth,
+                                              int min_depth) {
     double m = 0.5 * (a + b), lm = 0.5 * (a + m), rm = 0.5 * (m + b);
     double flm = f(lm), frm = f(rm);
     double left = (m - a) / 6.0 * (fa + 4.0 * flm + fm);
@@ -404,8 +410,7 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
         res.weight_stddev[c] = float(std::sqrt(var));
     }
     auto count_failure = [&](uint64_t count, const char *what) {
-        if (count > 0)
-            res.failures.push_back(fmt::format("{} of {} samples: {}", count, n, what));
+        if (count > 0) res.failures.push_back(fmt::format("{} of {} samples: {}", count, n, what));
     };
     count_failure(total.nonfinite_weight, "non-finite weight");
     count_failure(total.bad_direction, "sampled direction is not a unit vector");
@@ -422,8 +427,8 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
     res.max_weight_error = total.max_weight_error;
     uint64_t mismatched = total.pdf_mismatch + total.weight_mismatch + total.adapter_problem;
     double worst = std::max(total.max_pdf_error, total.max_weight_error);
-    bool mismatch_failure = mismatched > uint64_t(opts.mismatch_fraction * double(n)) ||
-                            worst > opts.gross_tolerance;
+    bool mismatch_failure =
+        mismatched > uint64_t(opts.mismatch_fraction * double(n)) || worst > opts.gross_tolerance;
     std::vector<std::string> &mismatch_out = mismatch_failure ? res.failures : res.notes;
     if (mismatched > 0) {
         mismatch_out.push_back(fmt::format(
@@ -463,25 +468,29 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
         res.expected[k] = integrals[k].value * double(n);
     }
     if (bad_cells > 0)
-        res.failures.push_back(fmt::format("{} cells have non-finite or negative pdf values", bad_cells));
+        res.failures.push_back(
+            fmt::format("{} cells have non-finite or negative pdf values", bad_cells));
 
     // 3. The pdf integrates to the fraction of samples that got a smooth direction, at most 1.
     double fraction = double(res.smooth) / double(n);
-    double integral_tol = 5.0 * std::sqrt(std::max(fraction * (1.0 - fraction), 1.0 / n) / n) + 2e-3;
+    double integral_tol =
+        5.0 * std::sqrt(std::max(fraction * (1.0 - fraction), 1.0 / n) / n) + 2e-3;
     if (res.pdf_integral > 1.0 + 2e-3)
         res.failures.push_back(fmt::format("the pdf integrates to {:.6f} > 1", res.pdf_integral));
     else if (std::abs(res.pdf_integral - fraction) > integral_tol)
-        res.failures.push_back(fmt::format("the pdf integrates to {:.6f} but a fraction {:.6f} of "
-                                           "the samples produced a smooth direction (tolerance {:.2g})",
-                                           res.pdf_integral, fraction, integral_tol));
+        res.failures.push_back(
+            fmt::format("the pdf integrates to {:.6f} but a fraction {:.6f} of "
+                        "the samples produced a smooth direction (tolerance {:.2g})",
+                        res.pdf_integral, fraction, integral_tol));
 
     // 4. Energy: the mean weight of a passive BSDF does not exceed 1 (5 standard errors of noise).
     if (adapter.bounded_weights()) {
         for (int c = 0; c < 3; ++c) {
             double bound = 1.0 + 5.0 * res.weight_stddev[c] / std::sqrt(double(n)) + 1e-4;
             if (res.mean_weight[c] > bound) {
-                res.failures.push_back(fmt::format("mean weight {} exceeds 1 (energy gain; bound {:.6f})",
-                                                   color_str(res.mean_weight), bound));
+                res.failures.push_back(
+                    fmt::format("mean weight {} exceeds 1 (energy gain; bound {:.6f})",
+                                color_str(res.mean_weight), bound));
                 break;
             }
         }
@@ -490,7 +499,8 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
     // 5. Pearson's statistic.
     res.significance = sidak_correction(opts.significance, std::max(1u, opts.test_count));
     if (res.smooth == 0 && res.pdf_integral == 0.0) {
-        res.notes.push_back("no smooth samples and a zero pdf: only delta lobes, no histogram to test");
+        res.notes.push_back(
+            "no smooth samples and a zero pdf: only delta lobes, no histogram to test");
         res.p_value = 1.0;
     } else {
         PearsonResult pr = pearson_chi2(res.observed, res.expected, opts.min_expected);
@@ -503,23 +513,25 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
             size_t k = pr.zero_expected_cell;
             int jc = int(k / phi_res), ip = int(k % phi_res);
             double phi = -kPi + (ip + 0.5) * dphi, c = -1.0 + (jc + 0.5) * dcos;
-            res.failures.push_back(fmt::format(
-                "{} samples fell into cell (phi {}, cos theta {}) around direction {} where the pdf "
-                "integrates to zero",
-                res.observed[k], ip, jc, vec_str(domain_to_direction(phi, c))));
+            res.failures.push_back(fmt::format("{} samples fell into cell (phi {}, cos theta {}) "
+                                               "around direction {} where the pdf "
+                                               "integrates to zero",
+                                               res.observed[k], ip, jc,
+                                               vec_str(domain_to_direction(phi, c))));
         }
         if (res.dof < 1) {
             res.failures.push_back(fmt::format("too few cells with enough expected samples "
-                                               "(dof = {}); use more samples or fewer cells", res.dof));
+                                               "(dof = {}); use more samples or fewer cells",
+                                               res.dof));
             res.p_value = 0.0;
         } else {
             res.p_value = chi2_survival(res.statistic, res.dof);
             if (!std::isfinite(res.p_value))
                 res.failures.push_back("the p-value is not finite");
             else if (res.p_value < res.significance)
-                res.failures.push_back(fmt::format(
-                    "the histogram does not match the pdf: p-value {:.4g} < {:.4g}", res.p_value,
-                    res.significance));
+                res.failures.push_back(
+                    fmt::format("the histogram does not match the pdf: p-value {:.4g} < {:.4g}",
+                                res.p_value, res.significance));
         }
     }
     res.passed = res.failures.empty();
@@ -528,12 +540,15 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
 
 std::string Chi2Result::summary() const {
     std::string s = fmt::format("chi2: {}\n", description);
-    s += fmt::format("  samples  {} ({} smooth, {} delta, {} failed)\n", samples, smooth, delta, failed);
-    s += fmt::format("  cells    {} (phi) x {} (cos theta), pdf integral {:.6f}, smooth fraction {:.6f}\n",
-                     phi_res, cos_res, pdf_integral, samples ? double(smooth) / samples : 0.0);
+    s += fmt::format("  samples  {} ({} smooth, {} delta, {} failed)\n", samples, smooth, delta,
+                     failed);
+    s += fmt::format(
+        "  cells    {} (phi) x {} (cos theta), pdf integral {:.6f}, smooth fraction {:.6f}\n",
+        phi_res, cos_res, pdf_integral, samples ? double(smooth) / samples : 0.0);
     s += fmt::format("  weight   mean {} stddev {}; largest relative error of weight {:.2g}, "
-                     "of pdf {:.2g}\n", color_str(mean_weight), color_str(weight_stddev),
-                     max_weight_error, max_pdf_error);
+                     "of pdf {:.2g}\n",
+                     color_str(mean_weight), color_str(weight_stddev), max_weight_error,
+                     max_pdf_error);
     s += fmt::format("  statistic {:.2f}, dof {}, p-value {:.6g} (level {:.4g})\n", statistic, dof,
                      p_value, significance);
     for (const std::string &n : notes) s += "  note: " + n + "\n";
@@ -556,8 +571,8 @@ Color3f diverging(double t) {
 /// A dark-to-bright sequential map for t in [0, 1] (black, purple, orange, yellow-white).
 Color3f sequential(double t) {
     t = std::clamp(t, 0.0, 1.0);
-    const Color3f stops[] = {{0.f, 0.f, 0.02f}, {0.35f, 0.05f, 0.45f}, {0.9f, 0.35f, 0.1f},
-                             {1.f, 0.95f, 0.6f}};
+    const Color3f stops[] = {
+        {0.f, 0.f, 0.02f}, {0.35f, 0.05f, 0.45f}, {0.9f, 0.35f, 0.1f}, {1.f, 0.95f, 0.6f}};
     double x = t * 3.0;
     int i = std::min(2, int(x));
     return lerp(float(x - i), stops[i], stops[i + 1]);
@@ -607,8 +622,9 @@ void write_chi2_tables(const std::string &path, const Chi2Result &r) {
     std::ofstream out(path);
     if (!out) FACET_THROW("cannot write \"{}\"", path);
     out << "# " << r.description << "\n";
-    out << fmt::format("# {} phi cells x {} cos theta cells; statistic {:.4f}, dof {}, p-value {:.6g}\n",
-                       r.phi_res, r.cos_res, r.statistic, r.dof, r.p_value);
+    out << fmt::format(
+        "# {} phi cells x {} cos theta cells; statistic {:.4f}, dof {}, p-value {:.6g}\n",
+        r.phi_res, r.cos_res, r.statistic, r.dof, r.p_value);
     out << "# phi_bin cos_bin phi_min phi_max cos_min cos_max observed expected\n";
     double dphi = 2.0 * kPi / r.phi_res, dcos = 2.0 / r.cos_res;
     for (int jc = 0; jc < r.cos_res; ++jc)

@@ -27,11 +27,20 @@ std::string xml_escape(const std::string &s) {
     std::string out;
     for (char c : s) {
         switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
+        case '&':
+            out += "&amp;";
+            break;
+        case '<':
+            out += "&lt;";
+            break;
+        case '>':
+            out += "&gt;";
+            break;
+        case '"':
+            out += "&quot;";
+            break;
+        default:
+            out += c;
         }
     }
     return out;
@@ -89,7 +98,8 @@ std::string entry_xml(const std::string &entry) {
     static const char *tags[] = {"float", "integer", "boolean", "string", "rgb", "spectrum"};
     if (std::find(std::begin(tags), std::end(tags), tag) == std::end(tags))
         FACET_THROW("parameter \"{}\": unknown type \"{}\" (expected float, integer, boolean, "
-                    "string, rgb, spectrum, vector or point)", entry, tag);
+                    "string, rgb, spectrum, vector or point)",
+                    entry, tag);
     return fmt::format("<{} name=\"{}\" value=\"{}\"/>", tag, xml_escape(key), xml_escape(value));
 }
 
@@ -99,8 +109,8 @@ std::string chi2_object_xml(ObjectType kind, const std::string &plugin,
                             const std::vector<std::string> &entries, const std::string &children,
                             bool with_version) {
     std::string tag = object_type_name(kind);
-    std::string xml = fmt::format("<{}{} type=\"{}\">", tag, with_version ? " version=\"3.0.0\"" : "",
-                                  xml_escape(plugin));
+    std::string xml = fmt::format("<{}{} type=\"{}\">", tag,
+                                  with_version ? " version=\"3.0.0\"" : "", xml_escape(plugin));
     for (const std::string &e : entries) xml += entry_xml(e);
     xml += children;
     xml += fmt::format("</{}>", tag);
@@ -116,7 +126,9 @@ Vector3f direction_from_angles(float theta_deg, float phi_deg) {
 
 namespace {
 
-std::string vec_str(const Vector3f &v) { return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z); }
+std::string vec_str(const Vector3f &v) {
+    return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z);
+}
 
 template <typename T> std::shared_ptr<T> load_as(const std::string &xml, ObjectType kind) {
     std::shared_ptr<Object> obj = load_string(xml);
@@ -192,17 +204,19 @@ Chi2Sample BSDFAdapter::sample(const float *u) const {
     };
     if (differs(pdf2, s.pdf) || differs(value2.r, s.value.r) || differs(value2.g, s.value.g) ||
         differs(value2.b, s.value.b))
-        s.problem = fmt::format("eval_pdf() = ({}, {}, {}; {}) but eval() = ({}, {}, {}), pdf() = {} "
-                                "at {}", value2.r, value2.g, value2.b, pdf2, s.value.r, s.value.g,
-                                s.value.b, s.pdf, vec_str(bs.wo));
+        s.problem =
+            fmt::format("eval_pdf() = ({}, {}, {}; {}) but eval() = ({}, {}, {}), pdf() = {} "
+                        "at {}",
+                        value2.r, value2.g, value2.b, pdf2, s.value.r, s.value.g, s.value.b, s.pdf,
+                        vec_str(bs.wo));
     return s;
 }
 
 double BSDFAdapter::pdf(const Vector3f &d) const { return m_bsdf->pdf(m_ctx, m_si, d); }
 
 std::string BSDFAdapter::to_string() const {
-    std::string comp = m_ctx.component == uint32_t(-1) ? std::string("all")
-                                                       : std::to_string(m_ctx.component);
+    std::string comp =
+        m_ctx.component == uint32_t(-1) ? std::string("all") : std::to_string(m_ctx.component);
     return fmt::format("{}, wi = {}, component {}{}", m_bsdf->to_string(), vec_str(m_si.wi), comp,
                        m_ctx.mode == TransportMode::Importance ? ", importance mode" : "");
 }
@@ -213,7 +227,8 @@ EmitterAdapter::EmitterAdapter(const std::string &scene_xml, const Point3f &ref,
     m_scene = load_as<Scene>(scene_xml, ObjectType::Scene);
     const auto &emitters = m_scene->emitters();
     if (index >= emitters.size())
-        FACET_THROW("EmitterAdapter: the scene has {} emitters, no emitter {}", emitters.size(), index);
+        FACET_THROW("EmitterAdapter: the scene has {} emitters, no emitter {}", emitters.size(),
+                    index);
     m_emitter = emitters[index];
     m_ref.p = ref;
     init();
@@ -232,12 +247,14 @@ void EmitterAdapter::init() {
     if (!m_scene || !m_emitter) FACET_THROW("EmitterAdapter: no scene or no emitter");
     if (has_flag(m_emitter->flags(), EmitterFlags::Delta))
         FACET_THROW("{}: a delta emitter (point-like or one direction) has no direction density "
-                    "to test", m_emitter->to_string());
+                    "to test",
+                    m_emitter->to_string());
     m_ref.n = Normal3f(0.f); // a point in space
     m_ref.t = 0.f;
 }
 
-std::string EmitterAdapter::scene_xml(const std::string &plugin, const std::vector<std::string> &entries,
+std::string EmitterAdapter::scene_xml(const std::string &plugin,
+                                      const std::vector<std::string> &entries,
                                       const std::string &shape) {
     std::string emitter = chi2_object_xml(ObjectType::Emitter, plugin, entries, "", false);
     std::string body;
@@ -278,7 +295,8 @@ double EmitterAdapter::pdf(const Vector3f &d) const {
         return m_emitter->pdf_direction(m_ref, ds);
     }
     SurfaceInteraction si;
-    if (!m_scene->ray_intersect(Ray(m_ref.p, d), si) || !si.shape || si.shape->emitter() != m_emitter.get())
+    if (!m_scene->ray_intersect(Ray(m_ref.p, d), si) || !si.shape ||
+        si.shape->emitter() != m_emitter.get())
         return 0.0;
     ds.p = si.p;
     ds.n = si.n;
@@ -311,9 +329,10 @@ MicrofacetAdapter::MicrofacetAdapter(const std::string &type, float alpha_u, flo
         FACET_THROW("microfacet roughness must be positive (got {}, {})", alpha_u, alpha_v);
     float len = norm(wi);
     if (!(len > 0.f) || wi.z <= 0.f)
-        FACET_THROW("microfacet incident direction {} must point into the upper hemisphere", vec_str(wi));
-    m_impl = std::make_unique<Impl>(Impl{MicrofacetDistribution(t, alpha_u, alpha_v, sample_visible),
-                                         wi / len});
+        FACET_THROW("microfacet incident direction {} must point into the upper hemisphere",
+                    vec_str(wi));
+    m_impl = std::make_unique<Impl>(
+        Impl{MicrofacetDistribution(t, alpha_u, alpha_v, sample_visible), wi / len});
 }
 
 MicrofacetAdapter::~MicrofacetAdapter() = default;

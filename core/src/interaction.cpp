@@ -31,8 +31,7 @@ Ray Interaction::spawn_ray_to(const Point3f &target) const {
     Point3f o = offset_origin(p, n, target - p);
     Vector3f d = target - o;
     float dist = norm(d);
-    if (!(dist > 0.f))
-        return Ray(o, Vector3f(0.f, 0.f, 1.f), 0.f, 0.f);
+    if (!(dist > 0.f)) return Ray(o, Vector3f(0.f, 0.f, 1.f), 0.f, 0.f);
     d /= dist;
     // Stop short of the target by the same margin, since it usually lies on a surface too.
     float maxt = std::max(0.f, dist - offset_scale(target));

@@ -13,12 +13,18 @@ std::mutex g_mutex;
 
 const char *prefix(LogLevel level) {
     switch (level) {
-    case LogLevel::Trace: return "[T] ";
-    case LogLevel::Debug: return "[D] ";
-    case LogLevel::Info: return "[I] ";
-    case LogLevel::Warn: return "[W] ";
-    case LogLevel::Error: return "[E] ";
-    default: return "";
+    case LogLevel::Trace:
+        return "[T] ";
+    case LogLevel::Debug:
+        return "[D] ";
+    case LogLevel::Info:
+        return "[I] ";
+    case LogLevel::Warn:
+        return "[W] ";
+    case LogLevel::Error:
+        return "[E] ";
+    default:
+        return "";
     }
 }
 } // namespace

@@ -18,8 +18,7 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
         FACET_THROW("{}: position array of {} floats is not a list of 3D points", m_name,
                     m_positions.size());
     size_t nv = m_positions.size() / 3;
-    if (m_faces.empty())
-        FACET_THROW("{}: the mesh has no triangles", m_name);
+    if (m_faces.empty()) FACET_THROW("{}: the mesh has no triangles", m_name);
     if (m_faces.size() % 3 != 0)
         FACET_THROW("{}: index array of {} entries is not a list of triangles", m_name,
                     m_faces.size());
@@ -33,8 +32,8 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
         FACET_THROW("{}: {} colour floats for {} vertices", m_name, m_colors.size(), nv);
     for (size_t i = 0; i < m_faces.size(); ++i)
         if (m_faces[i] >= nv)
-            FACET_THROW("{}: triangle {} uses vertex {}, but the mesh has only {} vertices",
-                        m_name, i / 3, m_faces[i], nv);
+            FACET_THROW("{}: triangle {} uses vertex {}, but the mesh has only {} vertices", m_name,
+                        i / 3, m_faces[i], nv);
     for (size_t i = 0; i < nv; ++i)
         if (!is_finite(vertex_position(i)))
             FACET_THROW("{}: vertex {} has a non-finite position", m_name, i);
@@ -62,8 +61,7 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
     }
     for (size_t i = 0; i < m_normals.size(); i += 3) {
         Normal3f n(m_normals[i], m_normals[i + 1], m_normals[i + 2]);
-        if (!to_world.is_identity())
-            n = to_world.apply_normal(n);
+        if (!to_world.is_identity()) n = to_world.apply_normal(n);
         float len = norm(n);
         // A zero or broken normal stays zero: shading then falls back to the face normal.
         n = (len > 0.f && std::isfinite(len)) ? n / len : Normal3f(0.f);
@@ -73,8 +71,7 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
     }
 
     m_bbox = BoundingBox3f();
-    for (size_t i = 0; i < nv; ++i)
-        m_bbox.expand(vertex_position(i));
+    for (size_t i = 0; i < nv; ++i) m_bbox.expand(vertex_position(i));
 
     size_t nf = face_count();
     m_area_cdf.resize(nf);
@@ -87,8 +84,7 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
     }
     m_area = float(total);
     if (total > 0.0) {
-        for (float &c : m_area_cdf)
-            c = float(double(c) / total);
+        for (float &c : m_area_cdf) c = float(double(c) / total);
         m_area_cdf.back() = 1.f;
     } else {
         FACET_LOG(Warn, "{}: all {} triangles are degenerate (zero area)", m_name, nf);
@@ -105,20 +101,17 @@ void Mesh::recompute_vertex_normals() {
     for (size_t f = 0; f < face_count(); ++f) {
         uint32_t idx[3] = {m_faces[3 * f], m_faces[3 * f + 1], m_faces[3 * f + 2]};
         Vector3d p[3];
-        for (int k = 0; k < 3; ++k)
-            p[k] = Vector3d(vertex_position(idx[k]));
+        for (int k = 0; k < 3; ++k) p[k] = Vector3d(vertex_position(idx[k]));
         Vector3d n = cross(p[1] - p[0], p[2] - p[0]);
         double len = norm(n);
-        if (!(len > 0.0))
-            continue;
+        if (!(len > 0.0)) continue;
         n /= len;
         // Each face contributes its normal weighted by its angle at the vertex
         // (Thürmer and Wüthrich 1998), which makes the result independent of the tessellation.
         for (int k = 0; k < 3; ++k) {
             Vector3d e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
             double l1 = norm(e1), l2 = norm(e2);
-            if (!(l1 > 0.0 && l2 > 0.0))
-                continue;
+            if (!(l1 > 0.0 && l2 > 0.0)) continue;
             double angle = std::acos(clamp(dot(e1, e2) / (l1 * l2), -1.0, 1.0));
             acc[idx[k]] += n * angle;
         }
@@ -136,8 +129,8 @@ void Mesh::recompute_vertex_normals() {
 
 RTCGeometry Mesh::embree_geometry(RTCDevice device) const {
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m_positions.data(),
-                               0, 3 * sizeof(float), vertex_count());
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                               m_positions.data(), 0, 3 * sizeof(float), vertex_count());
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m_faces.data(), 0,
                                3 * sizeof(uint32_t), face_count());
     rtcCommitGeometry(geom);
@@ -162,8 +155,7 @@ void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_in
     Normal3f n = cross(dp0, dp1);
     float n_len = norm(n);
     n = n_len > 0.f ? n / n_len : -ray.d;
-    if (m_flip_normals)
-        n = -n;
+    if (m_flip_normals) n = -n;
     si.n = n;
 
     bool have_dp = false;
@@ -179,8 +171,7 @@ void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_in
             si.dp_dv = (dp1 * duv0.x - dp0 * duv1.x) * inv;
             have_dp = is_finite(si.dp_du) && is_finite(si.dp_dv);
         }
-        if (!have_dp)
-            coordinate_system(n, si.dp_du, si.dp_dv);
+        if (!have_dp) coordinate_system(n, si.dp_du, si.dp_dv);
     } else {
         // Without texture coordinates the barycentrics serve as (u, v).
         si.uv = Point2f(b1, b2);
@@ -195,8 +186,7 @@ void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_in
         };
         Normal3f interp = vn(i0) * b0 + vn(i1) * b1 + vn(i2) * b2;
         float len = norm(interp);
-        if (len > 0.f && std::isfinite(len))
-            ns = m_flip_normals ? -interp / len : interp / len;
+        if (len > 0.f && std::isfinite(len)) ns = m_flip_normals ? -interp / len : interp / len;
     }
 
     // Shading frame: the shading normal and dp_du made orthogonal to it (Gram-Schmidt).
@@ -213,12 +203,11 @@ void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_in
 
 PositionSample Mesh::sample_position(const Point2f &u_) const {
     PositionSample ps;
-    if (m_area_cdf.empty() || !(m_area > 0.f))
-        return ps;
+    if (m_area_cdf.empty() || !(m_area > 0.f)) return ps;
     Point2f u = u_;
     // Pick a triangle in proportion to its area and reuse the sample within its interval.
-    size_t f = size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) -
-                      m_area_cdf.begin());
+    size_t f =
+        size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) - m_area_cdf.begin());
     f = std::min(f, m_area_cdf.size() - 1);
     float lo = f > 0 ? m_area_cdf[f - 1] : 0.f, hi = m_area_cdf[f];
     u.x = hi > lo ? clamp((u.x - lo) / (hi - lo), 0.f, OneMinusEpsilon) : 0.f;
@@ -246,8 +235,7 @@ std::string Mesh::to_string() const {
                        "colors={}, area={}, flip_normals={}, bsdf={}, emitter={}]",
                        m_name, vertex_count(), face_count(), has_vertex_normals(), has_uvs(),
                        has_vertex_colors(), m_area, m_flip_normals,
-                       m_bsdf ? m_bsdf->to_string() : "none",
-                       emitter_label());
+                       m_bsdf ? m_bsdf->to_string() : "none", emitter_label());
 }
 
 } // namespace facet

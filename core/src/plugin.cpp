@@ -1,9 +1,8 @@
 #include <facet/plugin.h>
 
-#include <dlfcn.h>
-
 #include <algorithm>
 #include <cstdlib>
+#include <dlfcn.h>
 #include <filesystem>
 #include <set>
 
@@ -85,9 +84,10 @@ std::vector<std::string> PluginRegistry::search_path() const {
 void PluginRegistry::register_static(const PluginDescriptor *desc) {
     if (!desc || !desc->name) FACET_THROW("register_static: invalid plugin descriptor");
     if (desc->abi_version != FACET_ABI_VERSION)
-        FACET_THROW("plugin \"{}\" was built for facet ABI version {}, but this facet has ABI version "
-                    "{}; rebuild the plugin",
-                    desc->name, desc->abi_version, FACET_ABI_VERSION);
+        FACET_THROW(
+            "plugin \"{}\" was built for facet ABI version {}, but this facet has ABI version "
+            "{}; rebuild the plugin",
+            desc->name, desc->abi_version, FACET_ABI_VERSION);
     std::lock_guard<std::recursive_mutex> lock(m_mutex);
     m_loaded[desc->name] = desc;
 }
@@ -119,9 +119,10 @@ const PluginDescriptor &PluginRegistry::load_library(const std::string &path, Ob
     if (!desc) FACET_THROW("plugin \"{}\" returned no descriptor", path);
     // abi_version is the first member in every version, so it is safe to read before anything else.
     if (desc->abi_version != FACET_ABI_VERSION)
-        FACET_THROW("plugin \"{}\" was built for facet ABI version {}, but this facet has ABI version "
-                    "{}; rebuild the plugin",
-                    path, desc->abi_version, FACET_ABI_VERSION);
+        FACET_THROW(
+            "plugin \"{}\" was built for facet ABI version {}, but this facet has ABI version "
+            "{}; rebuild the plugin",
+            path, desc->abi_version, FACET_ABI_VERSION);
     std::string file_name = fs::path(path).stem().string();
     if (!desc->name || file_name != desc->name)
         FACET_THROW("plugin \"{}\" calls itself \"{}\"; the library must be named after its plugin",
@@ -193,8 +194,7 @@ std::shared_ptr<Object> PluginRegistry::create(ObjectType expected, const Proper
         FACET_THROW_AT(props.location(), "failed to instantiate {} plugin of type \"{}\"",
                        kind_name(desc->kind), name);
     if (expected != ObjectType::Unknown && obj->type() != expected)
-        FACET_THROW_AT(props.location(),
-                       "plugin \"{}\" created {}, but {} was expected here", name,
+        FACET_THROW_AT(props.location(), "plugin \"{}\" created {}, but {} was expected here", name,
                        with_article(obj->type()), with_article(expected));
     if (!props.id().empty()) obj->set_id(props.id());
     check_unqueried(props, obj->type(), lenient);
@@ -230,9 +230,9 @@ std::vector<std::string> PluginRegistry::available(ObjectType kind) {
 void check_unqueried(const Properties &props, ObjectType kind, bool lenient) {
     std::vector<std::string> unused = props.unqueried();
     if (unused.empty()) return;
-    std::string msg = fmt::format("Found {} unreferenced propert{} in {} plugin of type \"{}\":",
-                                  unused.size(), unused.size() == 1 ? "y" : "ies",
-                                  object_type_name(kind), props.plugin_name());
+    std::string msg =
+        fmt::format("Found {} unreferenced propert{} in {} plugin of type \"{}\":", unused.size(),
+                    unused.size() == 1 ? "y" : "ies", object_type_name(kind), props.plugin_name());
     // Parameters the plugin asked for but did not get: the likely intended names of typos.
     std::vector<std::string> missing;
     const std::vector<std::string> requested = props.requested_names(); // has() may append
@@ -244,7 +244,8 @@ void check_unqueried(const Properties &props, ObjectType kind, bool lenient) {
         // entry_to_string gives `type "name": value`; put the location after the name.
         size_t colon = entry.find("\": ");
         if (loc.valid() && colon != std::string::npos)
-            entry = entry.substr(0, colon + 1) + " (" + loc.to_string() + ")" + entry.substr(colon + 1);
+            entry =
+                entry.substr(0, colon + 1) + " (" + loc.to_string() + ")" + entry.substr(colon + 1);
         std::string suggestion = closest_name(name, missing);
         if (!suggestion.empty()) entry += fmt::format(" (did you mean \"{}\"?)", suggestion);
         msg += "\n  - " + entry;

@@ -37,15 +37,24 @@ std::string entry_type_name(const Properties::Value &v) {
 
 const char *Properties::type_name(Type t) {
     switch (t) {
-    case Type::Bool: return "boolean";
-    case Type::Integer: return "integer";
-    case Type::Float: return "float";
-    case Type::String: return "string";
-    case Type::Vector: return "vector";
-    case Type::Color: return "rgb";
-    case Type::Spectrum: return "spectrum";
-    case Type::Transform: return "transform";
-    case Type::Object: return "object";
+    case Type::Bool:
+        return "boolean";
+    case Type::Integer:
+        return "integer";
+    case Type::Float:
+        return "float";
+    case Type::String:
+        return "string";
+    case Type::Vector:
+        return "vector";
+    case Type::Color:
+        return "rgb";
+    case Type::Spectrum:
+        return "spectrum";
+    case Type::Transform:
+        return "transform";
+    case Type::Object:
+        return "object";
     }
     return "unknown";
 }
@@ -189,14 +198,15 @@ Color3f Properties::get_color(const std::string &name, SpectrumKind kind) const 
         try {
             return spectrum_to_rgb(*v, kind);
         } catch (const Error &err) {
-            FACET_THROW_AT(e.location.valid() ? e.location : m_location, "parameter \"{}\": {}", name,
-                           err.message());
+            FACET_THROW_AT(e.location.valid() ? e.location : m_location, "parameter \"{}\": {}",
+                           name, err.message());
         }
     }
     type_error(name, "rgb, spectrum or float");
 }
 
-Color3f Properties::get_color(const std::string &name, const Color3f &def, SpectrumKind kind) const {
+Color3f Properties::get_color(const std::string &name, const Color3f &def,
+                              SpectrumKind kind) const {
     return has(name) ? get_color(name, kind) : def;
 }
 
@@ -216,8 +226,10 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
     case Type::Float:
     case Type::Integer:
     case Type::Color:
-    case Type::Spectrum: return std::make_shared<ConstantTexture>(get_color(name, kind));
-    default: type_error(name, "texture, rgb, spectrum or float");
+    case Type::Spectrum:
+        return std::make_shared<ConstantTexture>(get_color(name, kind));
+    default:
+        type_error(name, "texture, rgb, spectrum or float");
     }
 }
 
@@ -236,7 +248,8 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, const Colo
 std::vector<std::pair<std::string, std::shared_ptr<Object>>> Properties::objects() const {
     std::vector<std::pair<std::string, std::shared_ptr<Object>>> result;
     for (const auto &e : m_entries)
-        if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) result.emplace_back(e.name, *obj);
+        if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value))
+            result.emplace_back(e.name, *obj);
     return result;
 }
 

@@ -2,7 +2,6 @@
 #include <facet/resolver.h>
 
 #include <cstdio>
-
 #include <filesystem>
 
 namespace facet {

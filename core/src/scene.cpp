@@ -8,13 +8,12 @@
 #include <facet/shape.h>
 #include <facet/shapegroup.h>
 
-#include <xmmintrin.h>
-#include <pmmintrin.h>
-
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <pmmintrin.h>
 #include <vector>
+#include <xmmintrin.h>
 
 namespace facet {
 
@@ -44,13 +43,20 @@ inline void count_ray() {
 
 const char *embree_error_name(RTCError code) {
     switch (code) {
-    case RTC_ERROR_NONE: return "no error";
-    case RTC_ERROR_UNKNOWN: return "unknown error";
-    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
-    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
-    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
-    case RTC_ERROR_CANCELLED: return "cancelled";
+    case RTC_ERROR_NONE:
+        return "no error";
+    case RTC_ERROR_UNKNOWN:
+        return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT:
+        return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+        return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+        return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+        return "unsupported CPU";
+    case RTC_ERROR_CANCELLED:
+        return "cancelled";
     }
     return "unknown error";
 }
@@ -76,8 +82,7 @@ RTCDevice embree_device(int threads) {
                         embree_error_name(rtcGetDeviceError(nullptr)));
         rtcSetDeviceErrorFunction(device, embree_error_callback, nullptr);
     });
-    if (!device)
-        FACET_THROW("the Embree device is not available");
+    if (!device) FACET_THROW("the Embree device is not available");
     return device;
 }
 
@@ -94,15 +99,13 @@ Scene::Scene(const Properties &props) {
     } flush_denormals;
 
     for (const auto &[name, obj] : props.objects()) {
-        if (!obj)
-            continue;
+        if (!obj) continue;
         const Location &loc = props.location(name);
         switch (obj->type()) {
         case ObjectType::Shape: {
             auto shape = std::static_pointer_cast<Shape>(obj);
             m_shapes.push_back(shape);
-            if (auto emitter = shape->emitter_ptr())
-                m_emitters.push_back(emitter);
+            if (auto emitter = shape->emitter_ptr()) m_emitters.push_back(emitter);
             break;
         }
         case ObjectType::Emitter: {
@@ -110,8 +113,9 @@ Scene::Scene(const Properties &props) {
             if (emitter->shape())
                 break; // an area emitter referenced by a shape: the shape brings it in
             if (has_flag(emitter->flags(), EmitterFlags::Surface))
-                FACET_THROW_AT(loc, "area emitter {} is not attached to any shape: nest it in a "
-                                    "<shape> (or reference it from one)",
+                FACET_THROW_AT(loc,
+                               "area emitter {} is not attached to any shape: nest it in a "
+                               "<shape> (or reference it from one)",
                                object_label(*emitter));
             m_emitters.push_back(emitter);
             break;
@@ -139,27 +143,25 @@ Scene::Scene(const Properties &props) {
     if (!m_integrator)
         m_integrator = registry.create_as<Integrator>(ObjectType::Integrator, Properties("path"));
     if (m_sensors.empty())
-        m_sensors.push_back(registry.create_as<Sensor>(ObjectType::Sensor, Properties("perspective")));
+        m_sensors.push_back(
+            registry.create_as<Sensor>(ObjectType::Sensor, Properties("perspective")));
     // Shapes without a BSDF (those inside shape groups included) share one default diffuse.
     std::shared_ptr<BSDF> default_bsdf;
     auto give_default_bsdf = [&](Shape &shape) {
-        if (shape.bsdf())
-            return;
+        if (shape.bsdf()) return;
         if (!default_bsdf)
             default_bsdf = registry.create_as<BSDF>(ObjectType::BSDF, Properties("diffuse"));
         shape.set_bsdf(default_bsdf);
     };
     for (auto &shape : m_shapes) {
         if (auto group = dynamic_cast<const ShapeGroup *>(shape.get())) {
-            for (auto &member : group->shapes())
-                give_default_bsdf(*member);
+            for (auto &member : group->shapes()) give_default_bsdf(*member);
             continue;
         }
         give_default_bsdf(*shape);
     }
     for (auto &emitter : m_emitters)
-        if (emitter->is_infinite())
-            m_environment.push_back(emitter);
+        if (emitter->is_infinite()) m_environment.push_back(emitter);
 
     m_device = facet::embree_device(); // the free function, not the accessor of the same name
     rtcRetainDevice(m_device);
@@ -169,12 +171,10 @@ Scene::Scene(const Properties &props) {
     try {
         for (auto &shape : m_shapes) {
             RTCGeometry geom = shape->embree_geometry(m_device);
-            if (!geom)
-                continue; // a shape group: only visible through its instances
+            if (!geom) continue; // a shape group: only visible through its instances
             unsigned id = rtcAttachGeometry(m_rtc_scene, geom);
             rtcReleaseGeometry(geom); // the scene holds it now
-            if (id >= m_geometry_shapes.size())
-                m_geometry_shapes.resize(id + 1, nullptr);
+            if (id >= m_geometry_shapes.size()) m_geometry_shapes.resize(id + 1, nullptr);
             m_geometry_shapes[id] = shape.get();
             m_bbox.expand(shape->bbox());
         }
@@ -183,8 +183,7 @@ Scene::Scene(const Properties &props) {
         if (err != RTC_ERROR_NONE)
             FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));
 
-        for (auto &emitter : m_emitters)
-            emitter->set_scene(*this);
+        for (auto &emitter : m_emitters) emitter->set_scene(*this);
     } catch (...) {
         // The destructor does not run for a half-built object.
         rtcReleaseScene(m_rtc_scene);
@@ -194,10 +193,8 @@ Scene::Scene(const Properties &props) {
 }
 
 Scene::~Scene() {
-    if (m_rtc_scene)
-        rtcReleaseScene(m_rtc_scene);
-    if (m_device)
-        rtcReleaseDevice(m_device);
+    if (m_rtc_scene) rtcReleaseScene(m_rtc_scene);
+    if (m_device) rtcReleaseDevice(m_device);
 }
 
 uint64_t Scene::ray_count() {
@@ -267,12 +264,10 @@ bool Scene::ray_test(const Ray &ray) const {
     return r.tfar == -Infinity;
 }
 
-std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Interaction &ref,
-                                                                   Point2f u,
-                                                                   bool test_visibility) const {
+std::pair<DirectionSample, Color3f>
+Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility) const {
     const size_t count = m_emitters.size();
-    if (count == 0)
-        return {DirectionSample(), Color3f(0.f)};
+    if (count == 0) return {DirectionSample(), Color3f(0.f)};
     // Uniform emitter selection; the sample is stretched back to [0, 1) for the emitter.
     float scaled = u.x * float(count);
     size_t index = std::min(size_t(scaled), count - 1);
@@ -281,54 +276,45 @@ std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Intera
 
     auto [ds, weight] = emitter->sample_direction(ref, u);
     ds.emitter = emitter;
-    if (!(ds.pdf > 0.f) || weight.is_black())
-        return {ds, Color3f(0.f)};
+    if (!(ds.pdf > 0.f) || weight.is_black()) return {ds, Color3f(0.f)};
     // Delta emitters report pdf 1 (not a density): it is left as returned, as in
     // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
-    if (!ds.delta)
-        ds.pdf /= float(count);
+    if (!ds.delta) ds.pdf /= float(count);
     weight *= float(count);
 
     if (test_visibility) {
         Ray shadow = std::isfinite(ds.dist) ? ref.spawn_ray_to(ds.p) : ref.spawn_ray(ds.d);
-        if (ray_test(shadow))
-            weight = Color3f(0.f);
+        if (ray_test(shadow)) weight = Color3f(0.f);
     }
     return {ds, weight};
 }
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {
-    if (!ds.emitter || m_emitters.empty())
-        return 0.f;
+    if (!ds.emitter || m_emitters.empty()) return 0.f;
     return ds.emitter->pdf_direction(ref, ds) / float(m_emitters.size());
 }
 
 Color3f Scene::eval_environment(const Ray &ray) const {
     Color3f result(0.f);
-    if (m_environment.empty())
-        return result;
+    if (m_environment.empty()) return result;
     SurfaceInteraction si;
     si.p = ray.o;
     si.t = Infinity;
     si.sh_frame = Frame();
     si.wi = -ray.d;
-    for (const auto &emitter : m_environment)
-        result += emitter->eval(si);
+    for (const auto &emitter : m_environment) result += emitter->eval(si);
     return result;
 }
 
 std::string Scene::to_string() const {
-    std::string s = fmt::format("Scene[\n  bbox=[{}, {}, {}]-[{}, {}, {}],\n  shapes=[\n",
-                                m_bbox.min.x, m_bbox.min.y, m_bbox.min.z, m_bbox.max.x,
-                                m_bbox.max.y, m_bbox.max.z);
-    for (const auto &shape : m_shapes)
-        s += "    " + shape->to_string() + ",\n";
+    std::string s =
+        fmt::format("Scene[\n  bbox=[{}, {}, {}]-[{}, {}, {}],\n  shapes=[\n", m_bbox.min.x,
+                    m_bbox.min.y, m_bbox.min.z, m_bbox.max.x, m_bbox.max.y, m_bbox.max.z);
+    for (const auto &shape : m_shapes) s += "    " + shape->to_string() + ",\n";
     s += "  ],\n  emitters=[\n";
-    for (const auto &emitter : m_emitters)
-        s += "    " + emitter->to_string() + ",\n";
+    for (const auto &emitter : m_emitters) s += "    " + emitter->to_string() + ",\n";
     s += "  ],\n  sensors=[\n";
-    for (const auto &sensor : m_sensors)
-        s += "    " + sensor->to_string() + ",\n";
+    for (const auto &sensor : m_sensors) s += "    " + sensor->to_string() + ",\n";
     s += "  ],\n  integrator=" + (m_integrator ? m_integrator->to_string() : "none") + "\n]";
     return s;
 }

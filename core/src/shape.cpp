@@ -7,8 +7,7 @@ namespace facet {
 
 Shape::Shape(const Properties &props) {
     for (const auto &[name, obj] : props.objects()) {
-        if (!obj)
-            continue;
+        if (!obj) continue;
         const Location &loc = props.location(name);
         switch (obj->type()) {
         case ObjectType::BSDF:
@@ -60,14 +59,12 @@ DirectionSample Shape::sample_direction(const Interaction &ref, const Point2f &u
 
 float Shape::pdf_direction(const Interaction &ref, const DirectionSample &ds) const {
     float cos_theta = absdot(ds.n, ds.d);
-    if (!(cos_theta > 0.f))
-        return 0.f;
+    if (!(cos_theta > 0.f)) return 0.f;
     return pdf_position(ds) * ds.dist * ds.dist / cos_theta;
 }
 
 std::string Shape::emitter_label() const {
-    if (!m_emitter)
-        return "none";
+    if (!m_emitter) return "none";
     return m_emitter->id().empty() ? "attached" : "\"" + m_emitter->id() + "\"";
 }
 

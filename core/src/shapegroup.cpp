@@ -7,12 +7,14 @@ ShapeGroup::ShapeGroup(const Properties &props) {
     for (const auto &[name, obj] : props.objects()) {
         auto shape = std::dynamic_pointer_cast<Shape>(obj);
         if (!shape)
-            FACET_THROW_AT(props.location(name), "shapegroup: only shapes can be nested (\"{}\" is a {})",
-                           name, object_type_name(obj->type()));
+            FACET_THROW_AT(props.location(name),
+                           "shapegroup: only shapes can be nested (\"{}\" is a {})", name,
+                           object_type_name(obj->type()));
         if (dynamic_cast<const ShapeGroup *>(shape.get()))
             FACET_THROW_AT(props.location(name), "shapegroup: shape groups cannot be nested");
         if (shape->emitter())
-            FACET_THROW_AT(props.location(name), "shapegroup: emitters inside a shape group are not supported");
+            FACET_THROW_AT(props.location(name),
+                           "shapegroup: emitters inside a shape group are not supported");
         props.mark_queried(name);
         m_bbox.expand(shape->bbox());
         m_area += shape->surface_area();
@@ -55,4 +57,3 @@ std::string ShapeGroup::to_string() const {
 }
 
 } // namespace facet
-

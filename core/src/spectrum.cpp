@@ -1,7 +1,7 @@
+#include "cie_tables.h"
+
 #include <facet/logger.h>
 #include <facet/spectrum.h>
-
-#include "cie_tables.h"
 
 #include <cerrno>
 #include <cstdlib>
@@ -74,7 +74,8 @@ double SpectrumData::eval(double lambda) const {
     if (uniform) return value;
     if (wavelengths.empty() || lambda < wavelengths.front() || lambda > wavelengths.back())
         return 0.0;
-    size_t hi = std::upper_bound(wavelengths.begin(), wavelengths.end(), lambda) - wavelengths.begin();
+    size_t hi =
+        std::upper_bound(wavelengths.begin(), wavelengths.end(), lambda) - wavelengths.begin();
     if (hi >= wavelengths.size()) return values.back();
     size_t lo = hi - 1;
     double t = (lambda - wavelengths[lo]) / (wavelengths[hi] - wavelengths[lo]);
@@ -104,7 +105,8 @@ SpectrumData parse_spectrum_pairs(const std::string &text) {
         std::string item = trim(t.substr(start, end - start));
         start = end + 1;
         size_t colon = item.find(':');
-        if (item.empty() || colon == std::string::npos || item.find(':', colon + 1) != std::string::npos)
+        if (item.empty() || colon == std::string::npos ||
+            item.find(':', colon + 1) != std::string::npos)
             FACET_THROW("spectrum \"{}\": \"{}\" is not a wavelength:value pair", text, item);
         s.wavelengths.push_back(parse_number(trim(item.substr(0, colon)), "wavelength"));
         s.values.push_back(parse_number(trim(item.substr(colon + 1)), "spectrum value"));
@@ -128,7 +130,8 @@ SpectrumData read_spd_file(const std::string &path) {
         std::string wl, v, extra;
         if (!(ls >> wl)) continue;
         if (!(ls >> v) || (ls >> extra))
-            FACET_THROW("spectrum file \"{}\", line {}: expected \"wavelength value\"", path, line_no);
+            FACET_THROW("spectrum file \"{}\", line {}: expected \"wavelength value\"", path,
+                        line_no);
         try {
             s.wavelengths.push_back(parse_number(wl, "wavelength"));
             s.values.push_back(parse_number(v, "value"));

@@ -103,15 +103,23 @@ Normal3f Transform::apply_normal(const Normal3f &n) const {
 
 Transform Transform::translate(const Vector3f &v) {
     Matrix4f m, inv;
-    m.m[0][3] = v.x; m.m[1][3] = v.y; m.m[2][3] = v.z;
-    inv.m[0][3] = -v.x; inv.m[1][3] = -v.y; inv.m[2][3] = -v.z;
+    m.m[0][3] = v.x;
+    m.m[1][3] = v.y;
+    m.m[2][3] = v.z;
+    inv.m[0][3] = -v.x;
+    inv.m[1][3] = -v.y;
+    inv.m[2][3] = -v.z;
     return Transform(m, inv);
 }
 
 Transform Transform::scale(const Vector3f &v) {
     Matrix4f m, inv;
-    m.m[0][0] = v.x; m.m[1][1] = v.y; m.m[2][2] = v.z;
-    inv.m[0][0] = 1.f / v.x; inv.m[1][1] = 1.f / v.y; inv.m[2][2] = 1.f / v.z;
+    m.m[0][0] = v.x;
+    m.m[1][1] = v.y;
+    m.m[2][2] = v.z;
+    inv.m[0][0] = 1.f / v.x;
+    inv.m[1][1] = 1.f / v.y;
+    inv.m[2][2] = 1.f / v.z;
     return Transform(m, inv);
 }
 

@@ -9,8 +9,6 @@
 //  3. instantiate: children first, each node once; then parameters_changed() on every object.
 // Every error is a facet::Error carrying the file:line:col of the element it concerns.
 
-#include <facet/xml.h>
-
 #include <facet/frame.h>
 #include <facet/logger.h>
 #include <facet/plugin.h>
@@ -19,19 +17,19 @@
 #include <facet/scene.h>
 #include <facet/spectrum.h>
 #include <facet/transform.h>
-
-#include <pugixml.hpp>
+#include <facet/xml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <pugixml.hpp>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
@@ -55,12 +53,12 @@ struct ObjectTag {
 
 /// The object tags of the grammar. `<spectrum type="...">` is handled separately (a texture).
 constexpr ObjectTag OBJECT_TAGS[] = {
-    {"scene", ObjectType::Scene},       {"shape", ObjectType::Shape},
-    {"bsdf", ObjectType::BSDF},         {"emitter", ObjectType::Emitter},
-    {"sensor", ObjectType::Sensor},     {"film", ObjectType::Film},
-    {"sampler", ObjectType::Sampler},   {"integrator", ObjectType::Integrator},
-    {"texture", ObjectType::Texture},   {"rfilter", ObjectType::ReconstructionFilter},
-    {"medium", ObjectType::Medium},     {"phase", ObjectType::PhaseFunction},
+    {"scene", ObjectType::Scene},     {"shape", ObjectType::Shape},
+    {"bsdf", ObjectType::BSDF},       {"emitter", ObjectType::Emitter},
+    {"sensor", ObjectType::Sensor},   {"film", ObjectType::Film},
+    {"sampler", ObjectType::Sampler}, {"integrator", ObjectType::Integrator},
+    {"texture", ObjectType::Texture}, {"rfilter", ObjectType::ReconstructionFilter},
+    {"medium", ObjectType::Medium},   {"phase", ObjectType::PhaseFunction},
     {"volume", ObjectType::Volume},
 };
 
@@ -106,10 +104,10 @@ struct SourceFile {
     fs::path dir;          ///< folder for relative <include> and <path> values
     std::string canonical; ///< for include-cycle detection; empty for strings
     std::string text;
-    size_t bom = 0;        ///< bytes of a UTF-8 byte order mark skipped before parsing
+    size_t bom = 0; ///< bytes of a UTF-8 byte order mark skipped before parsing
     std::vector<size_t> line_starts;
     Version version;
-    bool upgrade = false;  ///< version < 2.0.0: apply the 0.x upgrade to this file's nodes
+    bool upgrade = false; ///< version < 2.0.0: apply the 0.x upgrade to this file's nodes
 
     SourceFile(std::string name_, fs::path dir_, std::string canonical_, std::string text_)
         : name(std::move(name_)), dir(std::move(dir_)), canonical(std::move(canonical_)),
@@ -135,7 +133,8 @@ struct Element {
     SourceFile *src;
     Location loc;
 
-    Element(pugi::xml_node n, SourceFile *s) : node(n), src(s), loc(s->location(n.offset_debug())) {}
+    Element(pugi::xml_node n, SourceFile *s)
+        : node(n), src(s), loc(s->location(n.offset_debug())) {}
     std::string tag() const { return node.name(); }
     /// "<float>", for messages.
     std::string bracketed() const { return "<" + tag() + ">"; }
@@ -163,8 +162,8 @@ std::string canonical_name(const fs::path &path) {
 // =============================================================================================
 
 std::string_view trim(std::string_view s) {
-    while (!s.empty() && std::isspace((unsigned char) s.front())) s.remove_prefix(1);
-    while (!s.empty() && std::isspace((unsigned char) s.back())) s.remove_suffix(1);
+    while (!s.empty() && std::isspace((unsigned char)s.front())) s.remove_prefix(1);
+    while (!s.empty() && std::isspace((unsigned char)s.back())) s.remove_suffix(1);
     return s;
 }
 
@@ -190,7 +189,7 @@ std::vector<std::string> tokenize(const std::string &text) {
     std::vector<std::string> out;
     std::string cur;
     for (char c : text) {
-        if (c == ',' || std::isspace((unsigned char) c)) {
+        if (c == ',' || std::isspace((unsigned char)c)) {
             if (!cur.empty()) out.push_back(std::move(cur));
             cur.clear();
         } else {
@@ -216,16 +215,19 @@ std::vector<double> to_doubles(const Element &el, const std::string &text) {
 
 int64_t to_int(const Element &el, const std::string &text) {
     int64_t v;
-    if (!parse_int(text, v)) fail(el.loc, fmt::format("could not parse integer value \"{}\"", text));
+    if (!parse_int(text, v))
+        fail(el.loc, fmt::format("could not parse integer value \"{}\"", text));
     return v;
 }
 
 bool to_bool(const Element &el, const std::string &text) {
     std::string s(trim(text));
-    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    std::transform(s.begin(), s.end(), s.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     if (s == "true") return true;
     if (s == "false") return false;
-    fail(el.loc, fmt::format("could not parse boolean value \"{}\" (expected true or false)", text));
+    fail(el.loc,
+         fmt::format("could not parse boolean value \"{}\" (expected true or false)", text));
 }
 
 /// 0.x scenes: `intIOR` -> `int_ior`. An underscore goes before a capital that follows a
@@ -233,9 +235,9 @@ bool to_bool(const Element &el, const std::string &text) {
 std::string camel_to_snake(const std::string &name) {
     std::string out;
     for (size_t i = 0; i < name.size(); ++i) {
-        unsigned char c = (unsigned char) name[i];
+        unsigned char c = (unsigned char)name[i];
         if (std::isupper(c)) {
-            if (i > 0 && std::islower((unsigned char) name[i - 1])) out += '_';
+            if (i > 0 && std::islower((unsigned char)name[i - 1])) out += '_';
             out += char(std::tolower(c));
         } else {
             out += char(c);
@@ -244,7 +246,7 @@ std::string camel_to_snake(const std::string &name) {
     return out;
 }
 
-bool is_ident_char(char c) { return std::isalnum((unsigned char) c) || c == '_'; }
+bool is_ident_char(char c) { return std::isalnum((unsigned char)c) || c == '_'; }
 
 bool all_finite(const Matrix4f &m) {
     for (const auto &row : m.m)
@@ -276,7 +278,7 @@ struct ObjectNode {
     Location location;
     std::vector<Entry> entries;
     std::unordered_map<std::string, Location> names; ///< entry names, for duplicate checks
-    size_t arg_counter = 0; ///< next `_arg_N`
+    size_t arg_counter = 0;                          ///< next `_arg_N`
     std::shared_ptr<Object> instance;
 
     Entry *find(const std::string &name) {
@@ -344,7 +346,8 @@ public:
         SourceFile *src = add_source(path, dir, canonical_name(path), std::move(text));
 
         ResolverGuard guard;
-        file_resolver().prepend(fs::absolute(dir.empty() ? fs::path(".") : dir).lexically_normal().string());
+        file_resolver().prepend(
+            fs::absolute(dir.empty() ? fs::path(".") : dir).lexically_normal().string());
         return load(src, require_scene);
     }
 
@@ -360,9 +363,8 @@ private:
 
         size_t root = parse_document(src, NoNode, "");
         if (require_scene && m_nodes[root].kind != ObjectType::Scene)
-            fail(m_nodes[root].location,
-                 fmt::format("expected a <scene> root element, found <{}>",
-                             object_kind_name(m_nodes[root].kind)));
+            fail(m_nodes[root].location, fmt::format("expected a <scene> root element, found <{}>",
+                                                     object_kind_name(m_nodes[root].kind)));
         check_unused_parameters(src->name);
         apply_aliases();
         resolve_references();
@@ -375,14 +377,16 @@ private:
                 node.instance->parameters_changed();
             } catch (const std::exception &e) {
                 throw instantiation_error(
-                    node, e, fmt::format("failed to initialise {} plugin of type \"{}\"",
-                                         object_kind_name(node.kind), node.plugin));
+                    node, e,
+                    fmt::format("failed to initialise {} plugin of type \"{}\"",
+                                object_kind_name(node.kind), node.plugin));
             }
         }
         return result;
     }
 
-    SourceFile *add_source(std::string name, fs::path dir, std::string canonical, std::string text) {
+    SourceFile *add_source(std::string name, fs::path dir, std::string canonical,
+                           std::string text) {
         m_sources.push_back(std::make_unique<SourceFile>(std::move(name), std::move(dir),
                                                          std::move(canonical), std::move(text)));
         return m_sources.back().get();
@@ -393,8 +397,9 @@ private:
     void update_keys() {
         m_keys.clear();
         for (const auto &kv : m_params) m_keys.push_back(kv.first);
-        std::stable_sort(m_keys.begin(), m_keys.end(),
-                         [](const std::string &a, const std::string &b) { return a.size() > b.size(); });
+        std::stable_sort(
+            m_keys.begin(), m_keys.end(),
+            [](const std::string &a, const std::string &b) { return a.size() > b.size(); });
     }
 
     /// Replaces `$key` by its value (longest keys first), `\$` by `$`; a `$name` that matches no
@@ -475,7 +480,8 @@ private:
             if (c.type() == pugi::node_element)
                 fail(Element(c, el.src).loc,
                      fmt::format("unexpected element <{}> inside {}: this element cannot have "
-                                 "children", c.name(), el.bracketed()));
+                                 "children",
+                                 c.name(), el.bracketed()));
     }
 
     /// A 3-vector from `value` (1 or 3 numbers) or from x/y/z attributes. A missing x/y/z takes
@@ -485,7 +491,8 @@ private:
         if (has_attr(el, "value")) {
             if (has_xyz)
                 fail(el.loc, fmt::format("{} can have either a \"value\" attribute or x/y/z "
-                                         "attributes, not both", el.bracketed()));
+                                         "attributes, not both",
+                                         el.bracketed()));
             return vector_from_text(el, "value", attr(el, "value"));
         }
         if (!def && !has_xyz)
@@ -505,7 +512,8 @@ private:
     }
 
     /// "x, y, z" or a single value for all three components.
-    static Vector3f vector_from_text(const Element &el, const char *attr_name, const std::string &text) {
+    static Vector3f vector_from_text(const Element &el, const char *attr_name,
+                                     const std::string &text) {
         std::vector<double> v = to_doubles(el, text);
         if (v.size() == 1) return Vector3f(float(v[0]));
         if (v.size() != 3)
@@ -596,9 +604,11 @@ private:
                    tag == "include" || tag == "alias" || tag == "path" ||
                    is_transform_op(tag, src->upgrade)) {
             fail(root.loc, fmt::format("the root element must be <scene> or an object tag such as "
-                                       "<bsdf>, not {}", root.bracketed()));
+                                       "<bsdf>, not {}",
+                                       root.bracketed()));
         } else {
-            fail(root.loc, fmt::format("encountered an unsupported XML element: {}", root.bracketed()));
+            fail(root.loc,
+                 fmt::format("encountered an unsupported XML element: {}", root.bracketed()));
         }
         m_include_stack.pop_back();
         return index;
@@ -618,7 +628,8 @@ private:
             int64_t v[3];
             if (parts.size() != 3 || !parse_int(parts[0], v[0]) || !parse_int(parts[1], v[1]) ||
                 !parse_int(parts[2], v[2]) || v[0] < 0 || v[1] < 0 || v[2] < 0)
-                fail(root.loc, fmt::format("invalid version \"{}\" (expected X.Y.Z, e.g. 3.0.0)", text));
+                fail(root.loc,
+                     fmt::format("invalid version \"{}\" (expected X.Y.Z, e.g. 3.0.0)", text));
             src->version = Version{int(v[0]), int(v[1]), int(v[2])};
         }
         src->upgrade = src->version.before(2, 0, 0);
@@ -645,7 +656,8 @@ private:
         for (size_t i = 0; i < m_include_stack.size(); ++i) {
             if (m_include_stack[i]->canonical != canonical) continue;
             std::string chain;
-            for (size_t j = i; j < m_include_stack.size(); ++j) chain += m_include_stack[j]->name + " -> ";
+            for (size_t j = i; j < m_include_stack.size(); ++j)
+                chain += m_include_stack[j]->name + " -> ";
             fail(el.loc, "include cycle detected: " + chain + found.string());
         }
         if (int(m_include_stack.size()) > MaxIncludeDepth)
@@ -655,7 +667,8 @@ private:
         bool ok = false;
         std::string text = read_text_file(found, ok);
         if (!ok) fail(el.loc, fmt::format("could not open included file \"{}\"", found.string()));
-        SourceFile *src = add_source(found.string(), found.parent_path(), canonical, std::move(text));
+        SourceFile *src =
+            add_source(found.string(), found.parent_path(), canonical, std::move(text));
         parse_document(src, parent, name);
     }
 
@@ -670,7 +683,8 @@ private:
         std::string tag = el.tag();
         if (tag == "scene")
             fail(el.loc, "<scene> may only appear as the root element of a file");
-        else if (object_tag_kind(tag) != ObjectType::Unknown || (tag == "spectrum" && has_attr(el, "type")))
+        else if (object_tag_kind(tag) != ObjectType::Unknown ||
+                 (tag == "spectrum" && has_attr(el, "type")))
             parse_object(el, parent, false, "");
         else if (is_property_tag(tag))
             parse_property(el, parent);
@@ -693,7 +707,8 @@ private:
     }
 
     /// An object tag (also a non-scene root). Returns its node.
-    size_t parse_object(const Element &el, size_t parent, bool is_root, const std::string &name_override) {
+    size_t parse_object(const Element &el, size_t parent, bool is_root,
+                        const std::string &name_override) {
         if (is_root)
             check_attributes(el, {"version", "type", "id", "name"});
         else
@@ -701,7 +716,8 @@ private:
         std::string tag = el.tag();
         ObjectType kind = tag == "spectrum" ? ObjectType::Texture : object_tag_kind(tag);
         std::string type = attr(el, "type");
-        if (type.empty()) fail(el.loc, fmt::format("empty \"type\" attribute in element {}", el.bracketed()));
+        if (type.empty())
+            fail(el.loc, fmt::format("empty \"type\" attribute in element {}", el.bracketed()));
         std::string id = attr(el, "id", "");
         std::string name = name_override.empty() ? property_name(el, true) : name_override;
 
@@ -749,7 +765,8 @@ private:
     SpectrumData read_spectrum(const Element &el) {
         bool has_value = has_attr(el, "value"), has_file = has_attr(el, "filename");
         if (has_value == has_file)
-            fail(el.loc, "<spectrum> needs exactly one of the attributes \"value\" and \"filename\"");
+            fail(el.loc,
+                 "<spectrum> needs exactly one of the attributes \"value\" and \"filename\"");
         try {
             if (has_value) return parse_spectrum_pairs(attr(el, "value"));
             std::string filename = attr(el, "filename");
@@ -772,7 +789,8 @@ private:
             Element op(c, el.src);
             if (!is_transform_op(op.tag(), el.src->upgrade))
                 fail(op.loc, fmt::format("{} cannot appear inside <transform>: only translate, "
-                                         "rotate, scale, matrix and lookat can", op.bracketed()));
+                                         "rotate, scale, matrix and lookat can",
+                                         op.bracketed()));
             // Each operation is applied after the previous ones.
             t = parse_transform_op(op) * t;
         }
@@ -862,14 +880,16 @@ private:
     void parse_path(const Element &el, bool parent_is_root) {
         check_attributes(el, {"value"});
         check_no_children(el);
-        if (!parent_is_root) fail(el.loc, "<path> may only appear directly inside the root element");
+        if (!parent_is_root)
+            fail(el.loc, "<path> may only appear directly inside the root element");
         std::string value = attr(el, "value");
         fs::path p(value), found = p;
         if (p.is_relative()) {
             found = el.src->dir / p;
             if (!fs::is_directory(found)) found = file_resolver().resolve(value);
         }
-        if (!fs::is_directory(found)) fail(el.loc, fmt::format("folder \"{}\" does not exist", value));
+        if (!fs::is_directory(found))
+            fail(el.loc, fmt::format("folder \"{}\" does not exist", value));
         file_resolver().prepend(fs::absolute(found).lexically_normal().string());
     }
 
@@ -923,9 +943,10 @@ private:
         if (unused.empty()) return;
         std::string list;
         for (size_t i = 0; i < unused.size(); ++i) list += (i ? ", " : "") + unused[i];
-        std::string msg = unused.size() == 1
-                              ? fmt::format("unused parameter {}: {} never references it", list, file)
-                              : fmt::format("unused parameters {}: {} never references them", list, file);
+        std::string msg =
+            unused.size() == 1
+                ? fmt::format("unused parameter {}: {} never references it", list, file)
+                : fmt::format("unused parameters {}: {} never references them", list, file);
         if (!m_opts.lenient) throw Error(msg);
         FACET_LOG(Warn, "{}", msg);
     }
@@ -949,8 +970,9 @@ private:
                                              did_you_mean(a.source)));
             auto dst = m_ids.find(a.target);
             if (dst != m_ids.end())
-                fail(a.location, fmt::format("<alias> target id \"{}\" already exists (declared at {})",
-                                             a.target, dst->second.location.to_string()));
+                fail(a.location,
+                     fmt::format("<alias> target id \"{}\" already exists (declared at {})",
+                                 a.target, dst->second.location.to_string()));
             m_ids.emplace(a.target, IdEntry{src->second.node, a.location});
         }
     }
@@ -982,8 +1004,10 @@ private:
             if (state[e.child] == 1) {
                 auto start = std::find(stack.begin(), stack.end(), e.child);
                 std::string chain;
-                for (auto it = start; it != stack.end(); ++it) chain += m_nodes[*it].describe() + " -> ";
-                fail(e.location, "circular reference detected: " + chain + m_nodes[e.child].describe());
+                for (auto it = start; it != stack.end(); ++it)
+                    chain += m_nodes[*it].describe() + " -> ";
+                fail(e.location,
+                     "circular reference detected: " + chain + m_nodes[e.child].describe());
             }
             if (state[e.child] == 0) visit_for_cycles(e.child, state, stack);
         }

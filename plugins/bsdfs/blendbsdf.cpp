@@ -44,8 +44,10 @@ public:
             auto bsdf = std::dynamic_pointer_cast<BSDF>(obj);
             if (!bsdf) continue;
             if (count == 2)
-                FACET_THROW_AT(props.location(), "blendbsdf takes exactly two nested BSDFs, found "
-                               "a third (\"{}\")", name);
+                FACET_THROW_AT(props.location(),
+                               "blendbsdf takes exactly two nested BSDFs, found "
+                               "a third (\"{}\")",
+                               name);
             m_nested[count++] = bsdf;
             props.mark_queried(name);
         }
@@ -98,7 +100,8 @@ public:
         u = clamp(u, 0.f, OneMinusEpsilon);
         float p_which = which == 1 ? w : 1.f - w;
         auto [bs, value] = m_nested[which]->sample(ctx, si, u, sample2);
-        if (which == 1 && bs.sampled_component != uint32_t(-1)) bs.sampled_component += m_first_count;
+        if (which == 1 && bs.sampled_component != uint32_t(-1))
+            bs.sampled_component += m_first_count;
         if (value.is_black() || !(p_which > 0.f)) return {bs, Color3f(0.f)};
 
         if (has_flag(bs.sampled_type, BSDFFlags::Delta | BSDFFlags::Delta1D)) {
@@ -189,7 +192,9 @@ public:
     }
 
 private:
-    float weight(const SurfaceInteraction &si) const { return clamp(m_weight->eval_1(si), 0.f, 1.f); }
+    float weight(const SurfaceInteraction &si) const {
+        return clamp(m_weight->eval_1(si), 0.f, 1.f);
+    }
 
     /// The nested BSDF that owns ctx.component, and the context with the component renumbered
     /// for it.

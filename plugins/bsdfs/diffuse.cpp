@@ -36,7 +36,8 @@ public:
     }
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                          float /*sample1*/, const Point2f &sample2) const override {
+                                          float /*sample1*/,
+                                          const Point2f &sample2) const override {
         BSDFSample bs;
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || Frame::cos_theta(si.wi) <= 0.f)
             return {bs, Color3f(0.f)};

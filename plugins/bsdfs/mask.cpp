@@ -43,8 +43,10 @@ public:
             auto bsdf = std::dynamic_pointer_cast<BSDF>(obj);
             if (!bsdf) continue;
             if (m_nested)
-                FACET_THROW_AT(props.location(), "mask takes exactly one nested BSDF, found a "
-                               "second (\"{}\")", name);
+                FACET_THROW_AT(props.location(),
+                               "mask takes exactly one nested BSDF, found a "
+                               "second (\"{}\")",
+                               name);
             m_nested = bsdf;
             props.mark_queried(name);
         }

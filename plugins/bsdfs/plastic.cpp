@@ -134,7 +134,8 @@ public:
         if (!has_diffuse || cos_i <= 0.f || cos_o <= 0.f) return {Color3f(0.f), 0.f};
         float F_i = fresnel_dielectric(cos_i, m_eta).F;
         float p_diff = 1.f - specular_probability(F_i, has_specular, has_diffuse);
-        return {diffuse_value(si, cos_i, cos_o), p_diff * warp::square_to_cosine_hemisphere_pdf(wo)};
+        return {diffuse_value(si, cos_i, cos_o),
+                p_diff * warp::square_to_cosine_hemisphere_pdf(wo)};
     }
 
     Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const override {
@@ -142,11 +143,12 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("Plastic[eta = {}, diffuse_reflectance = {}, specular_reflectance = {}, "
-                           "nonlinear = {}, fdr_int = {}, fdr_ext = {}, specular_sampling_weight = {}]",
-                           m_eta, m_diffuse_reflectance->to_string(),
-                           m_specular_reflectance ? m_specular_reflectance->to_string() : "1",
-                           m_nonlinear, m_fdr_int, m_fdr_ext, m_specular_sampling_weight);
+        return fmt::format(
+            "Plastic[eta = {}, diffuse_reflectance = {}, specular_reflectance = {}, "
+            "nonlinear = {}, fdr_int = {}, fdr_ext = {}, specular_sampling_weight = {}]",
+            m_eta, m_diffuse_reflectance->to_string(),
+            m_specular_reflectance ? m_specular_reflectance->to_string() : "1", m_nonlinear,
+            m_fdr_int, m_fdr_ext, m_specular_sampling_weight);
     }
 
 private:

@@ -167,8 +167,8 @@ CoatingTables compute_tables(MicrofacetType type, float alpha, float eta) {
         Vector3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
         double t = rough_interface_energy(distr, wi, eta, false, nodes_ext, weights_ext);
         tables.external_transmittance[size_t(j)] = float(clamp(t, 0.0, 1.0));
-        internal += rough_interface_energy(distr, wi, 1.f / eta, true, nodes_int, weights_int) *
-                    double(mu);
+        internal +=
+            rough_interface_energy(distr, wi, 1.f / eta, true, nodes_int, weights_int) * double(mu);
     }
     tables.internal_reflectance = float(2.0 * internal / TransmittanceRes);
     return tables;
@@ -193,14 +193,16 @@ public:
         m_microfacet = read_microfacet(props, 0.1f, /*allow_textures=*/false);
         if (m_microfacet.is_anisotropic())
             FACET_THROW_AT(props.location(), "roughplastic is isotropic only: give one alpha, not "
-                           "different alpha_u and alpha_v");
+                                             "different alpha_u and alpha_v");
         m_alpha = m_microfacet.alpha_u()->mean().mean();
 
         float int_ior = read_ior(props, "int_ior", "polypropylene");
         float ext_ior = read_ior(props, "ext_ior", "air");
         if (int_ior == ext_ior)
-            FACET_THROW_AT(props.location(), "roughplastic: int_ior and ext_ior must differ (both "
-                           "are {}), otherwise there is no coating; use diffuse instead", int_ior);
+            FACET_THROW_AT(props.location(),
+                           "roughplastic: int_ior and ext_ior must differ (both "
+                           "are {}), otherwise there is no coating; use diffuse instead",
+                           int_ior);
         m_eta = int_ior / ext_ior;
         m_inv_eta_2 = 1.f / (m_eta * m_eta);
 
@@ -294,8 +296,8 @@ public:
             Color3f rho = m_diffuse_reflectance->eval(si);
             Color3f albedo = m_nonlinear ? rho / (Color3f(1.f) - rho * m_internal_reflectance)
                                          : rho / (1.f - m_internal_reflectance);
-            value += albedo * (m_inv_eta_2 * transmittance(cos_i) * transmittance(cos_o) * InvPi *
-                               cos_o);
+            value += albedo *
+                     (m_inv_eta_2 * transmittance(cos_i) * transmittance(cos_o) * InvPi * cos_o);
             pdf += (1.f - p_spec) * warp::square_to_cosine_hemisphere_pdf(wo);
         }
         return {value, pdf};

@@ -41,14 +41,16 @@ public:
             auto bsdf = std::dynamic_pointer_cast<BSDF>(obj);
             if (!bsdf) continue;
             if (nested.size() == 2)
-                FACET_THROW_AT(props.location(), "twosided takes at most two nested BSDFs (front "
-                               "and back side), found a third (\"{}\")", name);
+                FACET_THROW_AT(props.location(),
+                               "twosided takes at most two nested BSDFs (front "
+                               "and back side), found a third (\"{}\")",
+                               name);
             nested.push_back(bsdf);
             props.mark_queried(name);
         }
         if (nested.empty())
             FACET_THROW_AT(props.location(), "twosided needs a nested BSDF (one for both sides, or "
-                           "two: front then back)");
+                                             "two: front then back)");
         m_front = nested[0];
         m_back = nested.size() == 2 ? nested[1] : nested[0];
         m_allow_transmission = props.get_bool("allow_transmission", false);
@@ -60,10 +62,12 @@ public:
             components.push_back((m_back->flags(i) & ~BSDFFlags::FrontSide) | BSDFFlags::BackSide);
         set_components(std::move(components));
         if (has_flag(m_flags, BSDFFlags::Transmission) && !m_allow_transmission)
-            FACET_THROW_AT(props.location(), "twosided: the nested BSDF transmits light ({}); only "
+            FACET_THROW_AT(props.location(),
+                           "twosided: the nested BSDF transmits light ({}); only "
                            "reflecting BSDFs can be nested unless allow_transmission is true",
-                           has_flag(m_front->flags(), BSDFFlags::Transmission) ? m_front->to_string()
-                                                                               : m_back->to_string());
+                           has_flag(m_front->flags(), BSDFFlags::Transmission)
+                               ? m_front->to_string()
+                               : m_back->to_string());
         m_front_count = uint32_t(m_front->component_count());
     }
 

@@ -31,14 +31,16 @@ public:
         m_irradiance = props.get_color("irradiance", Color3f(1.f), SpectrumKind::Emission);
         bool has_dir = props.has("direction"), has_xf = props.has("to_world");
         if (has_dir && has_xf)
-            FACET_THROW_AT(props.location(), "directional: give either \"direction\" or \"to_world\", not both");
+            FACET_THROW_AT(props.location(),
+                           "directional: give either \"direction\" or \"to_world\", not both");
         Vector3f d(0.f, 0.f, 1.f);
         if (has_dir)
             d = props.get_vector("direction");
         else if (has_xf)
             d = props.get_transform("to_world").apply_vector(Vector3f(0.f, 0.f, 1.f));
         if (!(norm(d) > 0.f) || !is_finite(d))
-            FACET_THROW_AT(props.location(), "directional: the direction must be a non-zero vector");
+            FACET_THROW_AT(props.location(),
+                           "directional: the direction must be a non-zero vector");
         m_direction = normalize(d);
         m_flags = EmitterFlags::DeltaDirection | EmitterFlags::Infinite;
     }

@@ -42,8 +42,10 @@ float srgb_to_linear(float v) {
 }
 bool is_display_encoded(const std::string &path) {
     std::string ext = path.substr(path.find_last_of('.') + 1);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == "png" || ext == "jpg" || ext == "jpeg" || ext == "bmp" || ext == "tga" || ext == "gif";
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == "png" || ext == "jpg" || ext == "jpeg" || ext == "bmp" || ext == "tga" ||
+           ext == "gif";
 }
 } // namespace
 
@@ -56,7 +58,8 @@ public:
         m_to_world = props.get_transform("to_world", Transform());
         std::string filter = props.get_string("filter_type", "bilinear");
         if (filter != "bilinear" && filter != "nearest")
-            FACET_THROW_AT(props.location("filter_type"), "envmap: filter_type must be bilinear or nearest, got \"{}\"", filter);
+            FACET_THROW_AT(props.location("filter_type"),
+                           "envmap: filter_type must be bilinear or nearest, got \"{}\"", filter);
         m_bilinear = filter == "bilinear";
         m_importance = props.get_bool("importance_sampling", true);
 
@@ -80,8 +83,11 @@ public:
                     c[ch] = (decode ? srgb_to_linear(v) : v) * m_scale;
                 }
                 if (!c.is_finite())
-                    FACET_THROW_AT(props.location("filename"), "envmap: \"{}\" has a non-finite pixel at ({}, {})", m_path, x, y);
-                m_pixels[size_t(y) * m_width + x] = Color3f(std::max(c.r, 0.f), std::max(c.g, 0.f), std::max(c.b, 0.f));
+                    FACET_THROW_AT(props.location("filename"),
+                                   "envmap: \"{}\" has a non-finite pixel at ({}, {})", m_path, x,
+                                   y);
+                m_pixels[size_t(y) * m_width + x] =
+                    Color3f(std::max(c.r, 0.f), std::max(c.g, 0.f), std::max(c.b, 0.f));
             }
         build_distribution();
         m_flags = EmitterFlags::Infinite | EmitterFlags::SpatiallyVarying;
@@ -120,7 +126,8 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("EnvironmentMap[\"{}\", {}x{}, scale={}]", m_path, m_width, m_height, m_scale);
+        return fmt::format("EnvironmentMap[\"{}\", {}x{}, scale={}]", m_path, m_width, m_height,
+                           m_scale);
     }
 
 private:
@@ -165,7 +172,8 @@ private:
 
     struct Cell {
         float u0, du, v0, dv;
-        float a, b, c, d; ///< luminance at the corners (u0,v0), (u0+du,v0), (u0,v0+dv), (u0+du,v0+dv)
+        float a, b, c,
+            d; ///< luminance at the corners (u0,v0), (u0+du,v0), (u0,v0+dv), (u0+du,v0+dv)
     };
 
     Cell cell(int i, int j) const {
@@ -216,7 +224,8 @@ private:
     }
 
     static float bilinear(const Cell &c, float s, float t) {
-        return (1.f - s) * (1.f - t) * c.a + s * (1.f - t) * c.b + (1.f - s) * t * c.c + s * t * c.d;
+        return (1.f - s) * (1.f - t) * c.a + s * (1.f - t) * c.b + (1.f - s) * t * c.c +
+               s * t * c.d;
     }
 
     /// Inverse CDF of the density on [0, 1] proportional to the line from v0 to v1.
@@ -261,8 +270,10 @@ private:
         for (int j = 0; j < cells_y(); ++j)
             for (int i = 0; i < cells_x(); ++i) {
                 Cell c = cell(i, j);
-                float solid_angle = 2.f * Pi * c.du * (std::cos(c.v0 * Pi) - std::cos((c.v0 + c.dv) * Pi));
-                weights[size_t(j) * size_t(cells_x()) + size_t(i)] = 0.25f * (c.a + c.b + c.c + c.d) * solid_angle;
+                float solid_angle =
+                    2.f * Pi * c.du * (std::cos(c.v0 * Pi) - std::cos((c.v0 + c.dv) * Pi));
+                weights[size_t(j) * size_t(cells_x()) + size_t(i)] =
+                    0.25f * (c.a + c.b + c.c + c.d) * solid_angle;
             }
         m_cells.build(weights.data(), weights.size());
     }

@@ -42,9 +42,11 @@ public:
         float cutoff = float(props.get_float("cutoff_angle", 20.0));
         float beam = float(props.get_float("beam_width", cutoff * 0.75));
         if (!(cutoff > 0.f && cutoff < 90.f))
-            FACET_THROW_AT(props.location(), "spot: cutoff_angle must be in (0, 90) degrees, got {}", cutoff);
+            FACET_THROW_AT(props.location(),
+                           "spot: cutoff_angle must be in (0, 90) degrees, got {}", cutoff);
         if (!(beam >= 0.f && beam <= cutoff))
-            FACET_THROW_AT(props.location(), "spot: beam_width must be in [0, cutoff_angle], got {}", beam);
+            FACET_THROW_AT(props.location(),
+                           "spot: beam_width must be in [0, cutoff_angle], got {}", beam);
         m_cutoff = deg_to_rad(cutoff);
         m_beam = deg_to_rad(beam);
         m_cos_cutoff = std::cos(m_cutoff);
@@ -52,7 +54,8 @@ public:
         m_uv_factor = std::tan(m_cutoff);
         m_position = m_to_world.apply_point(Point3f(0.f));
         m_flags = EmitterFlags::DeltaPosition;
-        if (m_texture && m_texture->is_spatially_varying()) m_flags = m_flags | EmitterFlags::SpatiallyVarying;
+        if (m_texture && m_texture->is_spatially_varying())
+            m_flags = m_flags | EmitterFlags::SpatiallyVarying;
     }
 
     /// Intensity towards the local direction d (unit vector).
@@ -65,7 +68,8 @@ public:
         Color3f result = m_intensity * falloff;
         if (m_texture) {
             SurfaceInteraction si;
-            si.uv = Point2f(0.5f + 0.5f * d.x / (d.z * m_uv_factor), 0.5f + 0.5f * d.y / (d.z * m_uv_factor));
+            si.uv = Point2f(0.5f + 0.5f * d.x / (d.z * m_uv_factor),
+                            0.5f + 0.5f * d.y / (d.z * m_uv_factor));
             result *= m_texture->eval(si);
         }
         return result;
@@ -118,4 +122,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::SpotEmitter, Emitter, "spot", "Spot light with a linear angular falloff", DOC)
+FACET_EXPORT_PLUGIN(facet::SpotEmitter, Emitter, "spot", "Spot light with a linear angular falloff",
+                    DOC)

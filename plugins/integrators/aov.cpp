@@ -34,7 +34,18 @@ scalars. Types: `albedo`, `depth`, `position`, `uv`, `geo_normal`, `sh_normal`, 
 namespace facet {
 
 class AovIntegrator final : public SamplingIntegrator {
-    enum class Kind { Albedo, Depth, Position, UV, GeoNormal, ShNormal, DpDu, DpDv, PrimIndex, ShapeIndex };
+    enum class Kind {
+        Albedo,
+        Depth,
+        Position,
+        UV,
+        GeoNormal,
+        ShNormal,
+        DpDu,
+        DpDv,
+        PrimIndex,
+        ShapeIndex
+    };
     struct Aov {
         std::string name;
         Kind kind;
@@ -50,16 +61,21 @@ public:
             if (item.empty()) continue;
             size_t colon = item.find(':');
             if (colon == std::string::npos)
-                FACET_THROW_AT(props.location("aovs"), "aov: entry \"{}\" must read name:type", item);
+                FACET_THROW_AT(props.location("aovs"), "aov: entry \"{}\" must read name:type",
+                               item);
             std::string name = trim(item.substr(0, colon)), type = trim(item.substr(colon + 1));
             m_aovs.push_back({name, parse_kind(type, props)});
         }
-        if (m_aovs.empty()) FACET_THROW_AT(props.location("aovs"), "aov: the list \"aovs\" is empty");
+        if (m_aovs.empty())
+            FACET_THROW_AT(props.location("aovs"), "aov: the list \"aovs\" is empty");
         for (auto &[name, obj] : props.objects()) {
             auto integrator = std::dynamic_pointer_cast<SamplingIntegrator>(obj);
             if (!integrator)
-                FACET_THROW_AT(props.location(name), "aov: nested objects must be sampling integrators");
-            if (m_nested) FACET_THROW_AT(props.location(name), "aov: only one nested integrator is supported");
+                FACET_THROW_AT(props.location(name),
+                               "aov: nested objects must be sampling integrators");
+            if (m_nested)
+                FACET_THROW_AT(props.location(name),
+                               "aov: only one nested integrator is supported");
             m_nested = integrator;
             props.mark_queried(name);
         }
@@ -76,7 +92,8 @@ public:
         return names;
     }
 
-    Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray, float *aovs) const override {
+    Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray,
+                   float *aovs) const override {
         Color3f result(0.f);
         if (m_nested) result = m_nested->sample(scene, sampler, ray, aovs);
         float *out = aovs + m_nested_aovs;
@@ -99,51 +116,75 @@ private:
 
     static Kind parse_kind(const std::string &t, const Properties &props) {
         static const std::pair<const char *, Kind> table[] = {
-            {"albedo", Kind::Albedo},         {"depth", Kind::Depth},
-            {"position", Kind::Position},     {"uv", Kind::UV},
-            {"geo_normal", Kind::GeoNormal},  {"sh_normal", Kind::ShNormal},
-            {"dp_du", Kind::DpDu},            {"dp_dv", Kind::DpDv},
-            {"prim_index", Kind::PrimIndex},  {"shape_index", Kind::ShapeIndex}};
+            {"albedo", Kind::Albedo},        {"depth", Kind::Depth},
+            {"position", Kind::Position},    {"uv", Kind::UV},
+            {"geo_normal", Kind::GeoNormal}, {"sh_normal", Kind::ShNormal},
+            {"dp_du", Kind::DpDu},           {"dp_dv", Kind::DpDv},
+            {"prim_index", Kind::PrimIndex}, {"shape_index", Kind::ShapeIndex}};
         std::string known;
         for (auto &[name, kind] : table) {
             if (t == name) return kind;
             known += known.empty() ? name : std::string(", ") + name;
         }
-        FACET_THROW_AT(props.location("aovs"), "aov: unknown AOV type \"{}\" (known: {})", t, known);
+        FACET_THROW_AT(props.location("aovs"), "aov: unknown AOV type \"{}\" (known: {})", t,
+                       known);
     }
 
     static std::vector<const char *> suffixes(Kind k) {
         switch (k) {
-        case Kind::Albedo: return {"R", "G", "B"};
-        case Kind::UV: return {"U", "V"};
+        case Kind::Albedo:
+            return {"R", "G", "B"};
+        case Kind::UV:
+            return {"U", "V"};
         case Kind::Depth:
         case Kind::PrimIndex:
-        case Kind::ShapeIndex: return {""};
-        default: return {"X", "Y", "Z"};
+        case Kind::ShapeIndex:
+            return {""};
+        default:
+            return {"X", "Y", "Z"};
         }
     }
 
     static float *put3(float *out, const Vector3f &v) {
-        out[0] = v.x; out[1] = v.y; out[2] = v.z;
+        out[0] = v.x;
+        out[1] = v.y;
+        out[2] = v.z;
         return out + 3;
     }
 
-    float *write(Kind k, const Scene &scene, const SurfaceInteraction &si, bool hit, float *out) const {
+    float *write(Kind k, const Scene &scene, const SurfaceInteraction &si, bool hit,
+                 float *out) const {
         switch (k) {
         case Kind::Albedo: {
             Color3f c = hit ? si.bsdf()->eval_diffuse_reflectance(si) : Color3f(0.f);
-            out[0] = c.r; out[1] = c.g; out[2] = c.b;
+            out[0] = c.r;
+            out[1] = c.g;
+            out[2] = c.b;
             return out + 3;
         }
-        case Kind::Depth: *out = hit ? si.t : 0.f; return out + 1;
-        case Kind::Position: return put3(out, hit ? si.p : Vector3f(0.f));
-        case Kind::UV: out[0] = hit ? si.uv.x : 0.f; out[1] = hit ? si.uv.y : 0.f; return out + 2;
-        case Kind::GeoNormal: return put3(out, hit ? si.n : Vector3f(0.f));
-        case Kind::ShNormal: return put3(out, hit ? si.sh_frame.n : Vector3f(0.f));
-        case Kind::DpDu: return put3(out, hit ? si.dp_du : Vector3f(0.f));
-        case Kind::DpDv: return put3(out, hit ? si.dp_dv : Vector3f(0.f));
-        case Kind::PrimIndex: *out = hit ? float(si.prim_index) : -1.f; return out + 1;
-        case Kind::ShapeIndex: *out = hit ? float(shape_index(scene, si.shape)) : -1.f; return out + 1;
+        case Kind::Depth:
+            *out = hit ? si.t : 0.f;
+            return out + 1;
+        case Kind::Position:
+            return put3(out, hit ? si.p : Vector3f(0.f));
+        case Kind::UV:
+            out[0] = hit ? si.uv.x : 0.f;
+            out[1] = hit ? si.uv.y : 0.f;
+            return out + 2;
+        case Kind::GeoNormal:
+            return put3(out, hit ? si.n : Vector3f(0.f));
+        case Kind::ShNormal:
+            return put3(out, hit ? si.sh_frame.n : Vector3f(0.f));
+        case Kind::DpDu:
+            return put3(out, hit ? si.dp_du : Vector3f(0.f));
+        case Kind::DpDv:
+            return put3(out, hit ? si.dp_dv : Vector3f(0.f));
+        case Kind::PrimIndex:
+            *out = hit ? float(si.prim_index) : -1.f;
+            return out + 1;
+        case Kind::ShapeIndex:
+            *out = hit ? float(shape_index(scene, si.shape)) : -1.f;
+            return out + 1;
         }
         return out;
     }
@@ -163,4 +204,5 @@ private:
 } // namespace facet
 
 FACET_EXPORT_PLUGIN(facet::AovIntegrator, Integrator, "aov",
-                    "Geometric and material AOVs (albedo, normals, depth, ...) as extra channels", DOC)
+                    "Geometric and material AOVs (albedo, normals, depth, ...) as extra channels",
+                    DOC)

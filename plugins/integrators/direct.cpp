@@ -80,8 +80,7 @@ public:
 
         // ---- Emitters seen directly ----
         if (!m_hide_emitters) {
-            if (!hit)
-                return environment_mis(scene, ray, si, 0.f, true);
+            if (!hit) return environment_mis(scene, ray, si, 0.f, true);
             if (const Emitter *emitter = si.emitter()) result += emitter->eval(si);
         }
         if (!hit) return result;
@@ -99,8 +98,8 @@ public:
                 auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
                 if (f.is_black()) continue;
                 // Densities of the two strategies scaled by their share of the samples.
-                float w = ds.delta ? 1.f
-                                   : mis_weight(ds.pdf * m_frac_emitter, bsdf_pdf * m_frac_bsdf);
+                float w =
+                    ds.delta ? 1.f : mis_weight(ds.pdf * m_frac_emitter, bsdf_pdf * m_frac_bsdf);
                 result += f * em_weight * (w * m_weight_emitter);
             }
         }
@@ -116,8 +115,9 @@ public:
             Ray bsdf_ray = si.spawn_ray(si.to_world(bs.wo));
             SurfaceInteraction si_bsdf;
             if (!scene.ray_intersect(bsdf_ray, si_bsdf)) {
-                result += bsdf_weight * environment_mis(scene, bsdf_ray, si, bs.pdf * m_frac_bsdf,
-                                                                  delta, m_frac_emitter) *
+                result += bsdf_weight *
+                          environment_mis(scene, bsdf_ray, si, bs.pdf * m_frac_bsdf, delta,
+                                          m_frac_emitter) *
                           m_weight_bsdf;
                 continue;
             }

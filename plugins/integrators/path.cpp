@@ -73,8 +73,8 @@ public:
             // ---- Emission found by the previous BSDF sample (or by the camera ray) ----
             if (!hit) {
                 if (count_emission)
-                    result += throughput * environment_mis(scene, ray, prev_si, prev_bsdf_pdf,
-                                                       prev_bsdf_delta);
+                    result += throughput *
+                              environment_mis(scene, ray, prev_si, prev_bsdf_pdf, prev_bsdf_delta);
                 break;
             }
             if (count_emission) {
@@ -83,7 +83,8 @@ public:
                     if (!L.is_black()) {
                         float w = 1.f;
                         if (!prev_bsdf_delta) {
-                            float em_pdf = scene.pdf_emitter_direction(prev_si, direction_to(si, prev_si));
+                            float em_pdf =
+                                scene.pdf_emitter_direction(prev_si, direction_to(si, prev_si));
                             w = mis_weight(prev_bsdf_pdf, em_pdf);
                         }
                         result += throughput * L * w;

@@ -29,7 +29,9 @@ class LowDiscrepancySampler final : public Sampler {
 public:
     explicit LowDiscrepancySampler(const Properties &props) : Sampler(props) { round_count(); }
 
-    std::unique_ptr<Sampler> clone() const override { return std::make_unique<LowDiscrepancySampler>(*this); }
+    std::unique_ptr<Sampler> clone() const override {
+        return std::make_unique<LowDiscrepancySampler>(*this);
+    }
 
     void seed(uint64_t seed_value) override {
         round_count(); // the render loop may have changed the sample count

@@ -36,7 +36,9 @@ public:
         update_grid();
     }
 
-    std::unique_ptr<Sampler> clone() const override { return std::make_unique<MultijitterSampler>(*this); }
+    std::unique_ptr<Sampler> clone() const override {
+        return std::make_unique<MultijitterSampler>(*this);
+    }
 
     void seed(uint64_t seed_value) override {
         update_grid(); // the render loop may have changed the sample count
@@ -67,7 +69,8 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("MultijitterSampler[sample_count={}, grid={}x{}]", m_sample_count, m_m, m_n);
+        return fmt::format("MultijitterSampler[sample_count={}, grid={}x{}]", m_sample_count, m_m,
+                           m_n);
     }
 
 private:

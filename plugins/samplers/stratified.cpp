@@ -34,7 +34,9 @@ public:
         update_resolution();
     }
 
-    std::unique_ptr<Sampler> clone() const override { return std::make_unique<StratifiedSampler>(*this); }
+    std::unique_ptr<Sampler> clone() const override {
+        return std::make_unique<StratifiedSampler>(*this);
+    }
 
     void seed(uint64_t seed_value) override {
         update_resolution(); // the render loop may have changed the sample count
@@ -60,7 +62,8 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("StratifiedSampler[sample_count={}, jitter={}]", m_sample_count, m_jitter);
+        return fmt::format("StratifiedSampler[sample_count={}, jitter={}]", m_sample_count,
+                           m_jitter);
     }
 
 private:
@@ -71,7 +74,8 @@ private:
 
     float jitter(uint32_t dim_seed, uint32_t axis) const {
         if (!m_jitter) return 0.5f;
-        return qmc::to_unit_float(qmc::hash_combine(qmc::hash_combine(dim_seed, m_sample_index), axis + 1));
+        return qmc::to_unit_float(
+            qmc::hash_combine(qmc::hash_combine(dim_seed, m_sample_index), axis + 1));
     }
 
     bool m_jitter = true;

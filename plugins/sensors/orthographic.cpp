@@ -38,23 +38,27 @@ public:
         m_near_clip = float(props.get_float("near_clip", 1e-2));
         m_far_clip = float(props.get_float("far_clip", 1e4));
         if (!(m_near_clip >= 0.f) || !(m_far_clip > m_near_clip))
-            FACET_THROW_AT(props.location(), "the clipping planes must satisfy 0 <= near_clip < far_clip");
+            FACET_THROW_AT(props.location(),
+                           "the clipping planes must satisfy 0 <= near_clip < far_clip");
         Vector3f d = m_to_world.apply_vector(Vector3f(0.f, 0.f, 1.f));
         m_scale_z = norm(d);
-        if (!(m_scale_z > 0.f)) FACET_THROW_AT(props.location(), "orthographic: to_world is singular");
+        if (!(m_scale_z > 0.f))
+            FACET_THROW_AT(props.location(), "orthographic: to_world is singular");
         m_direction = d / m_scale_z;
     }
 
-    std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos, const Point2f &) const override {
+    std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
+                                       const Point2f &) const override {
         Point3f local((1.f - 2.f * film_pos.x), (1.f - 2.f * film_pos.y) * m_inv_aspect, 0.f);
-        Ray ray(m_to_world.apply_point(local), m_direction, m_near_clip * m_scale_z, m_far_clip * m_scale_z);
+        Ray ray(m_to_world.apply_point(local), m_direction, m_near_clip * m_scale_z,
+                m_far_clip * m_scale_z);
         ray.time = time;
         return {ray, Color3f(1.f)};
     }
 
     std::string to_string() const override {
-        return fmt::format("OrthographicCamera[near_clip={}, far_clip={}, film={}, sampler={}]", m_near_clip,
-                           m_far_clip, m_film->to_string(), m_sampler->to_string());
+        return fmt::format("OrthographicCamera[near_clip={}, far_clip={}, film={}, sampler={}]",
+                           m_near_clip, m_far_clip, m_film->to_string(), m_sampler->to_string());
     }
 
 private:
@@ -64,4 +68,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::OrthographicCamera, Sensor, "orthographic", "Orthographic (parallel) camera", DOC)
+FACET_EXPORT_PLUGIN(facet::OrthographicCamera, Sensor, "orthographic",
+                    "Orthographic (parallel) camera", DOC)

@@ -49,11 +49,14 @@ public:
         m_near_clip = float(props.get_float("near_clip", 1e-2));
         m_far_clip = float(props.get_float("far_clip", 1e4));
         if (!(m_aperture_radius >= 0.f))
-            FACET_THROW_AT(props.location("aperture_radius"), "aperture_radius must be >= 0, got {}", m_aperture_radius);
+            FACET_THROW_AT(props.location("aperture_radius"),
+                           "aperture_radius must be >= 0, got {}", m_aperture_radius);
         if (!(m_focus_distance > 0.f))
-            FACET_THROW_AT(props.location("focus_distance"), "focus_distance must be positive, got {}", m_focus_distance);
+            FACET_THROW_AT(props.location("focus_distance"),
+                           "focus_distance must be positive, got {}", m_focus_distance);
         if (!(m_near_clip > 0.f) || !(m_far_clip > m_near_clip))
-            FACET_THROW_AT(props.location(), "the clipping planes must satisfy 0 < near_clip < far_clip");
+            FACET_THROW_AT(props.location(),
+                           "the clipping planes must satisfy 0 < near_clip < far_clip");
     }
 
     bool needs_aperture_sample() const override { return true; }
@@ -61,21 +64,23 @@ public:
     std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
                                        const Point2f &aperture_sample) const override {
         // Point on the plane in focus that the pinhole ray through film_pos would reach.
-        Vector3f pinhole((1.f - 2.f * film_pos.x) * m_tan_x, (1.f - 2.f * film_pos.y) * m_tan_y, 1.f);
+        Vector3f pinhole((1.f - 2.f * film_pos.x) * m_tan_x, (1.f - 2.f * film_pos.y) * m_tan_y,
+                         1.f);
         Point3f focus = pinhole * m_focus_distance;
         Point2f lens = warp::square_to_uniform_disk_concentric(aperture_sample) * m_aperture_radius;
         Point3f origin(lens.x, lens.y, 0.f);
         Vector3f d = normalize(focus - origin);
         float inv_z = 1.f / d.z;
-        Ray ray(m_to_world.apply_point(origin), normalize(m_to_world.apply_vector(d)), m_near_clip * inv_z,
-                m_far_clip * inv_z);
+        Ray ray(m_to_world.apply_point(origin), normalize(m_to_world.apply_vector(d)),
+                m_near_clip * inv_z, m_far_clip * inv_z);
         ray.time = time;
         return {ray, Color3f(1.f)};
     }
 
     std::string to_string() const override {
-        return fmt::format("ThinLensCamera[aperture_radius={}, focus_distance={}, film={}, sampler={}]",
-                           m_aperture_radius, m_focus_distance, m_film->to_string(), m_sampler->to_string());
+        return fmt::format(
+            "ThinLensCamera[aperture_radius={}, focus_distance={}, film={}, sampler={}]",
+            m_aperture_radius, m_focus_distance, m_film->to_string(), m_sampler->to_string());
     }
 
 private:
@@ -86,4 +91,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::ThinLensCamera, Sensor, "thinlens", "Perspective camera with a thin lens (depth of field)", DOC)
+FACET_EXPORT_PLUGIN(facet::ThinLensCamera, Sensor, "thinlens",
+                    "Perspective camera with a thin lens (depth of field)", DOC)

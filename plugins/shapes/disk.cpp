@@ -54,22 +54,24 @@ public:
         Normal3f n = normalize(m_to_world.apply_normal(Normal3f(0.f, 0.f, 1.f)));
         m_normal = m_flip_normals ? -n : n;
         for (int i = 0; i < 4; ++i)
-            m_bbox.expand(m_to_world.apply_point(
-                Point3f((i & 1) ? 1.f : -1.f, (i & 2) ? 1.f : -1.f, 0.f)));
+            m_bbox.expand(
+                m_to_world.apply_point(Point3f((i & 1) ? 1.f : -1.f, (i & 2) ? 1.f : -1.f, 0.f)));
         // Rows of the world-to-object matrix in double for the intersection test.
         const auto &w = m_to_object.matrix.m;
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 4; ++c)
-                m_inv[r][c] = w[r][c];
+            for (int c = 0; c < 4; ++c) m_inv[r][c] = w[r][c];
     }
 
     BoundingBox3f bbox() const override { return m_bbox; }
     float surface_area() const override { return m_area; }
 
-    RTCGeometry embree_geometry(RTCDevice device) const override { return make_user_geometry(device, this); }
+    RTCGeometry embree_geometry(RTCDevice device) const override {
+        return make_user_geometry(device, this);
+    }
 
     /// Embree callback (facet/user_geometry.h): keeps the object-space (x, y) of the hit as uv.
-    bool intersect_user(const Point3f &o, const Vector3f &d, float tnear, float tfar, UserHit &h) const {
+    bool intersect_user(const Point3f &o, const Vector3f &d, float tnear, float tfar,
+                        UserHit &h) const {
         if (!hit(o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar, h.t, h.uv.x, h.uv.y)) return false;
         h.ng = m_normal;
         return true;
@@ -85,8 +87,7 @@ public:
         si.n = m_normal;
         float r = std::sqrt(uv.x * uv.x + uv.y * uv.y);
         float phi = r > 0.f ? std::atan2(uv.y, uv.x) : 0.f;
-        if (phi < 0.f)
-            phi += 2.f * Pi;
+        if (phi < 0.f) phi += 2.f * Pi;
         si.uv = Point2f(r, phi * InvTwoPi);
         float cos_phi = std::cos(phi), sin_phi = std::sin(phi);
         si.dp_du = m_to_world.apply_vector(Vector3f(cos_phi, sin_phi, 0.f));
@@ -110,8 +111,7 @@ public:
         ps.n = m_normal;
         float r = norm(q);
         float phi = r > 0.f ? std::atan2(q.y, q.x) : 0.f;
-        if (phi < 0.f)
-            phi += 2.f * Pi;
+        if (phi < 0.f) phi += 2.f * Pi;
         ps.uv = Point2f(r, phi * InvTwoPi);
         ps.pdf = 1.f / m_area;
         return ps;
@@ -120,8 +120,7 @@ public:
     std::string to_string() const override {
         return fmt::format("Disk[to_world={}, area={}, flip_normals={}, bsdf={}, emitter={}]",
                            m_to_world.to_string(), m_area, m_flip_normals,
-                           m_bsdf ? m_bsdf->to_string() : "none",
-                           emitter_label());
+                           m_bsdf ? m_bsdf->to_string() : "none", emitter_label());
     }
 
 private:
@@ -135,14 +134,11 @@ private:
             lo[r] = m_inv[r][0] * o[0] + m_inv[r][1] * o[1] + m_inv[r][2] * o[2] + m_inv[r][3];
             ld[r] = m_inv[r][0] * d[0] + m_inv[r][1] * d[1] + m_inv[r][2] * d[2];
         }
-        if (ld[2] == 0.0)
-            return false;
+        if (ld[2] == 0.0) return false;
         double t = -lo[2] / ld[2];
-        if (!(t >= tnear && t <= tfar))
-            return false;
+        if (!(t >= tnear && t <= tfar)) return false;
         double px = lo[0] + t * ld[0], py = lo[1] + t * ld[1];
-        if (px * px + py * py > 1.0)
-            return false;
+        if (px * px + py * py > 1.0) return false;
         t_hit = float(t);
         x = float(px);
         y = float(py);

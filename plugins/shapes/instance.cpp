@@ -28,7 +28,8 @@ public:
         for (const auto &[name, obj] : props.objects()) {
             auto group = std::dynamic_pointer_cast<ShapeGroup>(obj);
             if (!group || m_group)
-                FACET_THROW_AT(props.location(name), "instance: expects exactly one nested shapegroup");
+                FACET_THROW_AT(props.location(name),
+                               "instance: expects exactly one nested shapegroup");
             m_group = std::move(group);
             props.mark_queried(name);
         }
@@ -61,8 +62,9 @@ public:
         FACET_THROW("instance: hits must go through compute_instance_interaction");
     }
 
-    void compute_instance_interaction(const Ray &ray, float t, uint32_t geom_id, uint32_t prim_index,
-                                      const Point2f &uv, SurfaceInteraction &si) const override {
+    void compute_instance_interaction(const Ray &ray, float t, uint32_t geom_id,
+                                      uint32_t prim_index, const Point2f &uv,
+                                      SurfaceInteraction &si) const override {
         // Same parametrisation t in object space: transform origin and (unnormalised) direction.
         Transform to_local = m_to_world.inverse();
         Ray local(to_local.apply_point(ray.o), to_local.apply_vector(ray.d), ray.mint, ray.maxt);
@@ -90,7 +92,8 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("Instance[{}, to_world={}]", m_group->to_string(), m_to_world.to_string());
+        return fmt::format("Instance[{}, to_world={}]", m_group->to_string(),
+                           m_to_world.to_string());
     }
 
 private:
@@ -101,4 +104,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Instance, Shape, "instance", "Placed copy of a shapegroup (Embree instance)", DOC)
+FACET_EXPORT_PLUGIN(facet::Instance, Shape, "instance",
+                    "Placed copy of a shapegroup (Embree instance)", DOC)

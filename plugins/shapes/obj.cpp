@@ -29,9 +29,9 @@ objects and materials are ignored: the whole file becomes one mesh. Without norm
 #include <facet/resolver.h>
 
 #include <charconv>
+#include <cstdio>
 #include <cstring>
 #include <string_view>
-#include <cstdio>
 
 namespace facet {
 
@@ -47,7 +47,7 @@ public:
     };
 
     std::vector<float> positions, texcoords, normals;
-    std::vector<Corner> unique;     ///< one per mesh vertex
+    std::vector<Corner> unique; ///< one per mesh vertex
     std::vector<uint32_t> faces;
 
     void parse() {
@@ -56,8 +56,7 @@ public:
         while (p < end) {
             ++m_line;
             const char *eol = static_cast<const char *>(std::memchr(p, '\n', size_t(end - p)));
-            if (!eol)
-                eol = end;
+            if (!eol) eol = end;
             m_cur = p;
             m_end = eol;
             parse_line(polygon);
@@ -71,23 +70,20 @@ private:
     }
 
     void skip_space() {
-        while (m_cur < m_end && (*m_cur == ' ' || *m_cur == '\t' || *m_cur == '\r'))
-            ++m_cur;
+        while (m_cur < m_end && (*m_cur == ' ' || *m_cur == '\t' || *m_cur == '\r')) ++m_cur;
     }
 
     std::string_view word() {
         skip_space();
         const char *b = m_cur;
-        while (m_cur < m_end && *m_cur != ' ' && *m_cur != '\t' && *m_cur != '\r')
-            ++m_cur;
+        while (m_cur < m_end && *m_cur != ' ' && *m_cur != '\t' && *m_cur != '\r') ++m_cur;
         return std::string_view(b, size_t(m_cur - b));
     }
 
     float number(const char *what) {
         skip_space();
         const char *b = m_cur;
-        if (b < m_end && *b == '+')
-            ++b;
+        if (b < m_end && *b == '+') ++b;
         float value;
         auto [ptr, ec] = std::from_chars(b, m_end, value);
         if (ec != std::errc() || ptr == b)
@@ -106,37 +102,33 @@ private:
     int64_t resolve(int64_t index, size_t count, const char *what) const {
         int64_t r = index > 0 ? index - 1 : int64_t(count) + index;
         if (index == 0 || r < 0 || r >= int64_t(count))
-            fail(fmt::format("{} index {} is out of range ({} defined so far)", what, index, count));
+            fail(
+                fmt::format("{} index {} is out of range ({} defined so far)", what, index, count));
         return r;
     }
 
     int64_t index_field(const char *what) {
         const char *b = m_cur;
-        if (b < m_end && *b == '+')
-            ++b;
+        if (b < m_end && *b == '+') ++b;
         int64_t value;
         auto [ptr, ec] = std::from_chars(b, m_end, value);
-        if (ec != std::errc() || ptr == b)
-            fail(fmt::format("malformed {} index in face", what));
+        if (ec != std::errc() || ptr == b) fail(fmt::format("malformed {} index in face", what));
         m_cur = ptr;
         return value;
     }
 
     void parse_line(std::vector<uint32_t> &polygon) {
         std::string_view key = word();
-        if (key.empty() || key[0] == '#')
-            return;
+        if (key.empty() || key[0] == '#') return;
         if (key == "v") {
-            for (int k = 0; k < 3; ++k)
-                positions.push_back(number("a vertex position"));
+            for (int k = 0; k < 3; ++k) positions.push_back(number("a vertex position"));
         } else if (key == "vt") {
             float u = number("a texture coordinate");
             float v = at_end_of_data() ? 0.f : number("a texture coordinate");
             texcoords.push_back(u);
             texcoords.push_back(v);
         } else if (key == "vn") {
-            for (int k = 0; k < 3; ++k)
-                normals.push_back(number("a normal"));
+            for (int k = 0; k < 3; ++k) normals.push_back(number("a normal"));
         } else if (key == "f") {
             polygon.clear();
             while (!at_end_of_data()) {
@@ -168,11 +160,9 @@ private:
     /// Mesh vertex for a (v, vt, vn) triple, shared between the faces that use the same triple.
     uint32_t vertex_id(const Corner &c) {
         size_t v = size_t(c.v);
-        if (v >= m_first.size())
-            m_first.resize(positions.size() / 3, uint32_t(-1));
+        if (v >= m_first.size()) m_first.resize(positions.size() / 3, uint32_t(-1));
         for (uint32_t id = m_first[v]; id != uint32_t(-1); id = m_next[id])
-            if (unique[id].vt == c.vt && unique[id].vn == c.vn)
-                return id;
+            if (unique[id].vt == c.vt && unique[id].vn == c.vn) return id;
         uint32_t id = uint32_t(unique.size());
         unique.push_back(c);
         m_next.push_back(m_first[v]);
@@ -203,8 +193,7 @@ public:
         std::string data = read_file(path, "obj");
         ObjParser parser(filename, data);
         parser.parse();
-        if (parser.faces.empty())
-            FACET_THROW("{}: the file has no faces", filename);
+        if (parser.faces.empty()) FACET_THROW("{}: the file has no faces", filename);
 
         bool any_uv = false, any_normal = false;
         for (const auto &c : parser.unique) {
@@ -213,16 +202,15 @@ public:
         }
         size_t n = parser.unique.size();
         m_positions.resize(3 * n);
-        if (any_uv)
-            m_uvs.assign(2 * n, 0.f);
-        if (any_normal && !face_normals)
-            m_normals.assign(3 * n, 0.f);
+        if (any_uv) m_uvs.assign(2 * n, 0.f);
+        if (any_normal && !face_normals) m_normals.assign(3 * n, 0.f);
         for (size_t i = 0; i < n; ++i) {
             const auto &c = parser.unique[i];
             for (int k = 0; k < 3; ++k)
                 m_positions[3 * i + k] = parser.positions[3 * size_t(c.v) + k];
             if (any_uv && c.vt >= 0) {
-                float u = parser.texcoords[2 * size_t(c.vt)], v = parser.texcoords[2 * size_t(c.vt) + 1];
+                float u = parser.texcoords[2 * size_t(c.vt)],
+                      v = parser.texcoords[2 * size_t(c.vt) + 1];
                 m_uvs[2 * i] = u;
                 m_uvs[2 * i + 1] = flip_tex_coords ? 1.f - v : v;
             }
@@ -232,8 +220,7 @@ public:
         }
         m_faces = std::move(parser.faces);
         initialize(to_world, face_normals, flip_normals);
-        if (!face_normals && !has_vertex_normals())
-            recompute_vertex_normals();
+        if (!face_normals && !has_vertex_normals()) recompute_vertex_normals();
         FACET_LOG(Debug, "obj: \"{}\": {} vertices, {} triangles", filename, vertex_count(),
                   face_count());
     }

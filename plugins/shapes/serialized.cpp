@@ -25,11 +25,10 @@ the file. `shape_index` selects the mesh.
 #include <facet/plugin.h>
 #include <facet/resolver.h>
 
-#include <zlib.h>
-
 #include <cstring>
 #include <fstream>
 #include <vector>
+#include <zlib.h>
 
 namespace facet {
 
@@ -48,7 +47,8 @@ enum : uint32_t {
 /// Reads little-endian values from the inflated stream with bounds checks.
 class Reader {
 public:
-    Reader(const std::vector<uint8_t> &data, const std::string &file) : m_data(data), m_file(file) {}
+    Reader(const std::vector<uint8_t> &data, const std::string &file)
+        : m_data(data), m_file(file) {}
     template <typename T> T read() {
         T value;
         need(sizeof(T));
@@ -79,12 +79,16 @@ public:
         }
         m_pos += count * (dbl ? 8 : 4);
     }
-    void skip(size_t bytes) { need(bytes); m_pos += bytes; }
+    void skip(size_t bytes) {
+        need(bytes);
+        m_pos += bytes;
+    }
 
 private:
     void need(size_t bytes) const {
         if (m_pos + bytes > m_data.size())
-            FACET_THROW("serialized: \"{}\" is truncated (mesh data ends after {} bytes)", m_file, m_data.size());
+            FACET_THROW("serialized: \"{}\" is truncated (mesh data ends after {} bytes)", m_file,
+                        m_data.size());
     }
     const std::vector<uint8_t> &m_data;
     const std::string &m_file;
@@ -133,16 +137,18 @@ public:
 
         std::ifstream in(path, std::ios::binary);
         if (!in) FACET_THROW_AT(props.location("filename"), "serialized: cannot open \"{}\"", path);
-        std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)),
+                                  std::istreambuf_iterator<char>());
         // Like obj and ply: smooth normals unless the scene or the file asks for face normals.
         bool file_face_normals = load(file, path, index, props);
         initialize(to_world, face_normals, flip);
-        if (!face_normals && !file_face_normals && !has_vertex_normals()) recompute_vertex_normals();
+        if (!face_normals && !file_face_normals && !has_vertex_normals())
+            recompute_vertex_normals();
     }
 
     std::string to_string() const override {
-        return fmt::format("SerializedMesh[\"{}\", {} vertices, {} triangles]", m_name, vertex_count(),
-                           face_count());
+        return fmt::format("SerializedMesh[\"{}\", {} vertices, {} triangles]", m_name,
+                           vertex_count(), face_count());
     }
 
 private:
@@ -154,9 +160,11 @@ private:
         std::memcpy(&id, file.data(), 2);
         std::memcpy(&version, file.data() + 2, 2);
         if (id != FormatId)
-            FACET_THROW("serialized: \"{}\" is not a serialized mesh (bad format id 0x{:04x})", path, id);
+            FACET_THROW("serialized: \"{}\" is not a serialized mesh (bad format id 0x{:04x})",
+                        path, id);
         if (version != 3 && version != 4)
-            FACET_THROW("serialized: \"{}\" has format version {}; versions 3 and 4 are supported", path, version);
+            FACET_THROW("serialized: \"{}\" has format version {}; versions 3 and 4 are supported",
+                        path, version);
 
         // The dictionary at the end: offsets (uint64 in v4, uint32 in v3) then a uint32 count.
         uint32_t count;
@@ -166,7 +174,8 @@ private:
             FACET_THROW("serialized: \"{}\" has a corrupt mesh table ({} meshes)", path, count);
         if (index < 0 || index >= int64_t(count))
             FACET_THROW_AT(props.location("shape_index"),
-                           "serialized: shape_index {} is out of range: \"{}\" holds {} mesh(es)", index, path, count);
+                           "serialized: shape_index {} is out of range: \"{}\" holds {} mesh(es)",
+                           index, path, count);
         size_t table = file.size() - 4 - size_t(count) * offset_size;
         auto offset_of = [&](size_t i) -> size_t {
             if (version == 4) {
@@ -199,7 +208,8 @@ private:
         size_t real = dbl ? 8 : 4;
         size_t need = size_t(nv) * 3 * real + size_t(nf) * 12;
         if (need > data.size())
-            FACET_THROW("serialized: \"{}\": mesh {} claims {} vertices and {} triangles, more than its data holds",
+            FACET_THROW("serialized: \"{}\": mesh {} claims {} vertices and {} triangles, more "
+                        "than its data holds",
                         path, index, nv, nf);
         r.read_reals(m_positions, size_t(nv) * 3, dbl);
         if (flags & HasNormals) r.read_reals(m_normals, size_t(nv) * 3, dbl);

@@ -61,18 +61,21 @@ public:
 
     float surface_area() const override { return 4.f * Pi * m_radius * m_radius; }
 
-    RTCGeometry embree_geometry(RTCDevice device) const override { return make_user_geometry(device, this); }
+    RTCGeometry embree_geometry(RTCDevice device) const override {
+        return make_user_geometry(device, this);
+    }
 
     /// Embree callback (facet/user_geometry.h): nearest hit in [tnear, tfar].
-    bool intersect_user(const Point3f &o, const Vector3f &d, float tnear, float tfar, UserHit &hit) const {
+    bool intersect_user(const Point3f &o, const Vector3f &d, float tnear, float tfar,
+                        UserHit &hit) const {
         if (!nearest_hit(o.x, o.y, o.z, d.x, d.y, d.z, tnear, tfar, hit.t)) return false;
         hit.ng = o + d * hit.t - m_center;
         hit.uv = Point2f(0.f);
         return true;
     }
 
-    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
-                                     const Point2f &, SurfaceInteraction &si) const override {
+    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index, const Point2f &,
+                                     SurfaceInteraction &si) const override {
         Vector3f dir = normalize(ray(t) - m_center);
         si.t = t;
         si.shape = this;
@@ -85,8 +88,7 @@ public:
         float cos_theta = clamp(q.z, -1.f, 1.f);
         float sin_theta = safe_sqrt(1.f - cos_theta * cos_theta);
         float phi = std::atan2(q.y, q.x);
-        if (phi < 0.f)
-            phi += 2.f * Pi;
+        if (phi < 0.f) phi += 2.f * Pi;
         si.uv = Point2f(phi * InvTwoPi, safe_acos(cos_theta) * InvPi);
         float cos_phi = std::cos(phi), sin_phi = std::sin(phi);
         si.dp_du = m_to_world.apply_vector(Vector3f(-q.y, q.x, 0.f) * (2.f * Pi));
@@ -131,8 +133,8 @@ public:
         double phi = 2.0 * 3.14159265358979323846 * double(u.y);
         Vector3d s, t;
         build_basis(axis, s, t);
-        Vector3d d = s * (sin_theta * std::cos(phi)) + t * (sin_theta * std::sin(phi)) +
-                     axis * cos_theta;
+        Vector3d d =
+            s * (sin_theta * std::cos(phi)) + t * (sin_theta * std::sin(phi)) + axis * cos_theta;
         // Nearest intersection of ref + τ·d with the sphere.
         double r2 = double(m_radius) * double(m_radius);
         double disc = std::max(r2 - dist * dist * sin2_theta, 0.0);
@@ -140,8 +142,7 @@ public:
 
         DirectionSample ds;
         ds.emitter = m_emitter.get();
-        if (!(tau > 0.0))
-            return ds;
+        if (!(tau > 0.0)) return ds;
         Vector3d hit = Vector3d(ref.p) + d * tau - Vector3d(m_center);
         Vector3f dir = Vector3f(hit / norm(hit));
         ds.p = m_center + dir * m_radius;
@@ -149,8 +150,7 @@ public:
         ds.uv = spherical_uv(object_direction(dir));
         ds.d = ds.p - ref.p;
         ds.dist = norm(ds.d);
-        if (!(ds.dist > 0.f))
-            return ds;
+        if (!(ds.dist > 0.f)) return ds;
         ds.d /= ds.dist;
         ds.pdf = cone_pdf(one_minus_cos_max);
         return ds;
@@ -158,8 +158,7 @@ public:
 
     float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
         double one_minus_cos_max;
-        if (!sees_cone(ref, one_minus_cos_max))
-            return Shape::pdf_direction(ref, ds);
+        if (!sees_cone(ref, one_minus_cos_max)) return Shape::pdf_direction(ref, ds);
         return cone_pdf(one_minus_cos_max);
     }
 
@@ -167,8 +166,7 @@ public:
         return fmt::format("Sphere[center=[{}, {}, {}], radius={}, flip_normals={}, bsdf={}, "
                            "emitter={}]",
                            m_center.x, m_center.y, m_center.z, m_radius, m_flip_normals,
-                           m_bsdf ? m_bsdf->to_string() : "none",
-                           emitter_label());
+                           m_bsdf ? m_bsdf->to_string() : "none", emitter_label());
     }
 
 private:
@@ -176,11 +174,11 @@ private:
     static void check_similarity(const Transform &tr, const Properties &props) {
         const auto &m = tr.matrix.m;
         if (m[3][0] != 0.f || m[3][1] != 0.f || m[3][2] != 0.f || m[3][3] != 1.f)
-            FACET_THROW_AT(props.location("to_world"),
-                           "sphere: to_world must be affine (rotation, uniform scale, translation)");
+            FACET_THROW_AT(
+                props.location("to_world"),
+                "sphere: to_world must be affine (rotation, uniform scale, translation)");
         Vector3d c[3];
-        for (int j = 0; j < 3; ++j)
-            c[j] = Vector3d(m[0][j], m[1][j], m[2][j]);
+        for (int j = 0; j < 3; ++j) c[j] = Vector3d(m[0][j], m[1][j], m[2][j]);
         double s2 = squared_norm(c[0]);
         double tol = 1e-4 * s2;
         bool ok = s2 > 0.0 && std::abs(squared_norm(c[1]) - s2) <= tol &&
@@ -208,8 +206,7 @@ private:
 
     static Point2f spherical_uv(const Vector3f &q) {
         float phi = std::atan2(q.y, q.x);
-        if (phi < 0.f)
-            phi += 2.f * Pi;
+        if (phi < 0.f) phi += 2.f * Pi;
         return Point2f(phi * InvTwoPi, safe_acos(q.z) * InvPi);
     }
 
@@ -219,8 +216,7 @@ private:
         double dist2 = squared_norm(Vector3d(m_center) - Vector3d(ref.p));
         double r2 = double(m_radius) * double(m_radius);
         double threshold = r2 * (m_flip_normals ? 1.0 + 2e-4 : 1.0 - 2e-4);
-        if (!(dist2 > threshold))
-            return false;
+        if (!(dist2 > threshold)) return false;
         double sin2_max = std::min(r2 / dist2, 1.0);
         // 1 - sqrt(1 - s) without cancellation for small cones.
         one_minus_cos_max = sin2_max / (1.0 + std::sqrt(1.0 - sin2_max));
@@ -239,8 +235,7 @@ private:
         oy -= m_center.y;
         oz -= m_center.z;
         double a = dx * dx + dy * dy + dz * dz;
-        if (!(a > 0.0))
-            return false;
+        if (!(a > 0.0)) return false;
         double b = ox * dx + oy * dy + oz * dz; // half of the usual linear coefficient
         double c = ox * ox + oy * oy + oz * oz - double(m_radius) * double(m_radius);
         // Discriminant from the distance between the centre and the line (Haines et al.,
@@ -248,8 +243,7 @@ private:
         double k = b / a;
         double lx = ox - dx * k, ly = oy - dy * k, lz = oz - dz * k;
         double disc = a * (double(m_radius) * double(m_radius) - (lx * lx + ly * ly + lz * lz));
-        if (disc < 0.0)
-            return false;
+        if (disc < 0.0) return false;
         double q = -b - std::copysign(std::sqrt(disc), b);
         if (q == 0.0) {
             t0 = t1 = 0.0;
@@ -257,8 +251,7 @@ private:
         }
         t0 = q / a;
         t1 = c / q;
-        if (t0 > t1)
-            std::swap(t0, t1);
+        if (t0 > t1) std::swap(t0, t1);
         return true;
     }
 
@@ -266,8 +259,7 @@ private:
     bool nearest_hit(float ox, float oy, float oz, float dx, float dy, float dz, float tnear,
                      float tfar, float &t_hit) const {
         double t0, t1;
-        if (!solve(ox, oy, oz, dx, dy, dz, t0, t1))
-            return false;
+        if (!solve(ox, oy, oz, dx, dy, dz, t0, t1)) return false;
         if (t0 >= tnear && t0 <= tfar) {
             t_hit = float(t0);
             return true;

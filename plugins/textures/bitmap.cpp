@@ -192,7 +192,8 @@ private:
             return r < n ? r : period - 1 - r;
         }
         case WrapMode::Clamp:
-        default: return clamp(i, 0, n - 1);
+        default:
+            return clamp(i, 0, n - 1);
         }
     }
 
@@ -204,8 +205,10 @@ private:
 
     template <int C> Color3f pixel(int x, int y) const {
         const float *p = m_data.data() + (size_t(y) * size_t(m_width) + size_t(x)) * C;
-        if constexpr (C == 1) return Color3f(p[0]);
-        else return Color3f(p[0], p[1], p[2]);
+        if constexpr (C == 1)
+            return Color3f(p[0]);
+        else
+            return Color3f(p[0], p[1], p[2]);
     }
 
     template <int C> Color3f lookup(const Point2f &uv) const {

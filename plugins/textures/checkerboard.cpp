@@ -57,8 +57,8 @@ public:
     float max() const override { return std::max(m_color0->max(), m_color1->max()); }
 
     std::string to_string() const override {
-        return fmt::format("Checkerboard[color0 = {}, color1 = {}, to_uv = {}]", m_color0->to_string(),
-                           m_color1->to_string(), m_to_uv.to_string());
+        return fmt::format("Checkerboard[color0 = {}, color1 = {}, to_uv = {}]",
+                           m_color0->to_string(), m_color1->to_string(), m_to_uv.to_string());
     }
 
 private:

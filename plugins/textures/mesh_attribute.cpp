@@ -34,24 +34,30 @@ public:
         m_name = props.get_string("name");
         if (m_name != "vertex_color")
             FACET_THROW_AT(props.location("name"),
-                           "mesh_attribute: unsupported attribute \"{}\" (supported: vertex_color)", m_name);
+                           "mesh_attribute: unsupported attribute \"{}\" (supported: vertex_color)",
+                           m_name);
         m_scale = float(props.get_float("scale", 1.0));
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
-        const Mesh *mesh = si.shape && si.shape->is_mesh() ? static_cast<const Mesh *>(si.shape) : nullptr;
+        const Mesh *mesh =
+            si.shape && si.shape->is_mesh() ? static_cast<const Mesh *>(si.shape) : nullptr;
         if (!mesh || !mesh->has_vertex_colors()) {
             if (!m_warned.exchange(true))
-                FACET_LOG(Warn, "mesh_attribute: the shape that was hit has no \"{}\"; using black", m_name);
+                FACET_LOG(Warn, "mesh_attribute: the shape that was hit has no \"{}\"; using black",
+                          m_name);
             return Color3f(0.f);
         }
         const auto &f = mesh->faces();
         const auto &c = mesh->colors();
-        uint32_t i0 = f[3 * si.prim_index], i1 = f[3 * si.prim_index + 1], i2 = f[3 * si.prim_index + 2];
+        uint32_t i0 = f[3 * si.prim_index], i1 = f[3 * si.prim_index + 1],
+                 i2 = f[3 * si.prim_index + 2];
         // Barycentrics of the hit point from the triangle's world-space vertices.
-        Point3f p0 = mesh->vertex_position(i0), p1 = mesh->vertex_position(i1), p2 = mesh->vertex_position(i2);
+        Point3f p0 = mesh->vertex_position(i0), p1 = mesh->vertex_position(i1),
+                p2 = mesh->vertex_position(i2);
         Vector3f e1 = p1 - p0, e2 = p2 - p0, v = si.p - p0;
-        float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), dv1 = dot(v, e1), dv2 = dot(v, e2);
+        float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), dv1 = dot(v, e1),
+              dv2 = dot(v, e2);
         float denom = d11 * d22 - d12 * d12;
         float b1 = denom != 0.f ? (d22 * dv1 - d12 * dv2) / denom : 0.f;
         float b2 = denom != 0.f ? (d11 * dv2 - d12 * dv1) / denom : 0.f;

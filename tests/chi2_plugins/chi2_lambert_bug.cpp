@@ -36,7 +36,8 @@ public:
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
                                           float, const Point2f &u) const override {
         BSDFSample bs;
-        if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f) return {bs, Color3f(0.f)};
+        if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f)
+            return {bs, Color3f(0.f)};
         bs.wo = m_bug == "uniform" ? warp::square_to_uniform_hemisphere(u)
                                    : warp::square_to_cosine_hemisphere(u);
         bs.pdf = pdf(ctx, si, bs.wo);
@@ -46,19 +47,23 @@ public:
         return {bs, eval(ctx, si, bs.wo) / bs.pdf};
     }
 
-    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
+    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
+                 const Vector3f &wo) const override {
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f || wo.z <= 0.f)
             return Color3f(0.f);
         return Color3f(0.5f * InvPi * wo.z);
     }
 
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+              const Vector3f &wo) const override {
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f || wo.z <= 0.f)
             return 0.f;
         return (m_bug == "scale" ? 1.05f : 1.f) * InvPi * wo.z;
     }
 
-    std::string to_string() const override { return fmt::format("Chi2LambertBug[bug = {}]", m_bug); }
+    std::string to_string() const override {
+        return fmt::format("Chi2LambertBug[bug = {}]", m_bug);
+    }
 
 private:
     std::string m_bug;

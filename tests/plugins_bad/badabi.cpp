@@ -15,7 +15,11 @@ facet::Object *create(const facet::Properties &props) { return new BadAbi(props)
 
 extern "C" __attribute__((visibility("default"))) const facet::PluginDescriptor *
 facet_plugin_descriptor() {
-    static const facet::PluginDescriptor desc{facet::FACET_ABI_VERSION + 1, facet::ObjectType::BSDF,
-                                              "badabi", "Built for another ABI", "", create};
+    static const facet::PluginDescriptor desc{facet::FACET_ABI_VERSION + 1,
+                                              facet::ObjectType::BSDF,
+                                              "badabi",
+                                              "Built for another ABI",
+                                              "",
+                                              create};
     return &desc;
 }

@@ -20,8 +20,7 @@ public:
         m_alpha = props.get_float("alpha", 0.5);
         if (props.get_bool("fail", false))
             FACET_THROW_AT(props.location("fail"), "asked to fail (alpha = {})", m_alpha);
-        if (m_alpha < 0 || m_alpha > 1)
-            FACET_THROW("alpha must be in [0, 1], got {}", m_alpha);
+        if (m_alpha < 0 || m_alpha > 1) FACET_THROW("alpha must be in [0, 1], got {}", m_alpha);
     }
     facet::ObjectType type() const override { return facet::ObjectType::BSDF; }
     std::string to_string() const override { return fmt::format("TestGood[alpha={}]", m_alpha); }

@@ -15,4 +15,5 @@ public:
 
 } // namespace
 
-FACET_EXPORT_PLUGIN(WrongKind, Emitter, "wrongkind", "An emitter used where a bsdf is expected", DOC)
+FACET_EXPORT_PLUGIN(WrongKind, Emitter, "wrongkind", "An emitter used where a bsdf is expected",
+                    DOC)

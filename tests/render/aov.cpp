@@ -63,8 +63,8 @@ TEST(AovIntegrator, ChannelsAndValues) {
         <string name="aovs" value="alb:albedo, dd:depth, nn:sh_normal, pp:position, id:shape_index"/>
         <integrator type="path"/>
     </integrator>)");
-    std::vector<std::string> expected = {"R", "G", "B", "alb.R", "alb.G", "alb.B", "dd", "nn.X", "nn.Y",
-                                         "nn.Z", "pp.X", "pp.Y", "pp.Z", "id"};
+    std::vector<std::string> expected = {"R",    "G",    "B",    "alb.R", "alb.G", "alb.B", "dd",
+                                         "nn.X", "nn.Y", "nn.Z", "pp.X",  "pp.Y",  "pp.Z",  "id"};
     for (const std::string &name : expected) channel(img, name);
     int alb = channel(img, "alb.R"), dd = channel(img, "dd"), nn = channel(img, "nn.X"),
         pp = channel(img, "pp.X"), id = channel(img, "id");
@@ -92,9 +92,11 @@ TEST(AovIntegrator, ChannelsAndValues) {
 
 TEST(AovIntegrator, UnknownTypeIsAnError) {
     try {
-        render_scene(R"(<integrator type="aov"><string name="aovs" value="x:normals"/></integrator>)");
+        render_scene(
+            R"(<integrator type="aov"><string name="aovs" value="x:normals"/></integrator>)");
         FAIL();
     } catch (const std::exception &e) {
-        EXPECT_NE(std::string(e.what()).find("unknown AOV type \"normals\""), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("unknown AOV type \"normals\""), std::string::npos)
+            << e.what();
     }
 }

@@ -5,23 +5,22 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <set>
+#include <spawn.h>
 #include <sstream>
 #include <string>
 #include <thread>
-#include <vector>
-
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
+#include <vector>
 
 extern char **environ;
 
@@ -130,7 +129,8 @@ protected:
     /// Every file in the test folder (temporary files of interrupted writes would show here).
     std::set<std::string> files() const {
         std::set<std::string> names;
-        for (const auto &e : fs::directory_iterator(m_dir)) names.insert(e.path().filename().string());
+        for (const auto &e : fs::directory_iterator(m_dir))
+            names.insert(e.path().filename().string());
         return names;
     }
 
@@ -211,7 +211,8 @@ TEST_F(CliTest, MissingSceneFileIsOneLineError) {
 }
 
 TEST_F(CliTest, MalformedXmlNamesFileLineAndColumn) {
-    write_file(m_dir / "bad.xml", "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n</scene>\n");
+    write_file(m_dir / "bad.xml",
+               "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n</scene>\n");
     std::string line = expect_one_line_error("render bad.xml");
     EXPECT_TRUE(std::regex_search(line, std::regex(R"(bad\.xml:\d+:\d+)"))) << line;
     EXPECT_FALSE(fs::exists(m_dir / "bad.exr"));
@@ -262,8 +263,10 @@ TEST_F(CliTest, PluginsListsEveryKind) {
     ASSERT_EQ(r.code, 0) << r.err;
     for (const char *name : {"diffuse", "path", "sphere", "perspective", "hdrfilm", "independent",
                              "gaussian", "area", "constant"})
-        EXPECT_TRUE(std::regex_search(r.out, std::regex(std::string(R"((^|\n)\s+)") + name + R"(\s)")))
-            << name << " missing from:\n" << r.out;
+        EXPECT_TRUE(
+            std::regex_search(r.out, std::regex(std::string(R"((^|\n)\s+)") + name + R"(\s)")))
+            << name << " missing from:\n"
+            << r.out;
     EXPECT_NE(r.out.find("bsdfs"), std::string::npos);
     EXPECT_NE(r.out.find("integrators"), std::string::npos);
 
@@ -276,7 +279,8 @@ TEST_F(CliTest, PluginsListsEveryKind) {
 TEST_F(CliTest, PluginsPrintsOnePluginsTable) {
     Result r = run("plugins diffuse");
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*Parameter\s*\|\s*Type\s*\|)"))) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*Parameter\s*\|\s*Type\s*\|)")))
+        << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*reflectance\s*\|)"))) << r.out;
 
     std::string line = expect_one_line_error("plugins difuse");
@@ -301,8 +305,8 @@ TEST_F(CliTest, InterruptWritesThePartialImage) {
     // Far too many samples to finish: about 2·10⁹ camera samples in small blocks.
     fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
     std::string scene = (m_dir / "scene.xml").string(), image = (m_dir / "long.exr").string();
-    std::vector<std::string> args = {FACET, "render", scene, "-D", "res=2048", "-D", "spp=512",
-                                     "-t", "2", "-o", image};
+    std::vector<std::string> args = {FACET,     "render", scene, "-D", "res=2048", "-D",
+                                     "spp=512", "-t",     "2",   "-o", image};
     std::vector<char *> argv;
     for (auto &a : args) argv.push_back(a.data());
     argv.push_back(nullptr);

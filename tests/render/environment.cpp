@@ -51,8 +51,10 @@ std::string scene_xml(const std::string &sky, bool importance) {
         </film>
     </sensor>
     <emitter type="envmap">
-        <string name="filename" value=")" + sky + R"("/>
-        <boolean name="importance_sampling" value=")" + (importance ? "true" : "false") + R"("/>
+        <string name="filename" value=")" +
+           sky + R"("/>
+        <boolean name="importance_sampling" value=")" +
+           (importance ? "true" : "false") + R"("/>
     </emitter>
     <shape type="rectangle">
         <transform name="to_world"><scale value="100"/><rotate x="1" angle="-90"/></transform>
@@ -125,8 +127,10 @@ TEST(EnvironmentMap, ImportanceAndUniformSamplingAgreeWithQuadrature) {
     Stats is = render_stats(scene_xml(sky, true));
     Stats us = render_stats(scene_xml(sky, false));
     for (int ch = 0; ch < 3; ++ch) {
-        EXPECT_NEAR(is.mean[ch], ref[ch], 4.f * is.stderr_[ch] + 1e-3f * ref[ch]) << "importance, channel " << ch;
-        EXPECT_NEAR(us.mean[ch], ref[ch], 4.f * us.stderr_[ch] + 1e-3f * ref[ch]) << "uniform, channel " << ch;
+        EXPECT_NEAR(is.mean[ch], ref[ch], 4.f * is.stderr_[ch] + 1e-3f * ref[ch])
+            << "importance, channel " << ch;
+        EXPECT_NEAR(us.mean[ch], ref[ch], 4.f * us.stderr_[ch] + 1e-3f * ref[ch])
+            << "uniform, channel " << ch;
         float se = std::sqrt(sqr(is.stderr_[ch]) + sqr(us.stderr_[ch]));
         EXPECT_NEAR(is.mean[ch], us.mean[ch], 4.f * se) << "channel " << ch;
     }

@@ -54,8 +54,9 @@ std::string instanced_scene(const std::string &integrator) {
     std::string xml = "<scene version=\"3.0.0\">" + integrator + SENSOR +
                       "<shape type=\"shapegroup\" id=\"group\">" + MEMBERS + "</shape>";
     for (const char *p : PLACEMENTS)
-        xml += std::string("<shape type=\"instance\"><ref id=\"group\"/><transform name=\"to_world\">") + p +
-               "</transform></shape>";
+        xml += std::string(
+                   "<shape type=\"instance\"><ref id=\"group\"/><transform name=\"to_world\">") +
+               p + "</transform></shape>";
     return xml + "</scene>";
 }
 
@@ -90,7 +91,8 @@ int channel(const Image &img, const std::string &name) {
 } // namespace
 
 TEST(Instancing, GeometryMatchesCopiedShapes) {
-    const std::string aov = R"(<integrator type="aov"><string name="aovs" value="dd:depth, nn:sh_normal"/></integrator>)";
+    const std::string aov =
+        R"(<integrator type="aov"><string name="aovs" value="dd:depth, nn:sh_normal"/></integrator>)";
     Image a = render_xml(instanced_scene(aov)), b = render_xml(copied_scene(aov));
     ASSERT_EQ(a.channel_names, b.channel_names);
     int depth = channel(a, "dd"), nx = channel(a, "nn.X");
@@ -101,19 +103,22 @@ TEST(Instancing, GeometryMatchesCopiedShapes) {
         for (int x = 0; x < a.width; ++x) {
             float da = a.at(x, y, depth), db = b.at(x, y, depth);
             bool ok = std::abs(da - db) <= 1e-3f * std::max(1.f, db);
-            for (int c = 0; c < 3; ++c) ok &= std::abs(a.at(x, y, nx + c) - b.at(x, y, nx + c)) < 1e-3f;
+            for (int c = 0; c < 3; ++c)
+                ok &= std::abs(a.at(x, y, nx + c) - b.at(x, y, nx + c)) < 1e-3f;
             agree += ok;
         }
     // Pixels straddling an edge may average slightly different hit sets; nearly all must agree.
     EXPECT_GE(agree, int(0.98 * pixels)) << agree << " of " << pixels << " pixels agree";
     // And the instances are actually there: the groups cover a good part of the image.
     for (int y = 0; y < a.height; ++y)
-        for (int x = 0; x < a.width; ++x) covered += a.at(x, y, depth) > 0.f && a.at(x, y, depth) < 8.5f;
+        for (int x = 0; x < a.width; ++x)
+            covered += a.at(x, y, depth) > 0.f && a.at(x, y, depth) < 8.5f;
     EXPECT_GT(covered, pixels / 10);
 }
 
 TEST(Instancing, ShadingMatchesCopiedShapes) {
-    const std::string path = R"(<integrator type="path"><integer name="max_depth" value="4"/></integrator>)";
+    const std::string path =
+        R"(<integrator type="path"><integer name="max_depth" value="4"/></integrator>)";
     Image a = render_xml(instanced_scene(path)), b = render_xml(copied_scene(path));
     for (int c = 0; c < 3; ++c) {
         double ma = 0, mb = 0;

@@ -49,13 +49,17 @@ TEST(MultipleSensors, DashSPicksTheSensor) {
     for (int index : {0, 1}) {
         fs::path image = dir / ("sensor" + std::to_string(index) + ".exr");
         fs::remove(image);
-        ASSERT_EQ(run("render -q " + scene.string() + " -s " + std::to_string(index) + " -o " + image.string(), out), 0)
+        ASSERT_EQ(run("render -q " + scene.string() + " -s " + std::to_string(index) + " -o " +
+                          image.string(),
+                      out),
+                  0)
             << out;
         facet::Image img = facet::read_image(image.string());
         EXPECT_EQ(img.width, index == 0 ? 16 : 8);
         EXPECT_EQ(img.height, index == 0 ? 8 : 12);
     }
-    EXPECT_NE(run("render -q " + scene.string() + " -s 2 -o " + (dir / "bad.exr").string(), out), 0);
+    EXPECT_NE(run("render -q " + scene.string() + " -s 2 -o " + (dir / "bad.exr").string(), out),
+              0);
     EXPECT_NE(out.find("2 sensors"), std::string::npos) << out;
     EXPECT_FALSE(fs::exists(dir / "bad.exr"));
 }

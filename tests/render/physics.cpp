@@ -38,9 +38,9 @@ std::unique_ptr<Sampler> make_sampler() {
     return proto->clone();
 }
 
-std::shared_ptr<SamplingIntegrator> make_integrator(const std::string &type,
-                                                    const std::vector<std::pair<std::string, int>> &ints = {},
-                                                    bool hide_emitters = false) {
+std::shared_ptr<SamplingIntegrator>
+make_integrator(const std::string &type, const std::vector<std::pair<std::string, int>> &ints = {},
+                bool hide_emitters = false) {
     Properties props(type);
     for (const auto &[name, value] : ints) props.set_int(name, value);
     if (hide_emitters) props.set_bool("hide_emitters", true);
@@ -52,22 +52,27 @@ std::shared_ptr<SamplingIntegrator> make_integrator(const std::string &type,
 std::string furnace_xml(const std::string &integrator, const std::string &emitters,
                         const std::string &shapes, int spp, int size = 64) {
     return R"(<scene version="3.0.0">
-    )" + integrator + R"(
+    )" + integrator +
+           R"(
     <sensor type="perspective">
         <float name="fov" value="45"/>
         <transform name="to_world">
             <lookat origin="0, 0, 7" target="0, 0, 0" up="0, 1, 0"/>
         </transform>
         <sampler type="independent">
-            <integer name="sample_count" value=")" + std::to_string(spp) + R"("/>
+            <integer name="sample_count" value=")" +
+           std::to_string(spp) + R"("/>
         </sampler>
         <film type="hdrfilm">
-            <integer name="width" value=")" + std::to_string(size) + R"("/>
-            <integer name="height" value=")" + std::to_string(size) + R"("/>
+            <integer name="width" value=")" +
+           std::to_string(size) + R"("/>
+            <integer name="height" value=")" +
+           std::to_string(size) + R"("/>
             <rfilter type="box"/>
         </film>
     </sensor>
-    )" + emitters + shapes + R"(
+    )" + emitters +
+           shapes + R"(
 </scene>)";
 }
 
@@ -166,12 +171,12 @@ void expect_pixels_near(const PixelEstimates &e, double expected, double max_z) 
             worst_index = i;
         }
     }
-    EXPECT_EQ(exact_mismatches, 0u) << "pixels without noise that are not " << expected
-                                    << ", the first: pixel " << first_mismatch / 3 << " = "
-                                    << e.mean[first_mismatch];
+    EXPECT_EQ(exact_mismatches, 0u)
+        << "pixels without noise that are not " << expected << ", the first: pixel "
+        << first_mismatch / 3 << " = " << e.mean[first_mismatch];
     EXPECT_GT(noisy, e.mean.size() / 5);
-    EXPECT_LT(worst, max_z) << "pixel " << worst_index / 3 << ": " << e.mean[worst_index]
-                            << " ± " << std::sqrt(e.var[worst_index]);
+    EXPECT_LT(worst, max_z) << "pixel " << worst_index / 3 << ": " << e.mean[worst_index] << " ± "
+                            << std::sqrt(e.var[worst_index]);
     // The channels of a white furnace are identical, so their variances add up as one.
     double n = double(e.mean.size());
     EXPECT_NEAR(sum / n, expected, 4.0 * std::sqrt(3.0 * var_sum) / n) << "mean over all pixels";
@@ -196,7 +201,8 @@ void check_furnace(const Scene &scene, int res, int spp) {
 
     auto integrator = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator());
     ASSERT_TRUE(integrator);
-    PixelEstimates e = estimate(scene, *integrator, camera_rays(*scene.sensors().at(0)), res, spp, 7);
+    PixelEstimates e =
+        estimate(scene, *integrator, camera_rays(*scene.sensors().at(0)), res, spp, 7);
     // res² · 3 z-scores (of which a third are independent): 5.5 σ keeps false alarms rare.
     expect_pixels_near(e, 1.0, 5.5);
 }
@@ -247,7 +253,8 @@ TEST(Furnace, PathDeltaAndDiffuse) {
     </shape>)";
     auto scene = load_scene_string(furnace_xml(
         R"(<integrator type="path"><integer name="rr_depth" value="1000"/></integrator>)",
-        R"(<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>)", shapes, 64));
+        R"(<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>)", shapes,
+        64));
     check_furnace(*scene, 32, 64);
 }
 
@@ -263,8 +270,9 @@ TEST(Furnace, DirectSingleSphere) {
           R"(<integrator type="direct"><integer name="emitter_samples" value="3"/></integrator>)",
           R"(<integrator type="path"><integer name="max_depth" value="2"/></integrator>)"}) {
         auto scene = load_scene_string(furnace_xml(
-            integrator, R"(<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>)",
-            sphere, 32));
+            integrator,
+            R"(<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>)", sphere,
+            32));
         SCOPED_TRACE(integrator);
         check_furnace(*scene, 32, 32);
     }
@@ -305,8 +313,14 @@ TEST(PointLight, DiffusePlaneRadiance) {
         }
         // The light cannot be seen and the plane's back side is black.
         sampler->seed(1);
-        EXPECT_TRUE(integrator->sample(*scene, *sampler, Ray(Point3f(0.f, 0.f, 5.f), Vector3f(0.f, 0.f, 1.f)), nullptr).is_black());
-        EXPECT_TRUE(integrator->sample(*scene, *sampler, Ray(Point3f(0.f, 0.f, -5.f), Vector3f(0.f, 0.f, 1.f)), nullptr).is_black());
+        EXPECT_TRUE(integrator
+                        ->sample(*scene, *sampler,
+                                 Ray(Point3f(0.f, 0.f, 5.f), Vector3f(0.f, 0.f, 1.f)), nullptr)
+                        .is_black());
+        EXPECT_TRUE(integrator
+                        ->sample(*scene, *sampler,
+                                 Ray(Point3f(0.f, 0.f, -5.f), Vector3f(0.f, 0.f, 1.f)), nullptr)
+                        .is_black());
     }
 }
 
@@ -416,8 +430,8 @@ void compare(const PixelEstimates &a, const PixelEstimates &b, double max_z) {
         }
     }
     EXPECT_GT(lit, a.mean.size() / 2);
-    EXPECT_LT(worst, max_z) << "pixel " << worst_index / 3 << " channel " << worst_index % 3
-                            << ": " << a.mean[worst_index] << " vs " << b.mean[worst_index];
+    EXPECT_LT(worst, max_z) << "pixel " << worst_index / 3 << " channel " << worst_index % 3 << ": "
+                            << a.mean[worst_index] << " vs " << b.mean[worst_index];
     double z_mean = std::abs(sum_a - sum_b) / std::sqrt(var_sum);
     EXPECT_LT(z_mean, 4.0) << "image means " << sum_a / a.mean.size() << " vs "
                            << sum_b / b.mean.size();
@@ -483,14 +497,16 @@ TEST(PathVsDirect, HiddenEnvironment) {
         Color3f L = make_integrator(type)->sample(*scene, *sampler, miss, nullptr);
         EXPECT_NEAR(L.r, 0.5f, 1e-6f);
         EXPECT_NEAR(L.b, 2.f, 1e-6f);
-        EXPECT_TRUE(make_integrator(type, {}, true)->sample(*scene, *sampler, miss, nullptr).is_black());
+        EXPECT_TRUE(
+            make_integrator(type, {}, true)->sample(*scene, *sampler, miss, nullptr).is_black());
     }
 }
 
 TEST(Integrators, RejectBadParameters) {
     EXPECT_THROW(make_integrator("path", {{"max_depth", -2}}), Error);
     EXPECT_THROW(make_integrator("path", {{"rr_depth", 0}}), Error);
-    EXPECT_THROW(make_integrator("direct", {{"shading_samples", 2}, {"emitter_samples", 1}}), Error);
+    EXPECT_THROW(make_integrator("direct", {{"shading_samples", 2}, {"emitter_samples", 1}}),
+                 Error);
     EXPECT_THROW(make_integrator("direct", {{"emitter_samples", 0}, {"bsdf_samples", 0}}), Error);
     EXPECT_THROW(make_integrator("direct", {{"bsdf_samples", -1}}), Error);
 }

@@ -18,7 +18,8 @@ namespace {
 
 std::vector<std::string> shipped_scenes() {
     std::vector<std::string> files;
-    for (const auto &entry : fs::recursive_directory_iterator(fs::path(FACET_SOURCE_DIR) / "scenes")) {
+    for (const auto &entry :
+         fs::recursive_directory_iterator(fs::path(FACET_SOURCE_DIR) / "scenes")) {
         if (entry.path().extension() != ".xml") continue;
         // Fragments included by the scenes live in folders named "common".
         if (entry.path().parent_path().filename() == "common") continue;

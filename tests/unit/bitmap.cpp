@@ -23,7 +23,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-float srgb_decode(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+float srgb_decode(float v) {
+    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
 
 SurfaceInteraction at_uv(float u, float v) {
     SurfaceInteraction si;
@@ -52,7 +54,8 @@ protected:
         img.channel_names = {"R", "G", "B"};
         for (int y = 0; y < 2; ++y)
             for (int x = 0; x < 4; ++x)
-                for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(40 * x + 100 * y + 10 * c + 5) / 255.f;
+                for (int c = 0; c < 3; ++c)
+                    img.at(x, y, c) = float(40 * x + 100 * y + 10 * c + 5) / 255.f;
         return img;
     }
 
@@ -90,7 +93,9 @@ protected:
 };
 
 /// uv of the centre of pixel (x, y) of a w × h image.
-Point2f centre(int x, int y, int w, int h) { return {(float(x) + 0.5f) / float(w), (float(y) + 0.5f) / float(h)}; }
+Point2f centre(int x, int y, int w, int h) {
+    return {(float(x) + 0.5f) / float(w), (float(y) + 0.5f) / float(h)};
+}
 
 void expect_color_near(const Color3f &a, const Color3f &b, float tol, const std::string &what) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], tol) << what << " channel " << c;
@@ -129,7 +134,8 @@ TEST_F(Bitmap, EightBitIsSrgbDecodedUnlessRaw) {
 TEST_F(Bitmap, ExrIsLinearAndExact) {
     Image img(3, 2, 3);
     img.channel_names = {"R", "G", "B"};
-    for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = 0.1f * float(i) + (i == 7 ? 20.f : 0.f);
+    for (size_t i = 0; i < img.data.size(); ++i)
+        img.data[i] = 0.1f * float(i) + (i == 7 ? 20.f : 0.f);
     write_image(path("linear.exr"), img);
     for (bool raw : {false, true}) {
         auto tex = make_bitmap("linear.exr", "nearest", "", raw);
@@ -137,7 +143,8 @@ TEST_F(Bitmap, ExrIsLinearAndExact) {
             for (int x = 0; x < 3; ++x) {
                 Point2f uv = centre(x, y, 3, 2);
                 Color3f v = tex->eval(at_uv(uv.x, uv.y));
-                for (int c = 0; c < 3; ++c) EXPECT_EQ(v[c], img.at(x, y, c)) << x << "," << y << " raw " << raw;
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_EQ(v[c], img.at(x, y, c)) << x << "," << y << " raw " << raw;
             }
         // mean() is the image average, max() its largest value.
         Color3f mean;
@@ -170,41 +177,52 @@ TEST_F(Bitmap, NearestAndBilinear) {
     write_png_codes("p.png", img);
     auto nearest = make_bitmap("p.png", "nearest", "clamp", true);
     auto bilinear = make_bitmap("p.png", "bilinear", "clamp", true);
-    auto px = [&](int x, int y) { return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2)); };
+    auto px = [&](int x, int y) {
+        return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2));
+    };
     // At pixel centres both give the pixel.
     for (int y = 0; y < 2; ++y)
         for (int x = 0; x < 4; ++x) {
             Point2f uv = centre(x, y, 4, 2);
             expect_color_near(nearest->eval(at_uv(uv.x, uv.y)), px(x, y), 1e-6f, "nearest centre");
-            expect_color_near(bilinear->eval(at_uv(uv.x, uv.y)), px(x, y), 1e-6f, "bilinear centre");
+            expect_color_near(bilinear->eval(at_uv(uv.x, uv.y)), px(x, y), 1e-6f,
+                              "bilinear centre");
         }
     // Between centres: nearest takes the pixel the point falls in, bilinear interpolates.
     // u = 1.3/4: x = u·4 − 0.5 = 0.8, i.e. 20 % of pixel 0 and 80 % of pixel 1 on the top row's
     // centre line; the point itself lies in pixel 1.
     float u = 1.3f / 4.f;
-    expect_color_near(bilinear->eval(at_uv(u, 0.25f)), px(0, 0) * 0.2f + px(1, 0) * 0.8f, 1e-5f, "bilinear x");
+    expect_color_near(bilinear->eval(at_uv(u, 0.25f)), px(0, 0) * 0.2f + px(1, 0) * 0.8f, 1e-5f,
+                      "bilinear x");
     expect_color_near(nearest->eval(at_uv(u, 0.25f)), px(1, 0), 1e-6f, "nearest x");
     // Halfway between the two rows and two columns: the average of four pixels.
-    expect_color_near(bilinear->eval(at_uv(0.5f, 0.5f)), (px(1, 0) + px(2, 0) + px(1, 1) + px(2, 1)) * 0.25f,
-                      1e-5f, "bilinear corner");
+    expect_color_near(bilinear->eval(at_uv(0.5f, 0.5f)),
+                      (px(1, 0) + px(2, 0) + px(1, 1) + px(2, 1)) * 0.25f, 1e-5f,
+                      "bilinear corner");
     expect_color_near(nearest->eval(at_uv(0.5f, 0.5f)), px(2, 1), 1e-6f, "nearest corner");
 }
 
 TEST_F(Bitmap, WrapModes) {
     Image img = pattern();
     write_png_codes("w.png", img);
-    auto px = [&](int x, int y) { return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2)); };
+    auto px = [&](int x, int y) {
+        return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2));
+    };
     float row0 = 0.25f;
     // Nearest: pixel index −1 and 4 (one past each edge), and far away.
     struct Case {
         const char *mode;
         int left, right, far; // pixel for x = −1, x = 4, x = 4·3 + 1 = 13 (u = 3.375)
     };
-    for (const Case &c : {Case{"repeat", 3, 0, 1}, Case{"mirror", 0, 3, 2}, Case{"clamp", 0, 3, 3}}) {
+    for (const Case &c :
+         {Case{"repeat", 3, 0, 1}, Case{"mirror", 0, 3, 2}, Case{"clamp", 0, 3, 3}}) {
         auto tex = make_bitmap("w.png", "nearest", c.mode, true);
-        expect_color_near(tex->eval(at_uv(-0.5f / 4.f, row0)), px(c.left, 0), 1e-6f, std::string(c.mode) + " left");
-        expect_color_near(tex->eval(at_uv(4.5f / 4.f, row0)), px(c.right, 0), 1e-6f, std::string(c.mode) + " right");
-        expect_color_near(tex->eval(at_uv(13.5f / 4.f, row0)), px(c.far, 0), 1e-6f, std::string(c.mode) + " far");
+        expect_color_near(tex->eval(at_uv(-0.5f / 4.f, row0)), px(c.left, 0), 1e-6f,
+                          std::string(c.mode) + " left");
+        expect_color_near(tex->eval(at_uv(4.5f / 4.f, row0)), px(c.right, 0), 1e-6f,
+                          std::string(c.mode) + " right");
+        expect_color_near(tex->eval(at_uv(13.5f / 4.f, row0)), px(c.far, 0), 1e-6f,
+                          std::string(c.mode) + " far");
         // In v as well: row −1.
         int row = std::string(c.mode) == "repeat" ? 1 : 0;
         expect_color_near(tex->eval(at_uv(centre(2, 0, 4, 2).x, -0.25f)), px(2, row), 1e-6f,
@@ -215,15 +233,18 @@ TEST_F(Bitmap, WrapModes) {
     auto repeat = make_bitmap("w.png", "bilinear", "repeat", true);
     auto mirror = make_bitmap("w.png", "bilinear", "mirror", true);
     auto clamp_ = make_bitmap("w.png", "bilinear", "clamp", true);
-    expect_color_near(repeat->eval(at_uv(0.f, row0)), (px(3, 0) + px(0, 0)) * 0.5f, 1e-5f, "bilinear repeat");
+    expect_color_near(repeat->eval(at_uv(0.f, row0)), (px(3, 0) + px(0, 0)) * 0.5f, 1e-5f,
+                      "bilinear repeat");
     expect_color_near(mirror->eval(at_uv(0.f, row0)), px(0, 0), 1e-5f, "bilinear mirror");
     expect_color_near(clamp_->eval(at_uv(0.f, row0)), px(0, 0), 1e-5f, "bilinear clamp");
     // Repeat is periodic: u and u + 7 agree.
     for (float u : {0.1f, 0.37f, 0.8f})
-        expect_color_near(repeat->eval(at_uv(u + 7.f, 0.3f)), repeat->eval(at_uv(u, 0.3f)), 1e-5f, "period");
+        expect_color_near(repeat->eval(at_uv(u + 7.f, 0.3f)), repeat->eval(at_uv(u, 0.3f)), 1e-5f,
+                          "period");
     // Mirror is symmetric about u = 1.
     for (float u : {0.1f, 0.37f, 0.8f})
-        expect_color_near(mirror->eval(at_uv(2.f - u, 0.3f)), mirror->eval(at_uv(u, 0.3f)), 1e-5f, "mirror");
+        expect_color_near(mirror->eval(at_uv(2.f - u, 0.3f)), mirror->eval(at_uv(u, 0.3f)), 1e-5f,
+                          "mirror");
     // Non-finite coordinates do not crash or read outside the image.
     Color3f nan_value = repeat->eval(at_uv(std::nanf(""), 1e30f));
     EXPECT_TRUE(nan_value.is_finite());
@@ -232,7 +253,9 @@ TEST_F(Bitmap, WrapModes) {
 TEST_F(Bitmap, ToUvTransform) {
     Image img = pattern();
     write_png_codes("t.png", img);
-    auto px = [&](int x, int y) { return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2)); };
+    auto px = [&](int x, int y) {
+        return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2));
+    };
     Properties props("bitmap");
     props.set_string("filename", path("t.png"));
     props.set_string("filter_type", "nearest");
@@ -242,7 +265,8 @@ TEST_F(Bitmap, ToUvTransform) {
                                      Transform::scale(Vector3f(2.f, 0.5f, 1.f)));
     auto tex = make_texture("bitmap", props);
     expect_color_near(tex->eval(at_uv(0.2f, 0.9f)), px(2, 0), 1e-6f, "to_uv");
-    expect_color_near(tex->eval(at_uv(0.45f, 3.5f)), px(0, 1), 1e-6f, "to_uv repeat"); // (1.15, 1.75)
+    expect_color_near(tex->eval(at_uv(0.45f, 3.5f)), px(0, 1), 1e-6f,
+                      "to_uv repeat"); // (1.15, 1.75)
 }
 
 TEST_F(Bitmap, GreyImagesAndEval1) {
@@ -334,7 +358,8 @@ TEST_F(Bitmap, WorksAsABSDFParameter) {
     write_image(path("albedo.exr"), img);
     std::string xml = R"(<bsdf version="3.0.0" type="diffuse">
         <texture type="bitmap" name="reflectance">
-            <string name="filename" value=")" + path("albedo.exr") + R"("/>
+            <string name="filename" value=")" +
+                      path("albedo.exr") + R"("/>
             <string name="filter_type" value="nearest"/>
         </texture>
     </bsdf>)";
@@ -345,7 +370,8 @@ TEST_F(Bitmap, WorksAsABSDFParameter) {
     Color3f left = bsdf->eval(BSDFContext(), si, Vector3f(0.f, 0.f, 1.f));
     expect_color_near(left, Color3f(0.8f, 0.1f, 0.1f) * InvPi, 1e-6f, "left");
     si.uv = Point2f(0.75f, 0.5f);
-    expect_color_near(bsdf->eval_diffuse_reflectance(si), Color3f(0.1f, 0.1f, 0.8f), 1e-6f, "right");
+    expect_color_near(bsdf->eval_diffuse_reflectance(si), Color3f(0.1f, 0.1f, 0.8f), 1e-6f,
+                      "right");
 
     // A scalar parameter (roughness) reads eval_1.
     Image rough(1, 1, 1);
@@ -363,5 +389,6 @@ TEST_F(Bitmap, WorksAsABSDFParameter) {
     SurfaceInteraction s2 = at_uv(0.5f, 0.5f);
     s2.wi = normalize(Vector3f(0.3f, 0.f, 0.8f));
     Vector3f wo = normalize(Vector3f(-0.2f, 0.1f, 0.9f));
-    EXPECT_NEAR(textured->eval(BSDFContext(), s2, wo).r, plain->eval(BSDFContext(), s2, wo).r, 1e-6f);
+    EXPECT_NEAR(textured->eval(BSDFContext(), s2, wo).r, plain->eval(BSDFContext(), s2, wo).r,
+                1e-6f);
 }

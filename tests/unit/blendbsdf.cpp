@@ -19,7 +19,8 @@ std::shared_ptr<BSDF> rough_conductor(double alpha = 0.2) {
 } // namespace
 
 TEST(BlendBSDF, CreationAndFlags) {
-    auto bsdf = make_nested("blendbsdf", {make_bsdf("plastic"), rough_conductor()}, {{"weight", 0.3}});
+    auto bsdf =
+        make_nested("blendbsdf", {make_bsdf("plastic"), rough_conductor()}, {{"weight", 0.3}});
     ASSERT_EQ(bsdf->component_count(), 3u);
     EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
@@ -45,7 +46,8 @@ TEST(BlendBSDF, RejectsBadParameters) {
     expect_nested_error("blendbsdf", {}, {}, "exactly two nested BSDFs, found 0");
     expect_nested_error("blendbsdf", {d}, {}, "exactly two nested BSDFs, found 1");
     expect_nested_error("blendbsdf", {d, d, d}, {}, "found a third");
-    expect_nested_error("blendbsdf", {d, d}, {{"weight", 1.5}}, "weight must be in [0, 1], found 1.5");
+    expect_nested_error("blendbsdf", {d, d}, {{"weight", 1.5}},
+                        "weight must be in [0, 1], found 1.5");
     expect_nested_error("blendbsdf", {d, d}, {{"weight", -0.5}}, "weight must be in [0, 1]");
     expect_nested_error("blendbsdf", {d, d}, {{"weight", std::string("half")}}, "weight");
     expect_nested_error("blendbsdf", {d, d}, {{"opacity", 0.5}}, "opacity");
@@ -81,13 +83,16 @@ TEST(BlendBSDF, EvalAndPdfAreBlended) {
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
         SurfaceInteraction si = make_si(wi);
-        Color3f expected = first->eval(BSDFContext(), si, wo) * 0.65f + second->eval(BSDFContext(), si, wo) * 0.35f;
+        Color3f expected = first->eval(BSDFContext(), si, wo) * 0.65f +
+                           second->eval(BSDFContext(), si, wo) * 0.35f;
         Color3f value = bsdf->eval(BSDFContext(), si, wo);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(value[c], expected[c], 1e-6f * expected[c] + 1e-9f);
-        float pdf = 0.65f * first->pdf(BSDFContext(), si, wo) + 0.35f * second->pdf(BSDFContext(), si, wo);
+        float pdf =
+            0.65f * first->pdf(BSDFContext(), si, wo) + 0.35f * second->pdf(BSDFContext(), si, wo);
         EXPECT_NEAR(bsdf->pdf(BSDFContext(), si, wo), pdf, 1e-6f * pdf);
     }
-    EXPECT_NEAR(bsdf->eval_diffuse_reflectance(make_si(Vector3f(0.f, 0.f, 1.f))).r, 0.65f * 0.9f, 1e-6f);
+    EXPECT_NEAR(bsdf->eval_diffuse_reflectance(make_si(Vector3f(0.f, 0.f, 1.f))).r, 0.65f * 0.9f,
+                1e-6f);
 }
 
 TEST(BlendBSDF, DeltaSamplesKeepTheirWeight) {
@@ -112,7 +117,8 @@ TEST(BlendBSDF, ComponentsAreRouted) {
     SurfaceInteraction si = make_si(direction_from_angles(45.f, 0.f));
     Vector3f wo = direction_from_angles(45.f, 180.f);
     // Component 2 is the conductor's component 0, weighted by 0.25, with its own pdf.
-    EXPECT_NEAR(bsdf->eval(component_ctx(2), si, wo).r, 0.25f * second->eval(BSDFContext(), si, wo).r, 1e-6f);
+    EXPECT_NEAR(bsdf->eval(component_ctx(2), si, wo).r,
+                0.25f * second->eval(BSDFContext(), si, wo).r, 1e-6f);
     EXPECT_EQ(bsdf->pdf(component_ctx(2), si, wo), second->pdf(BSDFContext(), si, wo));
     auto [bs, weight] = bsdf->sample(component_ctx(2), si, 0.7f, Point2f(0.4f, 0.6f));
     auto [bs_s, weight_s] = second->sample(BSDFContext(), si, 0.7f, Point2f(0.4f, 0.6f));
@@ -120,13 +126,16 @@ TEST(BlendBSDF, ComponentsAreRouted) {
     EXPECT_EQ(bs.wo, bs_s.wo);
     EXPECT_NEAR(weight.r, 0.25f * weight_s.r, 1e-6f * weight_s.r);
     // Component 1 is the plastic's diffuse lobe, weighted by 0.75.
-    EXPECT_NEAR(bsdf->eval(component_ctx(1), si, wo).r, 0.75f * first->eval(component_ctx(1), si, wo).r, 1e-7f);
+    EXPECT_NEAR(bsdf->eval(component_ctx(1), si, wo).r,
+                0.75f * first->eval(component_ctx(1), si, wo).r, 1e-7f);
     EXPECT_EQ(bsdf->pdf(component_ctx(1), si, wo), first->pdf(component_ctx(1), si, wo));
     auto [bs0, w0] = bsdf->sample(component_ctx(0), si, 0.5f, Point2f(0.5f));
     EXPECT_EQ(bs0.sampled_type, BSDFFlags::DeltaReflection);
     EXPECT_EQ(bs0.sampled_component, 0u);
     for (uint32_t c = 0; c < 3; ++c)
-        EXPECT_GT(check_sample_eval_pdf(*bsdf, component_ctx(c), false, 300, 10 + c), c == 0 ? -1 : 150) << c;
+        EXPECT_GT(check_sample_eval_pdf(*bsdf, component_ctx(c), false, 300, 10 + c),
+                  c == 0 ? -1 : 150)
+            << c;
 }
 
 TEST(BlendBSDF, TexturedWeightIsEvaluatedPerPoint) {
@@ -141,7 +150,8 @@ TEST(BlendBSDF, TexturedWeightIsEvaluatedPerPoint) {
     for (float u : {0.f, 0.3f, 1.f}) {
         SurfaceInteraction si = make_si(direction_from_angles(30.f, 0.f));
         si.uv = Point2f(u, 0.5f);
-        EXPECT_NEAR(bsdf->eval(BSDFContext(), si, wo).r, (0.2f * (1.f - u) + 0.8f * u) * InvPi, 1e-6f);
+        EXPECT_NEAR(bsdf->eval(BSDFContext(), si, wo).r, (0.2f * (1.f - u) + 0.8f * u) * InvPi,
+                    1e-6f);
         auto [bs, weight] = bsdf->sample(BSDFContext(), si, 0.5f, Point2f(0.3f, 0.3f));
         EXPECT_NEAR(weight.r, 0.2f * (1.f - u) + 0.8f * u, 1e-5f);
     }
@@ -150,46 +160,64 @@ TEST(BlendBSDF, TexturedWeightIsEvaluatedPerPoint) {
 TEST(BlendBSDF, SampleWeightMatchesEvalPdf) {
     std::vector<std::shared_ptr<BSDF>> bsdfs = {
         make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
-        make_nested("blendbsdf", {make_bsdf("roughdielectric", {{"alpha", 0.5}}), make_bsdf("diffuse")}, {{"weight", 0.6}}),
-        make_nested("blendbsdf", {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})}, {{"weight", 0.5}}),
-        make_nested("blendbsdf", {make_bsdf("plastic"), make_bsdf("roughplastic", {{"alpha", 0.1}})}, {{"weight", 0.8}}),
+        make_nested("blendbsdf",
+                    {make_bsdf("roughdielectric", {{"alpha", 0.5}}), make_bsdf("diffuse")},
+                    {{"weight", 0.6}}),
+        make_nested("blendbsdf",
+                    {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})},
+                    {{"weight", 0.5}}),
+        make_nested("blendbsdf",
+                    {make_bsdf("plastic"), make_bsdf("roughplastic", {{"alpha", 0.1}})},
+                    {{"weight", 0.8}}),
     };
     for (const auto &bsdf : bsdfs)
-        EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 5), 500) << bsdf->to_string();
+        EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 5), 500)
+            << bsdf->to_string();
 }
 
 TEST(BlendBSDF, ReciprocityAndFurnace) {
-    auto bsdf = make_nested("blendbsdf", {make_bsdf("roughplastic", {{"alpha", 0.2}}), rough_conductor(0.3)}, {{"weight", 0.4}});
+    auto bsdf = make_nested("blendbsdf",
+                            {make_bsdf("roughplastic", {{"alpha", 0.2}}), rough_conductor(0.3)},
+                            {{"weight", 0.4}});
     PCG32 rng(9);
     for (int i = 0; i < 300; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
         Color3f f_io = bsdf->eval(BSDFContext(), make_si(wi), wo) / wo.z;
         Color3f f_oi = bsdf->eval(BSDFContext(), make_si(wo), wi) / wi.z;
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(f_io[c], f_oi[c], 1e-4f * std::max(f_io[c], f_oi[c]) + 1e-7f);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(f_io[c], f_oi[c], 1e-4f * std::max(f_io[c], f_oi[c]) + 1e-7f);
     }
     // Two white diffuse BSDFs blend to a white one; mixed ones stay below one.
-    auto white = make_nested("blendbsdf", {make_bsdf("diffuse", {{"reflectance", 1.0}}), make_bsdf("diffuse", {{"reflectance", 1.0}})},
-                            {{"weight", 0.2}});
-    EXPECT_NEAR(furnace(*white, BSDFContext(), direction_from_angles(30.f, 0.f), 20000).r, 1.f, 1e-4f);
-    auto glass = make_nested("blendbsdf", {make_bsdf("roughdielectric", {{"alpha", 0.3}}), rough_conductor(0.3)}, {{"weight", 0.5}});
+    auto white = make_nested("blendbsdf",
+                             {make_bsdf("diffuse", {{"reflectance", 1.0}}),
+                              make_bsdf("diffuse", {{"reflectance", 1.0}})},
+                             {{"weight", 0.2}});
+    EXPECT_NEAR(furnace(*white, BSDFContext(), direction_from_angles(30.f, 0.f), 20000).r, 1.f,
+                1e-4f);
+    auto glass = make_nested("blendbsdf",
+                             {make_bsdf("roughdielectric", {{"alpha", 0.3}}), rough_conductor(0.3)},
+                             {{"weight", 0.5}});
     for (float theta : {10.f, 60.f, 120.f})
-        EXPECT_LE(furnace(*glass, BSDFContext(), direction_from_angles(theta, 0.f), 20000).max(), 1.f + 5e-3f);
+        EXPECT_LE(furnace(*glass, BSDFContext(), direction_from_angles(theta, 0.f), 20000).max(),
+                  1.f + 5e-3f);
 }
 
 TEST(BlendBSDF, LoadsFromXml) {
-    auto bsdf = std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="blendbsdf">
+    auto bsdf =
+        std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="blendbsdf">
         <float name="weight" value="0.25"/>
         <bsdf type="diffuse"><float name="reflectance" value="0.4"/></bsdf>
         <bsdf type="diffuse"><float name="reflectance" value="0.8"/></bsdf>
     </bsdf>)"));
     ASSERT_TRUE(bsdf);
-    Color3f value = bsdf->eval(BSDFContext(), make_si(Vector3f(0.f, 0.f, 1.f)), Vector3f(0.f, 0.f, 1.f));
+    Color3f value =
+        bsdf->eval(BSDFContext(), make_si(Vector3f(0.f, 0.f, 1.f)), Vector3f(0.f, 0.f, 1.f));
     EXPECT_NEAR(value.r, (0.75f * 0.4f + 0.25f * 0.8f) * InvPi, 1e-6f);
 }
 
 namespace {
-void chi2_blend(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32_t seed, const std::string &name,
-                const BSDFContext &ctx = {}) {
+void chi2_blend(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32_t seed,
+                const std::string &name, const BSDFContext &ctx = {}) {
     BSDFAdapter adapter(bsdf, wi, ctx);
     Chi2Options opts;
     opts.samples = 200000;
@@ -200,20 +228,26 @@ void chi2_blend(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32_t 
 } // namespace
 
 TEST(BSDFSampling, BlendDiffuseRoughConductor) {
-    chi2_blend(make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
-               direction_from_angles(50.f, 0.f), 0, "diffuse_roughconductor");
+    chi2_blend(
+        make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
+        direction_from_angles(50.f, 0.f), 0, "diffuse_roughconductor");
 }
 TEST(BSDFSampling, BlendRoughConductorRoughDielectric) {
-    chi2_blend(make_nested("blendbsdf", {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})}, {{"weight", 0.5}}),
+    chi2_blend(make_nested("blendbsdf",
+                           {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})},
+                           {{"weight", 0.5}}),
                direction_from_angles(30.f, 45.f), 1, "roughconductor_roughdielectric");
 }
 TEST(BSDFSampling, BlendWithDeltaLobes) {
-    chi2_blend(make_nested("blendbsdf", {make_bsdf("plastic"), make_bsdf("roughplastic", {{"distribution", std::string("ggx")},
-                                                                             {"alpha", 0.3}})},
-                          {{"weight", 0.6}}),
+    chi2_blend(make_nested("blendbsdf",
+                           {make_bsdf("plastic"),
+                            make_bsdf("roughplastic",
+                                      {{"distribution", std::string("ggx")}, {"alpha", 0.3}})},
+                           {{"weight", 0.6}}),
                direction_from_angles(20.f, 0.f), 2, "plastic_roughplastic");
 }
 TEST(BSDFSampling, BlendSecondComponent) {
-    chi2_blend(make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.3)}, {{"weight", 0.7}}),
-               direction_from_angles(65.f, 0.f), 3, "second_component", component_ctx(1));
+    chi2_blend(
+        make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.3)}, {{"weight", 0.7}}),
+        direction_from_angles(65.f, 0.f), 3, "second_component", component_ctx(1));
 }

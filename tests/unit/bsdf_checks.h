@@ -53,12 +53,14 @@ inline std::shared_ptr<BSDF> make_nested(const std::string &plugin,
                                          const std::vector<std::shared_ptr<BSDF>> &nested,
                                          const Params &params = {}) {
     Properties props = make_props(plugin, params);
-    for (size_t i = 0; i < nested.size(); ++i) props.set_object("_arg_" + std::to_string(i), nested[i]);
+    for (size_t i = 0; i < nested.size(); ++i)
+        props.set_object("_arg_" + std::to_string(i), nested[i]);
     return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
 }
 
 /// expect_error() for a BSDF with nested BSDFs.
-inline void expect_nested_error(const std::string &plugin, const std::vector<std::shared_ptr<BSDF>> &nested,
+inline void expect_nested_error(const std::string &plugin,
+                                const std::vector<std::shared_ptr<BSDF>> &nested,
                                 const Params &params, const std::string &fragment) {
     try {
         make_nested(plugin, nested, params);

@@ -13,8 +13,8 @@ using namespace facet;
 namespace {
 
 std::shared_ptr<Sensor> make_sensor(const std::string &type, const Transform &to_world,
-                                    const std::vector<std::pair<std::string, double>> &floats, int w = 64,
-                                    int h = 32) {
+                                    const std::vector<std::pair<std::string, double>> &floats,
+                                    int w = 64, int h = 32) {
     Properties film_props("hdrfilm");
     film_props.set_int("width", w);
     film_props.set_int("height", h);
@@ -35,7 +35,8 @@ void expect_vec_near(const Vector3f &a, const Vector3f &b, float tol) {
 } // namespace
 
 TEST(Orthographic, ParallelRaysOverTheScaledFilm) {
-    Transform xf = Transform::look_at({0, 10, 0}, {0, 0, 0}, {0, 0, 1}) * Transform::scale({3, 3, 1});
+    Transform xf =
+        Transform::look_at({0, 10, 0}, {0, 0, 0}, {0, 0, 1}) * Transform::scale({3, 3, 1});
     auto cam = make_sensor("orthographic", xf, {});
     auto [centre, w] = cam->sample_ray(0.f, Point2f(0.5f, 0.5f), Point2f(0.5f));
     EXPECT_EQ(w, Color3f(1.f));
@@ -57,7 +58,8 @@ TEST(Orthographic, ParallelRaysOverTheScaledFilm) {
 }
 
 TEST(Orthographic, ClipDistancesScaleWithTheTransform) {
-    Transform xf = Transform::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}) * Transform::scale({2, 2, 2});
+    Transform xf =
+        Transform::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}) * Transform::scale({2, 2, 2});
     auto cam = make_sensor("orthographic", xf, {{"near_clip", 1.0}, {"far_clip", 5.0}});
     auto [ray, w] = cam->sample_ray(0.f, Point2f(0.3f, 0.6f), Point2f(0.5f));
     EXPECT_NEAR(ray.mint, 2.f, 1e-5f);
@@ -66,7 +68,8 @@ TEST(Orthographic, ClipDistancesScaleWithTheTransform) {
 
 TEST(ThinLens, ZeroApertureIsThePinhole) {
     Transform xf = Transform::look_at({1, 2, 3}, {0, 0, 0}, {0, 1, 0});
-    auto lens = make_sensor("thinlens", xf, {{"fov", 50.0}, {"aperture_radius", 0.0}, {"focus_distance", 4.0}});
+    auto lens = make_sensor("thinlens", xf,
+                            {{"fov", 50.0}, {"aperture_radius", 0.0}, {"focus_distance", 4.0}});
     auto pin = make_sensor("perspective", xf, {{"fov", 50.0}});
     for (Point2f p : {Point2f(0.1f, 0.2f), Point2f(0.5f, 0.5f), Point2f(0.9f, 0.7f)}) {
         auto [a, wa] = lens->sample_ray(0.f, p, Point2f(0.3f, 0.8f));
@@ -79,13 +82,14 @@ TEST(ThinLens, ZeroApertureIsThePinhole) {
 TEST(ThinLens, RaysThroughOnePixelMeetOnTheFocusPlane) {
     Transform xf = Transform::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0});
     const float focus = 7.f, radius = 0.5f;
-    auto lens = make_sensor("thinlens", xf,
-                            {{"fov", 40.0}, {"aperture_radius", radius}, {"focus_distance", focus}});
+    auto lens = make_sensor(
+        "thinlens", xf, {{"fov", 40.0}, {"aperture_radius", radius}, {"focus_distance", focus}});
     Point2f film(0.3f, 0.65f);
     Point3f meet;
     bool first = true;
     float max_offset = 0.f;
-    for (Point2f ap : {Point2f(0.1f, 0.1f), Point2f(0.9f, 0.2f), Point2f(0.5f, 0.95f), Point2f(0.3f, 0.6f)}) {
+    for (Point2f ap :
+         {Point2f(0.1f, 0.1f), Point2f(0.9f, 0.2f), Point2f(0.5f, 0.95f), Point2f(0.3f, 0.6f)}) {
         auto [ray, w] = lens->sample_ray(0.f, film, ap);
         EXPECT_EQ(w, Color3f(1.f));
         EXPECT_LE(std::hypot(ray.o.x, ray.o.y), radius + 1e-5f); // starts on the aperture
@@ -102,6 +106,7 @@ TEST(ThinLens, RaysThroughOnePixelMeetOnTheFocusPlane) {
 TEST(ThinLens, MissingParametersAreErrors) {
     EXPECT_THROW(make_sensor("thinlens", Transform(), {{"aperture_radius", 0.1}}), std::exception);
     EXPECT_THROW(make_sensor("thinlens", Transform(), {{"focus_distance", 3.0}}), std::exception);
-    EXPECT_THROW(make_sensor("thinlens", Transform(), {{"aperture_radius", -1.0}, {"focus_distance", 3.0}}),
-                 std::exception);
+    EXPECT_THROW(
+        make_sensor("thinlens", Transform(), {{"aperture_radius", -1.0}, {"focus_distance", 3.0}}),
+        std::exception);
 }

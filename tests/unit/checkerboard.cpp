@@ -57,7 +57,8 @@ TEST(Checkerboard, DefaultPattern) {
         for (float dv : {-2.f, 0.f, 5.f})
             for (float u : {0.1f, 0.6f})
                 for (float v : {0.3f, 0.9f})
-                    EXPECT_EQ(tex->eval(at_uv(u + du, v + dv)), tex->eval(at_uv(u, v))) << u + du << "," << v + dv;
+                    EXPECT_EQ(tex->eval(at_uv(u + du, v + dv)), tex->eval(at_uv(u, v)))
+                        << u + du << "," << v + dv;
     EXPECT_EQ(tex->eval(at_uv(-0.25f, 0.25f)), Color3f(0.2f));
     EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.1f, 0.1f)), 0.4f);
     EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.6f, 0.1f)), 0.2f);
@@ -105,7 +106,8 @@ TEST(Checkerboard, RejectsBadParameters) {
     Properties all;
     all.set_float("color0", 0.1);
     make_checkerboard(all);
-    std::string doc = PluginRegistry::instance().descriptor("checkerboard", ObjectType::Texture).doc;
+    std::string doc =
+        PluginRegistry::instance().descriptor("checkerboard", ObjectType::Texture).doc;
     EXPECT_EQ(all.requested_names().size(), 3u);
     for (const std::string &name : all.requested_names())
         EXPECT_NE(doc.find("| " + name + " |"), std::string::npos) << name;
@@ -125,7 +127,8 @@ TEST(Checkerboard, WorksAsABSDFParameter) {
     EXPECT_NEAR(bsdf->eval(BSDFContext(), at_uv(0.7f, 0.2f), up).r, 0.1f * InvPi, 1e-6f);
 
     // As a blend weight: weight 0 (color0) on one check, 1 (color1) on the other.
-    auto blend = std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="blendbsdf">
+    auto blend =
+        std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="blendbsdf">
         <texture type="checkerboard" name="weight">
             <float name="color0" value="0"/>
             <float name="color1" value="1"/>

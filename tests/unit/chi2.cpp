@@ -35,7 +35,8 @@ public:
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
                                           float sample1, const Point2f &u) const override {
         BSDFSample bs;
-        if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f) return {bs, Color3f(0.f)};
+        if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f)
+            return {bs, Color3f(0.f)};
         bs.wo = m_bug == Bug::MissingCosine ? warp::square_to_uniform_hemisphere(u)
                                             : warp::square_to_cosine_hemisphere(u);
         if (m_bug == Bug::StrayBelow && sample1 < 1e-5f) bs.wo.z = -bs.wo.z;
@@ -46,15 +47,18 @@ public:
         if (!(bs.pdf > 0.f)) return {bs, Color3f(0.f)};
         Color3f weight = eval(ctx, si, bs.wo) / bs.pdf;
         if (m_bug == Bug::WrongWeight) weight = Color3f(1.f);
-        if (m_bug == Bug::NanWeight && bs.wo.x > 0.95f) weight.g = std::numeric_limits<float>::quiet_NaN();
+        if (m_bug == Bug::NanWeight && bs.wo.x > 0.95f)
+            weight.g = std::numeric_limits<float>::quiet_NaN();
         return {bs, weight};
     }
-    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
+    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
+                 const Vector3f &wo) const override {
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f || wo.z <= 0.f)
             return Color3f(0.f);
         return m_reflectance * (wo.z * InvPi);
     }
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+              const Vector3f &wo) const override {
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || si.wi.z <= 0.f || wo.z <= 0.f)
             return 0.f;
         if (m_bug == Bug::NanPdf && wo.x > 0.95f) return std::numeric_limits<float>::quiet_NaN();
@@ -101,13 +105,15 @@ TEST(Chi2Statistics, IncompleteGammaKnownValues) {
     for (double x : {0.01, 0.5, 1.0, 2.5, 7.0, 30.0}) {
         EXPECT_NEAR(regularized_gamma_p(1.0, x), 1.0 - std::exp(-x), 1e-13) << x;
         EXPECT_NEAR(regularized_gamma_p(0.5, x), std::erf(std::sqrt(x)), 1e-13) << x;
-        EXPECT_NEAR(regularized_gamma_q(3.0, x), std::exp(-x) * (1.0 + x + 0.5 * x * x), 1e-13) << x;
+        EXPECT_NEAR(regularized_gamma_q(3.0, x), std::exp(-x) * (1.0 + x + 0.5 * x * x), 1e-13)
+            << x;
     }
     // Both expansions (x < a + 1 and x >= a + 1) against the finite sum, relative to the value.
     for (int a : {5, 50, 400})
         for (double f : {0.3, 0.9, 1.0, 1.1, 2.0}) {
             double x = f * a, q = gamma_q_integer(a, x);
-            EXPECT_NEAR(regularized_gamma_q(a, x), q, 1e-10 * std::max(q, 1e-300) + 1e-15) << a << " " << x;
+            EXPECT_NEAR(regularized_gamma_q(a, x), q, 1e-10 * std::max(q, 1e-300) + 1e-15)
+                << a << " " << x;
             EXPECT_NEAR(regularized_gamma_p(a, x) + regularized_gamma_q(a, x), 1.0, 1e-12);
         }
     EXPECT_EQ(regularized_gamma_p(2.0, 0.0), 0.0);
@@ -182,7 +188,8 @@ TEST(Chi2BSDF, CorrectSamplerAcceptedOverTwentySeeds) {
 }
 
 TEST(Chi2BSDF, ResultsReproduce) {
-    Chi2Result a = run_lambert(TestLambert::Bug::None, 7), b = run_lambert(TestLambert::Bug::None, 7);
+    Chi2Result a = run_lambert(TestLambert::Bug::None, 7),
+               b = run_lambert(TestLambert::Bug::None, 7);
     EXPECT_EQ(a.observed, b.observed);
     EXPECT_EQ(a.statistic, b.statistic);
     Chi2Result c = run_lambert(TestLambert::Bug::None, 8);
@@ -243,7 +250,8 @@ TEST(Chi2BSDF, EnergyGainRejected) {
 
 TEST(Chi2BSDF, BackSideGivesNoSamplesAndZeroPdf) {
     // From below, the Lambertian BSDF does nothing: no histogram to test, and that is no failure.
-    BSDFAdapter adapter(std::make_shared<TestLambert>(TestLambert::Bug::None), Vector3f(0.3f, 0.f, -1.f));
+    BSDFAdapter adapter(std::make_shared<TestLambert>(TestLambert::Bug::None),
+                        Vector3f(0.3f, 0.f, -1.f));
     Chi2Options opts;
     opts.res = 8;
     opts.samples = 10000;
@@ -263,13 +271,18 @@ TEST(Chi2Microfacet, GGXVisibleNormalsAccepted) {
 }
 
 TEST(Chi2Xml, EntriesGetTheirTypes) {
-    std::string xml = chi2_object_xml(ObjectType::BSDF, "roughconductor",
-                                      {"alpha=0.2", "sample_visible=false", "specular_reflectance=0.5,0.6,0.7",
-                                       "distribution=ggx", "integer:n=3", "vector:v=1,2,3"});
-    EXPECT_NE(xml.find("<bsdf version=\"3.0.0\" type=\"roughconductor\">"), std::string::npos) << xml;
+    std::string xml =
+        chi2_object_xml(ObjectType::BSDF, "roughconductor",
+                        {"alpha=0.2", "sample_visible=false", "specular_reflectance=0.5,0.6,0.7",
+                         "distribution=ggx", "integer:n=3", "vector:v=1,2,3"});
+    EXPECT_NE(xml.find("<bsdf version=\"3.0.0\" type=\"roughconductor\">"), std::string::npos)
+        << xml;
     EXPECT_NE(xml.find("<float name=\"alpha\" value=\"0.2\"/>"), std::string::npos) << xml;
-    EXPECT_NE(xml.find("<boolean name=\"sample_visible\" value=\"false\"/>"), std::string::npos) << xml;
-    EXPECT_NE(xml.find("<rgb name=\"specular_reflectance\" value=\"0.5,0.6,0.7\"/>"), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<boolean name=\"sample_visible\" value=\"false\"/>"), std::string::npos)
+        << xml;
+    EXPECT_NE(xml.find("<rgb name=\"specular_reflectance\" value=\"0.5,0.6,0.7\"/>"),
+              std::string::npos)
+        << xml;
     EXPECT_NE(xml.find("<string name=\"distribution\" value=\"ggx\"/>"), std::string::npos) << xml;
     EXPECT_NE(xml.find("<integer name=\"n\" value=\"3\"/>"), std::string::npos) << xml;
     EXPECT_NE(xml.find("<vector name=\"v\" x=\"1\" y=\"2\" z=\"3\"/>"), std::string::npos) << xml;

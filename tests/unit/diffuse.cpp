@@ -103,9 +103,10 @@ TEST(BSDFEval, DiffuseTexturedReflectance) {
     BSDFContext ctx;
     Vector3f wo = normalize(Vector3f(0.3f, 0.1f, 0.8f));
     SurfaceInteraction si = interaction(Vector3f(0.f, 0.f, 1.f));
-    const std::pair<Point2f, Color3f> cases[] = {{Point2f(0.25f, 0.25f), Color3f(0.1f, 0.2f, 0.3f)},
-                                                 {Point2f(0.75f, 0.25f), Color3f(0.7f, 0.8f, 0.9f)},
-                                                 {Point2f(0.75f, 0.75f), Color3f(0.1f, 0.2f, 0.3f)}};
+    const std::pair<Point2f, Color3f> cases[] = {
+        {Point2f(0.25f, 0.25f), Color3f(0.1f, 0.2f, 0.3f)},
+        {Point2f(0.75f, 0.25f), Color3f(0.7f, 0.8f, 0.9f)},
+        {Point2f(0.75f, 0.75f), Color3f(0.1f, 0.2f, 0.3f)}};
     for (const auto &[uv, rho] : cases) {
         si.uv = uv;
         expect_color_near(bsdf->eval_diffuse_reflectance(si), rho, 1e-6f);
@@ -121,8 +122,8 @@ TEST(BSDFSampling, DiffuseConsistency) {
     int checked = 0;
     for (int i = 0; i < 10000; ++i) {
         SurfaceInteraction si = interaction(random_upper_direction(rng));
-        auto [bs, weight] = bsdf->sample(ctx, si, rng.next_float(),
-                                         Point2f(rng.next_float(), rng.next_float()));
+        auto [bs, weight] =
+            bsdf->sample(ctx, si, rng.next_float(), Point2f(rng.next_float(), rng.next_float()));
         if (weight.is_black()) continue;
         ++checked;
         EXPECT_EQ(bs.sampled_type, BSDFFlags::DiffuseReflection);
@@ -149,9 +150,10 @@ TEST(BSDFEnergy, DiffuseAlbedoEqualsReflectance) {
     const int n = 200000;
     double sum_w[3] = {0, 0, 0}, sum_u[3] = {0, 0, 0}, sum_u2 = 0;
     for (int i = 0; i < n; ++i) {
-        auto [bs, weight] = bsdf->sample(ctx, si, rng.next_float(),
-                                         Point2f(rng.next_float(), rng.next_float()));
-        Vector3f wo = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        auto [bs, weight] =
+            bsdf->sample(ctx, si, rng.next_float(), Point2f(rng.next_float(), rng.next_float()));
+        Vector3f wo =
+            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
         Color3f f = bsdf->eval(ctx, si, wo) / warp::square_to_uniform_hemisphere_pdf(wo);
         for (int c = 0; c < 3; ++c) {
             sum_w[c] += weight[c];
@@ -184,7 +186,8 @@ TEST(BSDFReciprocity, Diffuse) {
 TEST(BSDFEval, DiffuseBackSideIsBlack) {
     auto bsdf = make_diffuse(Color3f(0.8f));
     BSDFContext ctx;
-    Vector3f up = normalize(Vector3f(0.1f, 0.2f, 0.9f)), down = normalize(Vector3f(0.3f, 0.f, -0.6f));
+    Vector3f up = normalize(Vector3f(0.1f, 0.2f, 0.9f)),
+             down = normalize(Vector3f(0.3f, 0.f, -0.6f));
     // Incident from below.
     SurfaceInteraction below = interaction(down);
     EXPECT_TRUE(bsdf->eval(ctx, below, up).is_black());

@@ -41,7 +41,8 @@ TEST(Directional, LitDiffusePlane) {
     const float theta = deg_to_rad(60.f);
     std::string xml = R"(<scene version="3.0.0">
         <emitter type="directional">
-            <vector name="direction" x=")" + std::to_string(std::sin(theta)) + R"(" y=")" +
+            <vector name="direction" x=")" +
+                      std::to_string(std::sin(theta)) + R"(" y=")" +
                       std::to_string(-std::cos(theta)) + R"(" z="0"/>
             <rgb name="irradiance" value="2"/>
         </emitter>
@@ -53,10 +54,14 @@ TEST(Directional, LitDiffusePlane) {
     auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
     Properties ip("path");
     ip.set_int("max_depth", 2);
-    auto integrator = PluginRegistry::instance().create_as<SamplingIntegrator>(ObjectType::Integrator, ip);
-    auto sampler = PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler, Properties("independent"))->clone();
+    auto integrator =
+        PluginRegistry::instance().create_as<SamplingIntegrator>(ObjectType::Integrator, ip);
+    auto sampler = PluginRegistry::instance()
+                       .create_as<Sampler>(ObjectType::Sampler, Properties("independent"))
+                       ->clone();
     sampler->seed(1);
-    Color3f L = integrator->sample(*scene, *sampler, Ray(Point3f(0, 1, 0), Vector3f(0, -1, 0)), nullptr);
+    Color3f L =
+        integrator->sample(*scene, *sampler, Ray(Point3f(0, 1, 0), Vector3f(0, -1, 0)), nullptr);
     const float expected = 0.5f / Pi * 2.f * std::cos(theta);
     EXPECT_NEAR(L.r, expected, 1e-4f);
     EXPECT_NEAR(L.g, expected, 1e-4f);

@@ -60,7 +60,8 @@ Estimate irradiance(const Emitter &emitter, const Interaction &ref, int n, uint6
     double sum[3] = {0, 0, 0}, sum2 = 0;
     int pdf_failures = 0;
     for (int i = 0; i < n; ++i) {
-        auto [ds, weight] = emitter.sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        auto [ds, weight] =
+            emitter.sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
         float cos_theta = std::max(0.f, dot(ref.n, ds.d));
         if (!weight.is_black()) {
             EXPECT_EQ(ds.emitter, &emitter);
@@ -141,8 +142,8 @@ TEST(EmitterPoint, ToWorld) {
     Properties props("point");
     props.set_transform("to_world", Transform::translate(Vector3f(0.f, 5.f, 0.f)));
     auto e = make_emitter(props);
-    auto [ds, weight] = e->sample_direction(reference(Point3f(0.f), Normal3f(0.f, 1.f, 0.f)),
-                                            Point2f(0.5f, 0.5f));
+    auto [ds, weight] =
+        e->sample_direction(reference(Point3f(0.f), Normal3f(0.f, 1.f, 0.f)), Point2f(0.5f, 0.5f));
     EXPECT_EQ(ds.p, Point3f(0.f, 5.f, 0.f));
     expect_color_near(weight, Color3f(1.f / 25.f), 1e-6f); // default intensity 1
 }
@@ -399,7 +400,8 @@ TEST(EmitterChi2, AreaRectangle) {
 }
 
 TEST(EmitterChi2, AreaSphere) {
-    EmitterAdapter adapter(EmitterAdapter::scene_xml("area", {}, "sphere"), Point3f(0.f, 0.5f, 2.5f));
+    EmitterAdapter adapter(EmitterAdapter::scene_xml("area", {}, "sphere"),
+                           Point3f(0.f, 0.5f, 2.5f));
     Chi2Options opts;
     opts.test_count = 3;
     opts.seed = 1;

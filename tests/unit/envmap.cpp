@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string write_map(const std::string &name, int w, int h, const std::function<Color3f(int, int)> &f) {
+std::string write_map(const std::string &name, int w, int h,
+                      const std::function<Color3f(int, int)> &f) {
     fs::path dir = fs::temp_directory_path() / "facet-envmap-unit";
     fs::create_directories(dir);
     Image img(w, h, 3);
@@ -36,7 +37,8 @@ std::string write_map(const std::string &name, int w, int h, const std::function
 
 std::string scene_with(const std::string &map, const std::string &extra = "") {
     return R"(<scene version="3.0.0">
-        <emitter type="envmap"><string name="filename" value=")" + map + R"("/>)" + extra + R"(</emitter>
+        <emitter type="envmap"><string name="filename" value=")" +
+           map + R"("/>)" + extra + R"(</emitter>
         <shape type="sphere"><float name="radius" value="0.1"/></shape>
     </scene>)";
 }
@@ -51,7 +53,9 @@ void expect_chi2_passes(const std::string &xml, const Point3f &ref, int res = 32
     EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2) << r.summary();
 }
 
-std::shared_ptr<Scene> load(const std::string &xml) { return std::dynamic_pointer_cast<Scene>(load_string(xml)); }
+std::shared_ptr<Scene> load(const std::string &xml) {
+    return std::dynamic_pointer_cast<Scene>(load_string(xml));
+}
 
 } // namespace
 
@@ -75,7 +79,8 @@ TEST(EnvironmentMap, TopRowIsUpAndUTurnsAroundY) {
 }
 
 TEST(EnvironmentMap, ScaleAndEvalMatchSampleWeight) {
-    std::string map = write_map("flat.exr", 16, 8, [](int, int) { return Color3f(0.5f, 1.f, 2.f); });
+    std::string map =
+        write_map("flat.exr", 16, 8, [](int, int) { return Color3f(0.5f, 1.f, 2.f); });
     auto scene = load(scene_with(map, R"(<float name="scale" value="3"/>)"));
     const Emitter &env = *scene->environment_emitters().at(0);
     Interaction ref;
@@ -104,7 +109,8 @@ TEST(EnvironmentMapChi2, ConstantMap) {
 }
 
 TEST(EnvironmentMapChi2, TinyMap) {
-    std::string map = write_map("tiny.exr", 3, 2, [](int x, int y) { return Color3f(float(1 + x + 3 * y)); });
+    std::string map =
+        write_map("tiny.exr", 3, 2, [](int x, int y) { return Color3f(float(1 + x + 3 * y)); });
     expect_chi2_passes(scene_with(map), Point3f(0.f, 0.f, 0.f));
 }
 
@@ -114,12 +120,15 @@ TEST(EnvironmentMapChi2, RotatedSkyWithSun) {
         float t = float(y) / 31.f;
         return Color3f(0.3f + t, 0.5f + t, 1.f);
     });
-    expect_chi2_passes(scene_with(map, R"(<transform name="to_world"><rotate x="1" y="1" angle="30"/></transform>)"),
-                       Point3f(0.05f, 0.0f, 0.02f));
+    expect_chi2_passes(
+        scene_with(map,
+                   R"(<transform name="to_world"><rotate x="1" y="1" angle="30"/></transform>)"),
+        Point3f(0.05f, 0.0f, 0.02f));
 }
 
 TEST(EnvironmentMapChi2, UniformSamplingOption) {
-    std::string map = write_map("grad.exr", 32, 16, [](int x, int) { return Color3f(0.1f + float(x)); });
+    std::string map =
+        write_map("grad.exr", 32, 16, [](int x, int) { return Color3f(0.1f + float(x)); });
     expect_chi2_passes(scene_with(map, R"(<boolean name="importance_sampling" value="false"/>)"),
                        Point3f(0.f, 0.f, 0.f));
 }

@@ -101,7 +101,8 @@ TEST(Mask, EvalAndPdfScaleWithOpacity) {
     SurfaceInteraction si = make_si(direction_from_angles(30.f, 0.f));
     int null_count = 0, n = 20000;
     for (int i = 0; i < n; ++i) {
-        auto [bs, weight] = bsdf->sample(BSDFContext(), si, (float(i) + 0.5f) / float(n), Point2f(0.4f, 0.3f));
+        auto [bs, weight] =
+            bsdf->sample(BSDFContext(), si, (float(i) + 0.5f) / float(n), Point2f(0.4f, 0.3f));
         if (bs.sampled_type == BSDFFlags::Null) {
             ++null_count;
             EXPECT_NEAR(bs.pdf, 0.7f, 1e-6f);
@@ -150,7 +151,8 @@ TEST(Mask, TexturedOpacityIsEvaluatedPerPoint) {
     for (float u : {0.f, 0.25f, 0.9f}) {
         SurfaceInteraction si = make_si(direction_from_angles(50.f, 90.f));
         si.uv = Point2f(u, 0.5f);
-        EXPECT_NEAR(bsdf->eval(BSDFContext(), si, wo).r, u * nested->eval(BSDFContext(), si, wo).r, 1e-7f);
+        EXPECT_NEAR(bsdf->eval(BSDFContext(), si, wo).r, u * nested->eval(BSDFContext(), si, wo).r,
+                    1e-7f);
         EXPECT_NEAR(bsdf->eval_null_transmission(si).r, 1.f - u, 1e-7f);
     }
 }
@@ -159,7 +161,8 @@ TEST(Mask, SampleWeightMatchesEvalPdf) {
     for (auto nested : {rough_conductor(), make_bsdf("plastic"), make_bsdf("roughplastic"),
                         make_bsdf("roughdielectric", {{"alpha", 0.3}})}) {
         auto bsdf = make_nested("mask", {nested}, {{"opacity", 0.6}});
-        EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 4), 300) << nested->to_string();
+        EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 4), 300)
+            << nested->to_string();
     }
 }
 
@@ -169,10 +172,12 @@ TEST(Mask, WhiteFurnace) {
     auto bsdf = make_nested("mask", {nested}, {{"opacity", 0.4}});
     Color3f albedo = furnace(*bsdf, BSDFContext(), direction_from_angles(35.f, 0.f), 40000);
     EXPECT_NEAR(albedo.r, 0.6f + 0.4f * 0.8f, 0.01f);
-    auto glass = make_nested("mask", {make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"opacity", 0.5}});
+    auto glass =
+        make_nested("mask", {make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"opacity", 0.5}});
     for (float theta : {10.f, 60.f, 120.f})
         EXPECT_LE(furnace(*glass, BSDFContext(), direction_from_angles(theta, 0.f), 20000).max(),
-                  1.f + 5e-3f) << theta;
+                  1.f + 5e-3f)
+            << theta;
 }
 
 TEST(Mask, LoadsFromXml) {
@@ -185,8 +190,8 @@ TEST(Mask, LoadsFromXml) {
 }
 
 namespace {
-void chi2_mask(const std::shared_ptr<BSDF> &nested, double opacity, const Vector3f &wi, uint32_t seed,
-               const std::string &name, const BSDFContext &ctx = {}) {
+void chi2_mask(const std::shared_ptr<BSDF> &nested, double opacity, const Vector3f &wi,
+               uint32_t seed, const std::string &name, const BSDFContext &ctx = {}) {
     BSDFAdapter adapter(make_nested("mask", {nested}, {{"opacity", opacity}}), wi, ctx);
     Chi2Options opts;
     opts.samples = 200000;
@@ -200,8 +205,8 @@ TEST(BSDFSampling, MaskRoughConductor) {
     chi2_mask(rough_conductor(), 0.4, direction_from_angles(40.f, 0.f), 0, "roughconductor");
 }
 TEST(BSDFSampling, MaskRoughDielectricFromInside) {
-    chi2_mask(make_bsdf("roughdielectric", {{"alpha", 0.4}}), 0.7, normalize(Vector3f(0.2f, -0.3f, -0.6f)),
-              1, "roughdielectric");
+    chi2_mask(make_bsdf("roughdielectric", {{"alpha", 0.4}}), 0.7,
+              normalize(Vector3f(0.2f, -0.3f, -0.6f)), 1, "roughdielectric");
 }
 TEST(BSDFSampling, MaskNestedComponentOnly) {
     chi2_mask(make_bsdf("roughplastic", {{"alpha", 0.2}}), 0.5, direction_from_angles(60.f, 0.f), 2,

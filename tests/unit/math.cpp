@@ -22,7 +22,8 @@ void expect_near(const Vector3f &a, const Vector3f &b, float eps = 1e-5f) {
 
 void expect_identity(const Matrix4f &m, float eps = 1e-5f) {
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) EXPECT_NEAR(m.m[i][j], i == j ? 1.f : 0.f, eps) << i << "," << j;
+        for (int j = 0; j < 4; ++j)
+            EXPECT_NEAR(m.m[i][j], i == j ? 1.f : 0.f, eps) << i << "," << j;
 }
 
 Vector3f column(const Transform &t, int j) {
@@ -42,7 +43,8 @@ TEST(Transform, ComposeAppliesRightOperandFirst) {
 }
 
 TEST(Transform, InverseIsInverse) {
-    Matrix4f m = Matrix4f::from_rows({2, 0.5f, 0, 1, 0.1f, 3, -1, 2, 0, 0.2f, 1.5f, -3, 0.3f, 0, 0.1f, 1});
+    Matrix4f m =
+        Matrix4f::from_rows({2, 0.5f, 0, 1, 0.1f, 3, -1, 2, 0, 0.2f, 1.5f, -3, 0.3f, 0, 0.1f, 1});
     expect_identity(m * m.inverse());
     expect_identity(m.inverse() * m);
     Transform t = Transform::rotate({1, 2, 3}, 33.f) * Transform::translate({4, -5, 6}) *
@@ -124,8 +126,10 @@ TEST(Transform, PerspectiveMapsFrustumToUnitRange) {
     Transform p = Transform::perspective(fov, near, far);
     float t = std::tan(deg_to_rad(fov / 2));
     // The frustum edge at x/z = tan(fov/2) maps to x = 1.
-    expect_near(p.apply_point({t * 7, 0, 7}), {1, 0, (far * (7 - near)) / ((far - near) * 7)}, 1e-4f);
-    expect_near(p.apply_point({0, -t * 3, 3}), {0, -1, (far * (3 - near)) / ((far - near) * 3)}, 1e-4f);
+    expect_near(p.apply_point({t * 7, 0, 7}), {1, 0, (far * (7 - near)) / ((far - near) * 7)},
+                1e-4f);
+    expect_near(p.apply_point({0, -t * 3, 3}), {0, -1, (far * (3 - near)) / ((far - near) * 3)},
+                1e-4f);
     EXPECT_NEAR(p.apply_point({0, 0, near}).z, 0.f, 1e-5f);
     EXPECT_NEAR(p.apply_point({0, 0, far}).z, 1.f, 1e-5f);
     expect_identity(p.matrix * p.inverse_matrix, 1e-4f);
@@ -196,7 +200,8 @@ struct HistogramTest {
         for (size_t c = 0; c < expected.size(); ++c) {
             double e = expected[c] * n_samples;
             if (e == 0.0) {
-                ASSERT_EQ(observed[c], 0.0) << "samples in a cell of zero density (cell " << c << ")";
+                ASSERT_EQ(observed[c], 0.0)
+                    << "samples in a cell of zero density (cell " << c << ")";
                 continue;
             }
             if (e < 5.0) {
@@ -298,7 +303,9 @@ TEST(Warp, UniformCone) {
         [&](double phi, double c) {
             return double(warp::square_to_uniform_cone_pdf(from_spherical(phi, c), cos_cutoff));
         },
-        [&](const Point2f &u) { return to_spherical(warp::square_to_uniform_cone(u, cos_cutoff)); });
+        [&](const Point2f &u) {
+            return to_spherical(warp::square_to_uniform_cone(u, cos_cutoff));
+        });
     EXPECT_EQ(warp::square_to_uniform_cone_pdf({1, 0, 0}, cos_cutoff), 0.f);
 }
 

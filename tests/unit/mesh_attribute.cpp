@@ -25,7 +25,8 @@ TEST(MeshAttribute, VertexColorsOfAPly) {
                           "0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2\n";
     std::string xml = R"(<scene version="3.0.0">
         <shape type="ply">
-            <string name="filename" value=")" + ply.string() + R"("/>
+            <string name="filename" value=")" +
+                      ply.string() + R"("/>
             <bsdf type="diffuse">
                 <texture type="mesh_attribute" name="reflectance" id="colors">
                     <string name="name" value="vertex_color"/>

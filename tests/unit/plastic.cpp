@@ -49,8 +49,9 @@ TEST(Plastic, CreationAndFlags) {
     EXPECT_NE(bsdf->to_string().find("Plastic"), std::string::npos);
     EXPECT_EQ(bsdf->eval_diffuse_reflectance(make_si(Vector3f(0.f, 0.f, 1.f))), Color3f(0.5f));
     expect_documented("plastic");
-    expect_documented("plastic", {{"specular_reflectance", 0.5}, {"nonlinear", true},
-                                  {"int_ior", 1.6}, {"ext_ior", 1.1}});
+    expect_documented(
+        "plastic",
+        {{"specular_reflectance", 0.5}, {"nonlinear", true}, {"int_ior", 1.6}, {"ext_ior", 1.1}});
 }
 
 TEST(Plastic, RejectsBadParameters) {
@@ -100,8 +101,8 @@ TEST(Plastic, SpecularWeightAtNormalIncidenceIsF0) {
 TEST(Plastic, DiffuseLobeClosedForm) {
     PCG32 rng(4);
     for (bool nonlinear : {false, true}) {
-        auto bsdf = make_bsdf("plastic", {{"diffuse_reflectance", 0.7}, {"int_ior", 1.7},
-                                          {"nonlinear", nonlinear}});
+        auto bsdf = make_bsdf(
+            "plastic", {{"diffuse_reflectance", 0.7}, {"int_ior", 1.7}, {"nonlinear", nonlinear}});
         float eta = 1.7f / 1.000277f;
         for (int i = 0; i < 100; ++i) {
             Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -134,7 +135,8 @@ TEST(Plastic, PdfMatchesLobeSelection) {
     // pdf() of the diffuse lobe includes 1 − p_spec, and is the full cosine density when the
     // diffuse lobe is alone.
     auto bsdf = make_bsdf("plastic", {{"diffuse_reflectance", 0.2}});
-    Vector3f wi = normalize(Vector3f(0.4f, 0.1f, 0.6f)), wo = normalize(Vector3f(-0.3f, 0.2f, 0.7f));
+    Vector3f wi = normalize(Vector3f(0.4f, 0.1f, 0.6f)),
+             wo = normalize(Vector3f(-0.3f, 0.2f, 0.7f));
     SurfaceInteraction si = make_si(wi);
     float F = fresnel_dielectric(wi.z, DefaultEta).F, w = 1.f / 1.2f;
     float p_spec = F * w / (F * w + (1.f - F) * (1.f - w));
@@ -161,16 +163,19 @@ TEST(Plastic, DiffuseLobeIsReciprocal) {
 
 TEST(Plastic, BackSideIsBlack) {
     auto bsdf = make_bsdf("plastic");
-    Vector3f below = normalize(Vector3f(0.2f, 0.1f, -0.6f)), above = normalize(Vector3f(-0.2f, 0.1f, 0.6f));
+    Vector3f below = normalize(Vector3f(0.2f, 0.1f, -0.6f)),
+             above = normalize(Vector3f(-0.2f, 0.1f, 0.6f));
     for (float s1 : {0.01f, 0.99f})
-        EXPECT_TRUE(bsdf->sample(BSDFContext(), make_si(below), s1, Point2f(0.3f, 0.4f)).second.is_black());
+        EXPECT_TRUE(
+            bsdf->sample(BSDFContext(), make_si(below), s1, Point2f(0.3f, 0.4f)).second.is_black());
     EXPECT_TRUE(bsdf->eval(BSDFContext(), make_si(below), above).is_black());
     EXPECT_TRUE(bsdf->eval(BSDFContext(), make_si(above), below).is_black());
     EXPECT_EQ(bsdf->pdf(BSDFContext(), make_si(above), below), 0.f);
     EXPECT_EQ(bsdf->pdf(BSDFContext(), make_si(below), above), 0.f);
     BSDFContext glossy_only;
     glossy_only.type_mask = uint32_t(BSDFFlags::Glossy);
-    EXPECT_TRUE(bsdf->sample(glossy_only, make_si(above), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
+    EXPECT_TRUE(
+        bsdf->sample(glossy_only, make_si(above), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
 }
 
 TEST(Plastic, WhiteFurnace) {

@@ -40,17 +40,18 @@ TEST(PluginDocs, EveryRequestedParameterIsInTheTable) {
         ASSERT_NE(desc.description, nullptr);
         EXPECT_FALSE(std::string(desc.description).empty());
         std::set<std::string> documented = documented_names(desc.doc);
-        EXPECT_FALSE(documented.empty() && std::string(desc.doc).find("no parameters") == std::string::npos)
+        EXPECT_FALSE(documented.empty() &&
+                     std::string(desc.doc).find("no parameters") == std::string::npos)
             << "no parameter table in the doc of " << name;
         // Construct with no parameters: plugins with required parameters throw, but every name
         // asked for up to that point is recorded, and the defaults path covers the rest.
         Properties props(name);
         try {
             registry.create(desc.kind, props, /*lenient=*/true);
-        } catch (const std::exception &) {
-        }
+        } catch (const std::exception &) {}
         for (const std::string &requested : props.requested_names())
-            EXPECT_TRUE(documented.count(requested)) << name << " reads \"" << requested
-                                                     << "\" but its parameter table does not list it";
+            EXPECT_TRUE(documented.count(requested))
+                << name << " reads \"" << requested
+                << "\" but its parameter table does not list it";
     }
 }

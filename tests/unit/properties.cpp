@@ -114,7 +114,8 @@ TEST(Properties, Conversions) {
     EXPECT_NEAR(e.b, 2 * 0.908916f, 1e-4f);
     // But a float is not an integer.
     std::string msg = error_of([&] { p.get_int("f"); });
-    EXPECT_TRUE(contains(msg, "\"f\"") && contains(msg, "float") && contains(msg, "integer")) << msg;
+    EXPECT_TRUE(contains(msg, "\"f\"") && contains(msg, "float") && contains(msg, "integer"))
+        << msg;
 }
 
 TEST(Properties, WrongTypeNamesParameterTypesAndLocation) {
@@ -133,12 +134,10 @@ TEST(Properties, WrongTypeNamesParameterTypesAndLocation) {
         EXPECT_EQ(e.location().line, 12);
     }
     // The same for the other getters.
-    for (auto get : std::vector<std::function<void()>>{[&] { p.get_bool("alpha"); },
-                                                        [&] { p.get_int("alpha"); },
-                                                        [&] { p.get_vector("alpha"); },
-                                                        [&] { p.get_color("alpha"); },
-                                                        [&] { p.get_transform("alpha"); },
-                                                        [&] { p.texture("alpha"); }})
+    for (auto get : std::vector<std::function<void()>>{
+             [&] { p.get_bool("alpha"); }, [&] { p.get_int("alpha"); },
+             [&] { p.get_vector("alpha"); }, [&] { p.get_color("alpha"); },
+             [&] { p.get_transform("alpha"); }, [&] { p.texture("alpha"); }})
         EXPECT_TRUE(contains(error_of(get), "has type string")) << error_of(get);
 }
 

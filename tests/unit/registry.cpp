@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include <functional>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <thread>
 
 using namespace facet;
@@ -27,7 +27,10 @@ public:
 };
 
 const PluginDescriptor StaticDiffuseDesc{
-    FACET_ABI_VERSION, ObjectType::BSDF, "staticdiffuse", "A statically registered test plugin",
+    FACET_ABI_VERSION,
+    ObjectType::BSDF,
+    "staticdiffuse",
+    "A statically registered test plugin",
     "| reflectance | float | 0.5 | |",
     [](const Properties &props) -> Object * { return new StaticDiffuse(props); }};
 
@@ -94,7 +97,8 @@ TEST_F(Registry, RefusesWrongKind) {
     // Once loaded, the same check applies, and through create() with the object's location.
     EXPECT_EQ(reg.descriptor("wrongkind").kind, ObjectType::Emitter);
     msg = error_of([&] { reg.create(ObjectType::BSDF, props_for("wrongkind")); });
-    EXPECT_TRUE(contains(msg, "scene.xml:10:3") && contains(msg, "emitter") && contains(msg, "bsdf"))
+    EXPECT_TRUE(contains(msg, "scene.xml:10:3") && contains(msg, "emitter") &&
+                contains(msg, "bsdf"))
         << msg;
     msg = error_of([&] { reg.load_library(lib("wrongkind"), ObjectType::BSDF); });
     EXPECT_TRUE(contains(msg, lib("wrongkind")) && contains(msg, "emitter")) << msg;
@@ -165,7 +169,8 @@ TEST_F(Registry, UnqueriedPropertiesAreAnErrorWithTheirLocation) {
         std::string msg = e.what();
         EXPECT_EQ(e.location().to_string(), "scene.xml:10:3");
         EXPECT_TRUE(contains(msg, "Found 2 unreferenced properties in bsdf plugin of type "
-                                  "\"testgood\":")) << msg;
+                                  "\"testgood\":"))
+            << msg;
         EXPECT_TRUE(contains(msg, "- float \"bogus\" (scene.xml:12:5): 0.1")) << msg;
         EXPECT_TRUE(contains(msg, "- rgb \"color\" (scene.xml:13:5): [0.5, 0.5, 0.5]")) << msg;
         EXPECT_FALSE(contains(msg, "alpha")) << msg;
@@ -195,7 +200,8 @@ TEST_F(Registry, PluginErrorsAreWrapped) {
     Properties p = props_for("testgood");
     p.set("fail", true, {"scene.xml", 15, 7});
     std::string msg = error_of([&] { reg.create(ObjectType::BSDF, p); });
-    EXPECT_TRUE(contains(msg, "failed to instantiate bsdf plugin of type \"testgood\": asked to fail"))
+    EXPECT_TRUE(
+        contains(msg, "failed to instantiate bsdf plugin of type \"testgood\": asked to fail"))
         << msg;
     // The entry's location when the plugin gave one ...
     EXPECT_TRUE(contains(msg, "scene.xml:15:7")) << msg;
@@ -204,7 +210,8 @@ TEST_F(Registry, PluginErrorsAreWrapped) {
     q.set("alpha", 2.0);
     msg = error_of([&] { reg.create(ObjectType::BSDF, q); });
     EXPECT_TRUE(contains(msg, "scene.xml:10:3: failed to instantiate bsdf plugin of type "
-                              "\"testgood\": alpha must be in [0, 1]")) << msg;
+                              "\"testgood\": alpha must be in [0, 1]"))
+        << msg;
 }
 
 TEST_F(Registry, SceneIsNotAPlugin) {
@@ -229,8 +236,9 @@ TEST_F(Registry, SearchPathOrder) {
     EXPECT_EQ(last.filename(), "plugins");
     EXPECT_EQ(last.parent_path().filename(), "facet");
 #ifdef FACET_BINARY_DIR
-    EXPECT_EQ(std::filesystem::weakly_canonical(last),
-              std::filesystem::weakly_canonical(std::string(FACET_BINARY_DIR) + "/lib/facet/plugins"));
+    EXPECT_EQ(
+        std::filesystem::weakly_canonical(last),
+        std::filesystem::weakly_canonical(std::string(FACET_BINARY_DIR) + "/lib/facet/plugins"));
 #endif
 }
 

@@ -22,11 +22,16 @@ struct Config {
 std::vector<Config> configs() {
     return {
         {"BeckmannDefaults", {}},
-        {"BeckmannSharp", {{"alpha", 0.05}, {"specular_reflectance", 0.7}, {"diffuse_reflectance", 0.1}}},
+        {"BeckmannSharp",
+         {{"alpha", 0.05}, {"specular_reflectance", 0.7}, {"diffuse_reflectance", 0.1}}},
         {"BeckmannRoughAll", {{"alpha", 0.7}, {"sample_visible", false}}},
         {"GGX", {{"distribution", std::string("ggx")}, {"alpha", 0.25}}},
-        {"GGXAllNonlinear", {{"distribution", std::string("ggx")}, {"alpha", 0.4}, {"sample_visible", false},
-                             {"nonlinear", true}, {"diffuse_reflectance", Color3f(0.9f, 0.4f, 0.1f)}}},
+        {"GGXAllNonlinear",
+         {{"distribution", std::string("ggx")},
+          {"alpha", 0.4},
+          {"sample_visible", false},
+          {"nonlinear", true},
+          {"diffuse_reflectance", Color3f(0.9f, 0.4f, 0.1f)}}},
         {"GGXDense", {{"distribution", std::string("ggx")}, {"alpha", 0.15}, {"int_ior", 2.4}}},
     };
 }
@@ -45,14 +50,19 @@ TEST(RoughPlastic, CreationAndFlags) {
     auto equal = make_bsdf("roughplastic", {{"alpha_u", 0.2}, {"alpha_v", 0.2}});
     EXPECT_FALSE(has_flag(equal->flags(), BSDFFlags::Anisotropic));
     expect_documented("roughplastic");
-    expect_documented("roughplastic", {{"distribution", std::string("ggx")}, {"alpha", 0.3},
-                                       {"sample_visible", false}, {"specular_reflectance", 0.5},
-                                       {"nonlinear", true}, {"int_ior", 1.6}, {"ext_ior", 1.1}});
+    expect_documented("roughplastic", {{"distribution", std::string("ggx")},
+                                       {"alpha", 0.3},
+                                       {"sample_visible", false},
+                                       {"specular_reflectance", 0.5},
+                                       {"nonlinear", true},
+                                       {"int_ior", 1.6},
+                                       {"ext_ior", 1.1}});
 }
 
 TEST(RoughPlastic, RejectsBadParameters) {
     expect_error("roughplastic", {{"alpha_u", 0.1}, {"alpha_v", 0.3}}, "isotropic only");
-    expect_error("roughplastic", {{"int_ior", 1.3}, {"ext_ior", 1.3}}, "int_ior and ext_ior must differ");
+    expect_error("roughplastic", {{"int_ior", 1.3}, {"ext_ior", 1.3}},
+                 "int_ior and ext_ior must differ");
     expect_error("roughplastic", {{"distribution", std::string("phong")}},
                  "distribution must be beckmann or ggx");
     expect_error("roughplastic", {{"alpha", -0.2}}, "alpha must be a roughness >= 0");
@@ -69,7 +79,8 @@ TEST(RoughPlastic, RejectsBadParameters) {
         PluginRegistry::instance().create(ObjectType::BSDF, textured);
         ADD_FAILURE() << "a textured alpha was accepted";
     } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find("must be a number here"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("must be a number here"), std::string::npos)
+            << e.what();
     }
 }
 
@@ -78,9 +89,10 @@ TEST(RoughPlastic, GlossyLobeClosedForm) {
     PCG32 rng(5);
     for (const char *distribution : {"beckmann", "ggx"}) {
         auto bsdf = make_bsdf("roughplastic", {{"distribution", std::string(distribution)},
-                                               {"alpha", 0.3}, {"specular_reflectance", 0.8}});
+                                               {"alpha", 0.3},
+                                               {"specular_reflectance", 0.8}});
         MicrofacetDistribution distr(std::string(distribution) == "ggx" ? MicrofacetType::GGX
-                                                                         : MicrofacetType::Beckmann,
+                                                                        : MicrofacetType::Beckmann,
                                      0.3f);
         for (int i = 0; i < 100; ++i) {
             Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
@@ -114,7 +126,8 @@ TEST(RoughPlastic, DiffuseLobeApproachesSmoothPlastic) {
     Color3f at_normal = rough->eval(component_ctx(1), si, Vector3f(0.f, 0.f, 1.f));
     Color3f smooth_normal = smooth->eval(component_ctx(1), si, Vector3f(0.f, 0.f, 1.f));
     float fdr_smooth = fresnel_diffuse_reflectance(1.f / DefaultEta);
-    EXPECT_NEAR(smooth_normal.r, 0.5f / (1.f - fdr_smooth) / sqr(DefaultEta) * sqr(1.f - F0) * InvPi, 1e-6f);
+    EXPECT_NEAR(smooth_normal.r,
+                0.5f / (1.f - fdr_smooth) / sqr(DefaultEta) * sqr(1.f - F0) * InvPi, 1e-6f);
     EXPECT_GT(at_normal.r, 0.f);
 }
 
@@ -123,7 +136,8 @@ TEST(RoughPlastic, TransmittanceMatchesTheRoughDielectric) {
     // those of the energy a roughdielectric with the same coating transmits (Monte Carlo mean of
     // its transmission-only sample weights in importance mode, no radiance scaling).
     for (const char *distribution : {"beckmann", "ggx"}) {
-        Params coating = {{"distribution", std::string(distribution)}, {"alpha", 0.3}, {"int_ior", 1.5}};
+        Params coating = {
+            {"distribution", std::string(distribution)}, {"alpha", 0.3}, {"int_ior", 1.5}};
         auto plastic = make_bsdf("roughplastic", coating);
         auto dielectric = make_bsdf("roughdielectric", coating);
         BSDFContext transmission(TransportMode::Importance);
@@ -135,11 +149,12 @@ TEST(RoughPlastic, TransmittanceMatchesTheRoughDielectric) {
         EXPECT_LT(T_normal, 1.f - 0.03f); // at least the smooth F(0) = 4 % is reflected
         // The glossy lobe is chosen with probability (1 − T)·w / ((1 − T)·w + T·(1 − w)), where
         // w = 1/(1 + 0.5) for the default reflectances.
-        float w = 1.f / 1.5f, p_spec = (1.f - T_normal) * w / ((1.f - T_normal) * w + T_normal * (1.f - w));
+        float w = 1.f / 1.5f,
+              p_spec = (1.f - T_normal) * w / ((1.f - T_normal) * w + T_normal * (1.f - w));
         int n = 10000, glossy = 0;
         for (int i = 0; i < n; ++i) {
-            auto [bs, weight] = plastic->sample(BSDFContext(), make_si(up), (float(i) + 0.5f) / float(n),
-                                                Point2f(0.3f, 0.7f));
+            auto [bs, weight] = plastic->sample(BSDFContext(), make_si(up),
+                                                (float(i) + 0.5f) / float(n), Point2f(0.3f, 0.7f));
             glossy += bs.sampled_component == 0;
         }
         EXPECT_NEAR(float(glossy) / float(n), p_spec, 2e-3f) << distribution;
@@ -171,16 +186,19 @@ TEST(RoughPlastic, Reciprocity) {
             Color3f f_io = bsdf->eval(BSDFContext(), make_si(wi), wo) / wo.z;
             Color3f f_oi = bsdf->eval(BSDFContext(), make_si(wo), wi) / wi.z;
             for (int ch = 0; ch < 3; ++ch)
-                EXPECT_NEAR(f_io[ch], f_oi[ch], 1e-4f * std::max(f_io[ch], f_oi[ch]) + 1e-7f) << c.name;
+                EXPECT_NEAR(f_io[ch], f_oi[ch], 1e-4f * std::max(f_io[ch], f_oi[ch]) + 1e-7f)
+                    << c.name;
         }
     }
 }
 
 TEST(RoughPlastic, BackSideIsBlack) {
     auto bsdf = make_bsdf("roughplastic");
-    Vector3f below = normalize(Vector3f(0.2f, 0.1f, -0.6f)), above = normalize(Vector3f(-0.2f, 0.1f, 0.6f));
+    Vector3f below = normalize(Vector3f(0.2f, 0.1f, -0.6f)),
+             above = normalize(Vector3f(-0.2f, 0.1f, 0.6f));
     for (float s1 : {0.01f, 0.99f})
-        EXPECT_TRUE(bsdf->sample(BSDFContext(), make_si(below), s1, Point2f(0.3f, 0.4f)).second.is_black());
+        EXPECT_TRUE(
+            bsdf->sample(BSDFContext(), make_si(below), s1, Point2f(0.3f, 0.4f)).second.is_black());
     EXPECT_TRUE(bsdf->eval(BSDFContext(), make_si(below), above).is_black());
     EXPECT_TRUE(bsdf->eval(BSDFContext(), make_si(above), below).is_black());
     EXPECT_EQ(bsdf->pdf(BSDFContext(), make_si(above), below), 0.f);
@@ -228,10 +246,10 @@ TEST(BSDFSampling, RoughPlasticBeckmann) {
                 "beckmann_all");
 }
 TEST(BSDFSampling, RoughPlasticGGX) {
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.25}}, direction_from_angles(40.f, 0.f),
-                2, "ggx_visible");
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.6}}, direction_from_angles(85.f, 200.f),
-                3, "ggx_grazing");
+    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.25}},
+                direction_from_angles(40.f, 0.f), 2, "ggx_visible");
+    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.6}},
+                direction_from_angles(85.f, 200.f), 3, "ggx_grazing");
 }
 TEST(BSDFSampling, RoughPlasticComponents) {
     Params p = {{"alpha", 0.2}};

@@ -20,7 +20,9 @@ std::shared_ptr<Sampler> make_sampler(const std::string &type, int spp) {
 }
 
 /// Smooth integrand on [0,1]²: x·e^x · (1 + cos(2πy)/2) with integral 1.
-double f2(const Point2f &p) { return p.x * std::exp(p.x) * (1.0 + 0.5 * std::cos(2.0 * M_PI * p.y)); }
+double f2(const Point2f &p) {
+    return p.x * std::exp(p.x) * (1.0 + 0.5 * std::cos(2.0 * M_PI * p.y));
+}
 
 /// RMS error of the N-sample estimate over `pixels` independent pixels. `dim` 2D draws are skipped
 /// first, so dimensions other than the first are exercised too.
@@ -52,10 +54,17 @@ double convergence_slope(const std::string &type, int dim) {
         ys.push_back(std::log(rms_error_2d(type, n, 256, dim)));
     }
     double mx = 0, my = 0;
-    for (size_t i = 0; i < xs.size(); ++i) { mx += xs[i]; my += ys[i]; }
-    mx /= xs.size(); my /= ys.size();
+    for (size_t i = 0; i < xs.size(); ++i) {
+        mx += xs[i];
+        my += ys[i];
+    }
+    mx /= xs.size();
+    my /= ys.size();
     double num = 0, den = 0;
-    for (size_t i = 0; i < xs.size(); ++i) { num += (xs[i] - mx) * (ys[i] - my); den += sqr(xs[i] - mx); }
+    for (size_t i = 0; i < xs.size(); ++i) {
+        num += (xs[i] - mx) * (ys[i] - my);
+        den += sqr(xs[i] - mx);
+    }
     return num / den;
 }
 
@@ -102,7 +111,9 @@ TEST(Samplers, DeterministicPerSeedAndInUnitInterval) {
                 }
                 differs_from_other_pixel |= pa != pc;
             }
-            a->advance(); b->advance(); c->advance();
+            a->advance();
+            b->advance();
+            c->advance();
         }
         EXPECT_TRUE(differs_from_other_pixel) << type;
     }

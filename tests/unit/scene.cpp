@@ -24,8 +24,7 @@ bool have_plugins() {
         auto names = PluginRegistry::instance().available();
         for (const char *n : {"path", "perspective", "diffuse", "area", "point", "constant",
                               "rectangle", "sphere", "disk", "cube"})
-            if (std::find(names.begin(), names.end(), n) == names.end())
-                return false;
+            if (std::find(names.begin(), names.end(), n) == names.end()) return false;
         return true;
     }();
     return ok;
@@ -53,8 +52,7 @@ Properties rect_and_sphere(std::shared_ptr<Object> sphere_emitter = nullptr) {
     Properties sphere;
     sphere.set_vector("center", Vector3f(0, 0, 2));
     sphere.set_float("radius", 0.5);
-    if (sphere_emitter)
-        sphere.set_object("light", sphere_emitter);
+    if (sphere_emitter) sphere.set_object("light", sphere_emitter);
     Properties props;
     props.set_object("floor", create(ObjectType::Shape, "rectangle", rect));
     props.set_object("ball", create(ObjectType::Shape, "sphere", sphere));
@@ -201,33 +199,29 @@ void check_spawned_rays(const Transform &to_world, float radius_world, uint64_t 
         Point3f target = on_sphere ? center : plane_center;
         // Camera rays from far away, aimed at the shape with a random offset.
         Vector3f from = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
-        if (!on_sphere)
-            from.z = std::abs(from.z) + 0.05f;
+        if (!on_sphere) from.z = std::abs(from.z) + 0.05f;
         Point3f o = target + normalize(from) * (radius_world * 20.f);
         Point3f aim = target + Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f,
                                         on_sphere ? rng.next_float() - 0.5f : 0.f) *
                                    (1.6f * radius_world);
         SurfaceInteraction si;
-        if (!scene.ray_intersect(Ray(o, normalize(aim - o)), si))
-            continue;
-        if (si.shape != (on_sphere ? ball : rect_shape))
-            continue;
+        if (!scene.ray_intersect(Ray(o, normalize(aim - o)), si)) continue;
+        if (si.shape != (on_sphere ? ball : rect_shape)) continue;
         ++hits;
         // A random direction back into the hemisphere the ray came from (including grazing).
         Vector3f n = si.n * sign(dot(si.n, o - si.p));
-        Vector3f local = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f local =
+            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
         Frame frame(n);
         Vector3f d = frame.to_world(local);
         SurfaceInteraction si2;
-        if (scene.ray_intersect(si.spawn_ray(d), si2) && si2.shape == si.shape)
-            ++self_hits;
+        if (scene.ray_intersect(si.spawn_ray(d), si2) && si2.shape == si.shape) ++self_hits;
         // Into the sphere: the ray must cross it and leave on the far side.
         if (on_sphere) {
             Vector3f din = frame.to_world(Vector3f(local.x, local.y, -local.z));
             if (scene.ray_intersect(si.spawn_ray(din), si2) && si2.shape == ball) {
                 float chord = 2.f * radius_world * std::abs(local.z);
-                if (si2.t < 0.5f * chord)
-                    ++short_chords;
+                if (si2.t < 0.5f * chord) ++short_chords;
             } else {
                 ++short_chords;
             }
@@ -284,15 +278,14 @@ TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
         // A point on the floor right of the wall, found by tracing down.
         Point3f start(0.05f + 1.9f * rng.next_float(), 3.8f * rng.next_float() - 1.9f, 1.f);
         SurfaceInteraction ref;
-        ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(start.x, start.y, 3.f), Vector3f(0, 0, -1)), ref));
-        if (ref.shape != scene.shapes()[0].get())
-            continue; // under the ball
+        ASSERT_TRUE(
+            scene.ray_intersect(Ray(Point3f(start.x, start.y, 3.f), Vector3f(0, 0, -1)), ref));
+        if (ref.shape != scene.shapes()[0].get()) continue; // under the ball
         // Points on the ball: those facing the reference point are visible, the others are not.
         PositionSample ps = ball.sample_position(Point2f(rng.next_float(), rng.next_float()));
         Vector3f to_ref = normalize(ref.p - ps.p);
         float facing = dot(ps.n, to_ref);
-        if (std::abs(facing) < 0.05f)
-            continue; // the silhouette, where both answers are right
+        if (std::abs(facing) < 0.05f) continue; // the silhouette, where both answers are right
         bool blocked = scene.ray_test(ref.spawn_ray_to(ps.p));
         EXPECT_EQ(blocked, facing < 0.f) << "floor point " << ref.p << ", ball point " << ps.p;
     }
@@ -300,8 +293,8 @@ TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
     for (float x : {-1e-3f, -1e-4f}) {
         SurfaceInteraction ref;
         ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(x, 0.3f, 3.f), Vector3f(0, 0, -1)), ref));
-        for (Point3f target : {Point3f(0.5f, 0.3f, 0.5f), Point3f(1.f, -1.f, 1e-3f),
-                               Point3f(0.01f, 0.3f, 1.f)})
+        for (Point3f target :
+             {Point3f(0.5f, 0.3f, 0.5f), Point3f(1.f, -1.f, 1e-3f), Point3f(0.01f, 0.3f, 1.f)})
             EXPECT_TRUE(scene.ray_test(ref.spawn_ray_to(target))) << x << " -> " << target;
         // The same points are reachable from the right side.
         SurfaceInteraction right;

@@ -4,11 +4,11 @@
 #include <facet/plugin.h>
 
 #include <gtest/gtest.h>
-#include <zlib.h>
 
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <zlib.h>
 
 using namespace facet;
 namespace fs = std::filesystem;
@@ -28,7 +28,8 @@ template <typename T> void put(std::vector<uint8_t> &out, T v) {
 }
 
 /// Writes meshes in the serialized layout (Mitsuba's format, versions 3 and 4).
-std::vector<uint8_t> write_serialized(const std::vector<TestMesh> &meshes, uint16_t version, bool dbl) {
+std::vector<uint8_t> write_serialized(const std::vector<TestMesh> &meshes, uint16_t version,
+                                      bool dbl) {
     std::vector<uint8_t> file;
     std::vector<uint64_t> offsets;
     for (const TestMesh &m : meshes) {
@@ -36,7 +37,8 @@ std::vector<uint8_t> write_serialized(const std::vector<TestMesh> &meshes, uint1
         put<uint16_t>(file, 0x041C);
         put<uint16_t>(file, version);
         std::vector<uint8_t> raw;
-        uint32_t flags = (dbl ? 0x2000u : 0x1000u) | (m.normals.empty() ? 0u : 1u) | (m.uvs.empty() ? 0u : 2u);
+        uint32_t flags =
+            (dbl ? 0x2000u : 0x1000u) | (m.normals.empty() ? 0u : 1u) | (m.uvs.empty() ? 0u : 2u);
         put<uint32_t>(raw, flags);
         if (version == 4) {
             raw.insert(raw.end(), m.name.begin(), m.name.end());
@@ -46,8 +48,10 @@ std::vector<uint8_t> write_serialized(const std::vector<TestMesh> &meshes, uint1
         put<uint64_t>(raw, m.faces.size() / 3);
         for (const auto *arr : {&m.positions, &m.normals, &m.uvs})
             for (double v : *arr) {
-                if (dbl) put<double>(raw, v);
-                else put<float>(raw, float(v));
+                if (dbl)
+                    put<double>(raw, v);
+                else
+                    put<float>(raw, float(v));
             }
         for (uint32_t f : m.faces) put<uint32_t>(raw, f);
         uLongf size = compressBound(uLong(raw.size()));
@@ -56,8 +60,10 @@ std::vector<uint8_t> write_serialized(const std::vector<TestMesh> &meshes, uint1
         file.insert(file.end(), packed.begin(), packed.begin() + long(size));
     }
     for (uint64_t o : offsets) {
-        if (version == 4) put<uint64_t>(file, o);
-        else put<uint32_t>(file, uint32_t(o));
+        if (version == 4)
+            put<uint64_t>(file, o);
+        else
+            put<uint32_t>(file, uint32_t(o));
     }
     put<uint32_t>(file, uint32_t(meshes.size()));
     return file;
@@ -67,7 +73,8 @@ fs::path write_file(const std::string &name, const std::vector<uint8_t> &bytes) 
     fs::path dir = fs::temp_directory_path() / "facet-serialized-test";
     fs::create_directories(dir);
     fs::path p = dir / name;
-    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char *>(bytes.data()), long(bytes.size()));
+    std::ofstream(p, std::ios::binary)
+        .write(reinterpret_cast<const char *>(bytes.data()), long(bytes.size()));
     return p;
 }
 
@@ -75,12 +82,16 @@ std::shared_ptr<Mesh> load(const fs::path &p, int index) {
     Properties props("serialized");
     props.set_string("filename", p.string());
     props.set_int("shape_index", index);
-    return std::dynamic_pointer_cast<Mesh>(PluginRegistry::instance().create(ObjectType::Shape, props));
+    return std::dynamic_pointer_cast<Mesh>(
+        PluginRegistry::instance().create(ObjectType::Shape, props));
 }
 
 std::vector<TestMesh> two_meshes() {
-    TestMesh quad{"quad", {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1},
-                  {0, 0, 1, 0, 1, 1, 0, 1}, {0, 1, 2, 0, 2, 3}};
+    TestMesh quad{"quad",
+                  {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0},
+                  {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1},
+                  {0, 0, 1, 0, 1, 1, 0, 1},
+                  {0, 1, 2, 0, 2, 3}};
     TestMesh tri{"tri", {0, 0, 0.25, 2, 0, 0.25, 0, 3, 0.25}, {}, {}, {0, 1, 2}};
     return {quad, tri};
 }
@@ -116,7 +127,8 @@ TEST(Serialized, FaceNormalsDropVertexNormals) {
     Properties props("serialized");
     props.set_string("filename", p.string());
     props.set_bool("face_normals", true);
-    auto mesh = std::dynamic_pointer_cast<Mesh>(PluginRegistry::instance().create(ObjectType::Shape, props));
+    auto mesh = std::dynamic_pointer_cast<Mesh>(
+        PluginRegistry::instance().create(ObjectType::Shape, props));
     ASSERT_TRUE(mesh);
     EXPECT_FALSE(mesh->has_vertex_normals());
 }
@@ -148,7 +160,8 @@ TEST(Serialized, TruncatedFileIsAnError) {
     std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + 20);
     uint64_t zero = 0;
     uint32_t one = 1;
-    cut.insert(cut.end(), reinterpret_cast<uint8_t *>(&zero), reinterpret_cast<uint8_t *>(&zero) + 8);
+    cut.insert(cut.end(), reinterpret_cast<uint8_t *>(&zero),
+               reinterpret_cast<uint8_t *>(&zero) + 8);
     cut.insert(cut.end(), reinterpret_cast<uint8_t *>(&one), reinterpret_cast<uint8_t *>(&one) + 4);
     fs::path p = write_file("cut.serialized", cut);
     try {

@@ -14,10 +14,10 @@
 
 #include <cstdio>
 #include <cstring>
-#include <functional>
-#include <unistd.h>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <unistd.h>
 
 using namespace facet;
 namespace fs = std::filesystem;
@@ -105,8 +105,7 @@ public:
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(m_scene, &ctx, &rh);
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-            return false;
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
         m_shape->compute_surface_interaction(ray, rh.ray.tfar, rh.hit.primID,
                                              Point2f(rh.hit.u, rh.hit.v), si);
         return true;
@@ -159,15 +158,16 @@ TEST(ObjLoader, QuadIsSplitIntoTwoTriangles) {
     EXPECT_FALSE(mesh->has_uvs());
     // No normals in the file: smooth ones are computed, all +z for a flat square.
     ASSERT_TRUE(mesh->has_vertex_normals());
-    for (size_t i = 0; i < 4; ++i)
-        EXPECT_FLOAT_EQ(mesh->normals()[3 * i + 2], 1.f);
+    for (size_t i = 0; i < 4; ++i) EXPECT_FLOAT_EQ(mesh->normals()[3 * i + 2], 1.f);
 }
 
 TEST(ObjLoader, PentagonFanAndNegativeIndices) {
     TempDir dir;
     const char *verts = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\n";
-    auto pos = make_mesh("obj", file_props(dir.write("pos.obj", std::string(verts) + "f 1 2 3 4 5\n")));
-    auto neg = make_mesh("obj", file_props(dir.write("neg.obj", std::string(verts) + "f -5 -4 -3 -2 -1\n")));
+    auto pos =
+        make_mesh("obj", file_props(dir.write("pos.obj", std::string(verts) + "f 1 2 3 4 5\n")));
+    auto neg = make_mesh(
+        "obj", file_props(dir.write("neg.obj", std::string(verts) + "f -5 -4 -3 -2 -1\n")));
     EXPECT_EQ(pos->face_count(), 3u);
     EXPECT_EQ(neg->faces(), pos->faces());
     EXPECT_EQ(neg->positions(), pos->positions());
@@ -288,8 +288,7 @@ std::string ply_header(const char *format, size_t nv, size_t nf) {
 template <typename T> void put(std::string &s, T v, bool big) {
     char b[sizeof(T)];
     std::memcpy(b, &v, sizeof(T));
-    if (big)
-        std::reverse(b, b + sizeof(T));
+    if (big) std::reverse(b, b + sizeof(T));
     s.append(b, sizeof(T));
 }
 
@@ -304,8 +303,7 @@ std::string write_ply(const PlyMesh &m, const char *format) {
                              m.rgb[3 * i + 2]);
         for (const auto &f : m.faces) {
             s += std::to_string(f.size());
-            for (int32_t i : f)
-                s += " " + std::to_string(i);
+            for (int32_t i : f) s += " " + std::to_string(i);
             s += " 7\n";
         }
         s += "3 1 2 3 0.5\n0 -1\n";
@@ -339,8 +337,8 @@ TEST(PlyLoader, AsciiAndBinaryRoundTrip) {
     PlyMesh m;
     for (const char *format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
         SCOPED_TRACE(format);
-        auto mesh = make_mesh("ply", file_props(dir.write(std::string(format) + ".ply",
-                                                          write_ply(m, format))));
+        auto mesh = make_mesh(
+            "ply", file_props(dir.write(std::string(format) + ".ply", write_ply(m, format))));
         ASSERT_EQ(mesh->vertex_count(), 5u);
         ASSERT_EQ(mesh->face_count(), 3u);
         EXPECT_EQ(mesh->faces(), (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 4, 1}));
@@ -350,8 +348,7 @@ TEST(PlyLoader, AsciiAndBinaryRoundTrip) {
             EXPECT_NEAR(mesh->colors()[i], m.rgb[i] / 255.f, 1e-6f);
         }
         // PLY keeps v as it is (flip_tex_coords defaults to false).
-        for (size_t i = 0; i < 10; ++i)
-            EXPECT_FLOAT_EQ(mesh->uvs()[i], m.uv[i]);
+        for (size_t i = 0; i < 10; ++i) EXPECT_FLOAT_EQ(mesh->uvs()[i], m.uv[i]);
         EXPECT_NEAR(mesh->surface_area(), 1.5f, 1e-6f);
     }
 }
@@ -372,7 +369,8 @@ TEST(PlyLoader, TruncatedAndMalformedFilesAreErrors) {
     PlyMesh m;
     std::string bin = write_ply(m, "binary_little_endian");
     // Cut in the middle of the face list.
-    std::string path = dir.write("cut.ply", bin.substr(0, ply_header("binary_little_endian", 5, 2).size() + 5 * 35 + 7));
+    std::string path = dir.write(
+        "cut.ply", bin.substr(0, ply_header("binary_little_endian", 5, 2).size() + 5 * 35 + 7));
     std::string msg = error_of([&] { make_mesh("ply", file_props(path)); });
     EXPECT_NE(msg.find("cut.ply"), std::string::npos) << msg;
     EXPECT_NE(msg.find("ends early"), std::string::npos) << msg;
@@ -607,9 +605,12 @@ TEST(ShapeIntersection, SphereHitDistanceIsExact) {
     for (int i = 0; i < 2000; ++i) {
         // Origins at distances from 2 to 1000 radii, aimed near the sphere.
         float dist = radius * std::pow(500.f, rng.next_float()) * 2.f;
-        Vector3f dir_o = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f dir_o =
+            warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
         Point3f o = center + dir_o * dist;
-        Point3f target = center + warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float())) * (radius * 1.2f);
+        Point3f target =
+            center + warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float())) *
+                         (radius * 1.2f);
         Vector3f d = normalize(target - o);
         // Reference in double.
         Vector3d od = Vector3d(o) - Vector3d(center), dd = Vector3d(d);
@@ -625,8 +626,7 @@ TEST(ShapeIntersection, SphereHitDistanceIsExact) {
             continue;
         }
         double t_ref = (-b - std::sqrt(disc)) / dot(dd, dd);
-        if (disc < 1e-3 * radius * radius)
-            continue; // grazing: skip the rim
+        if (disc < 1e-3 * radius * radius) continue; // grazing: skip the rim
         ASSERT_TRUE(hit);
         ++hits;
         EXPECT_NEAR(si.t, t_ref, 1e-5 * t_ref);
@@ -673,11 +673,9 @@ TEST(ShapeIntersection, DiskHitIsExactWithUvAndNormal) {
         double r = std::hypot(double(o.x) + t_ref * d.x, double(o.y) + t_ref * d.y);
         SurfaceInteraction si;
         bool hit = scene.intersect(Ray(o, d), si);
-        if (std::abs(r - 2.0) < 1e-4)
-            continue;
+        if (std::abs(r - 2.0) < 1e-4) continue;
         ASSERT_EQ(hit, r < 2.0) << r;
-        if (!hit)
-            continue;
+        if (!hit) continue;
         EXPECT_NEAR(si.t, t_ref, 1e-5 * t_ref);
         EXPECT_NEAR(si.p.z, 3.f, 1e-6f);
         expect_near_vec(si.n, Vector3f(0, 0, 1), 1e-6f);
@@ -727,16 +725,17 @@ TEST(ShapeIntersection, MeshShadingNormalsAreInterpolated) {
     ASSERT_TRUE(scene.intersect(Ray(Point3f(0.5f, 0.25f, 1.f), Vector3f(0, 0, -1)), si));
     expect_near_vec(si.n, Vector3f(0, 0, 1), 1e-6f);
     // Barycentrics (0.25, 0.5, 0.25): normal ∝ 0.25·(-1,0,1)/√2 + 0.5·(1,0,1)/√2 + 0.25·(0,0,1).
-    Vector3f expected = normalize(Vector3f(-1, 0, 1) * (0.25f / std::sqrt(2.f)) +
-                                  Vector3f(1, 0, 1) * (0.5f / std::sqrt(2.f)) +
-                                  Vector3f(0, 0, 1) * 0.25f);
+    Vector3f expected =
+        normalize(Vector3f(-1, 0, 1) * (0.25f / std::sqrt(2.f)) +
+                  Vector3f(1, 0, 1) * (0.5f / std::sqrt(2.f)) + Vector3f(0, 0, 1) * 0.25f);
     expect_near_vec(si.sh_frame.n, expected, 1e-5f);
     // Without texture coordinates, uv are the barycentrics of vertices 1 and 2.
     EXPECT_NEAR(si.uv.x, 0.5f, 1e-6f);
     EXPECT_NEAR(si.uv.y, 0.25f, 1e-6f);
     expect_near_vec(si.p, Vector3f(0.5f, 0.25f, 0.f), 1e-6f);
     EXPECT_NEAR(si.sh_frame.n.x * si.sh_frame.s.x + si.sh_frame.n.y * si.sh_frame.s.y +
-                    si.sh_frame.n.z * si.sh_frame.s.z, 0.f, 1e-6f);
+                    si.sh_frame.n.z * si.sh_frame.s.z,
+                0.f, 1e-6f);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -753,8 +752,7 @@ double integrate_direction_pdf(const Shape &shape, const SingleShape &scene, con
     for (int i = 0; i < n; ++i) {
         Vector3f d = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
         SurfaceInteraction si;
-        if (!scene.intersect(Ray(ref.p, d), si))
-            continue;
+        if (!scene.intersect(Ray(ref.p, d), si)) continue;
         DirectionSample ds;
         ds.p = si.p;
         ds.n = si.n;
@@ -798,7 +796,8 @@ TEST(ShapeSampling, SphereConeSamplingIsUniformInTheCone) {
     std::vector<int> hist(bins * bins, 0);
     PCG32 rng(99);
     for (int i = 0; i < n; ++i) {
-        DirectionSample ds = sphere->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        DirectionSample ds =
+            sphere->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
         ASSERT_NEAR(ds.pdf, expected_pdf, 1e-3f * expected_pdf);
         ASSERT_NEAR(sphere->pdf_direction(ref, ds), ds.pdf, 1e-6f * ds.pdf);
         ASSERT_NEAR(norm(ds.p), 0.5f, 1e-6f);
@@ -811,14 +810,14 @@ TEST(ShapeSampling, SphereConeSamplingIsUniformInTheCone) {
         ASSERT_NEAR(si.t, ds.dist, 1e-4f);
         double c = -double(ds.d.y);
         double x = (1.0 - c) / one_minus_cos_max;
-        double phi = std::atan2(double(ds.d.z), double(ds.d.x)) / (2.0 * 3.14159265358979323846) + 0.5;
+        double phi =
+            std::atan2(double(ds.d.z), double(ds.d.x)) / (2.0 * 3.14159265358979323846) + 0.5;
         int bx = std::min(bins - 1, int(x * bins)), by = std::min(bins - 1, int(phi * bins));
         hist[by * bins + bx]++;
     }
     // Pearson χ² with 63 degrees of freedom: the 0.999 quantile is 103.4.
     double expected = double(n) / (bins * bins), chi2 = 0.0;
-    for (int h : hist)
-        chi2 += (h - expected) * (h - expected) / expected;
+    for (int h : hist) chi2 += (h - expected) * (h - expected) / expected;
     EXPECT_LT(chi2, 103.4);
 }
 
@@ -833,7 +832,8 @@ TEST(ShapeSampling, DefaultDirectionPdfMatchesAndIntegrates) {
         ref.p = Point3f(0.3f, -0.2f, -1.5f);
         PCG32 rng(1);
         for (int i = 0; i < 200; ++i) {
-            DirectionSample ds = shape->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+            DirectionSample ds =
+                shape->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
             ASSERT_GT(ds.pdf, 0.f);
             EXPECT_NEAR(shape->pdf_direction(ref, ds), ds.pdf, 1e-4f * ds.pdf);
             EXPECT_NEAR(norm(ds.d), 1.f, 1e-5f);

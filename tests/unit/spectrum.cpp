@@ -1,13 +1,14 @@
-// Spectrum parsing and conversion to RGB (CIE 1931, D65, the conventions of Mitsuba's RGB variants).
+// Spectrum parsing and conversion to RGB (CIE 1931, D65, the conventions of Mitsuba's RGB
+// variants).
 #include <facet/logger.h>
 #include <facet/spectrum.h>
 
 #include <gtest/gtest.h>
 
-#include <functional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 using namespace facet;
 
@@ -43,7 +44,8 @@ struct TempFile {
     std::string path;
     explicit TempFile(const std::string &name, const std::string &content) {
         path = (std::filesystem::temp_directory_path() /
-                (name + "_" + std::to_string(::getpid()) + ".spd")).string();
+                (name + "_" + std::to_string(::getpid()) + ".spd"))
+                   .string();
         std::ofstream(path) << content;
     }
     ~TempFile() { std::remove(path.c_str()); }
@@ -142,7 +144,8 @@ TEST(Spectrum, ParseErrors) {
 }
 
 TEST(Spectrum, ReadSpdFile) {
-    TempFile f("facet_spectrum_test", "# measured\n400 0.5\n\n  450\t0.6  # inline comment\n500 0.7\n");
+    TempFile f("facet_spectrum_test",
+               "# measured\n400 0.5\n\n  450\t0.6  # inline comment\n500 0.7\n");
     SpectrumData s = read_spd_file(f.path);
     ASSERT_FALSE(s.uniform);
     EXPECT_EQ(s.wavelengths, (std::vector<double>{400, 450, 500}));

@@ -13,7 +13,8 @@ using namespace facet;
 
 namespace {
 
-std::shared_ptr<Emitter> make_spot(float cutoff, float beam, const Transform &to_world = Transform()) {
+std::shared_ptr<Emitter> make_spot(float cutoff, float beam,
+                                   const Transform &to_world = Transform()) {
     Properties props("spot");
     props.set_float("cutoff_angle", cutoff);
     props.set_float("beam_width", beam);

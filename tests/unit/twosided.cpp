@@ -26,7 +26,8 @@ TEST(TwoSided, CreationAndFlags) {
     ASSERT_EQ(one->component_count(), 2u);
     EXPECT_EQ(one->flags(0), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(one->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::BackSide);
-    EXPECT_EQ(one->flags(), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::BackSide);
+    EXPECT_EQ(one->flags(),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::BackSide);
     EXPECT_NE(one->to_string().find("TwoSided"), std::string::npos);
     EXPECT_NE(one->to_string().find("Diffuse"), std::string::npos);
 
@@ -41,7 +42,8 @@ TEST(TwoSided, CreationAndFlags) {
     auto glass = make_nested("twosided", {make_bsdf("dielectric")}, {{"allow_transmission", true}});
     ASSERT_EQ(glass->component_count(), 4u);
     EXPECT_EQ(glass->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(glass->flags(3), BSDFFlags::DeltaTransmission | BSDFFlags::BackSide | BSDFFlags::NonSymmetric);
+    EXPECT_EQ(glass->flags(3),
+              BSDFFlags::DeltaTransmission | BSDFFlags::BackSide | BSDFFlags::NonSymmetric);
 
     Properties props("twosided");
     props.set_object("_arg_0", diffuse);
@@ -56,9 +58,11 @@ TEST(TwoSided, RejectsBadNesting) {
     expect_nested_error("twosided", {}, {}, "twosided needs a nested BSDF");
     auto d = make_bsdf("diffuse");
     expect_nested_error("twosided", {d, d, d}, {}, "at most two nested BSDFs");
-    expect_nested_error("twosided", {make_bsdf("dielectric")}, {}, "unless allow_transmission is true");
+    expect_nested_error("twosided", {make_bsdf("dielectric")}, {},
+                        "unless allow_transmission is true");
     expect_nested_error("twosided", {d, make_bsdf("roughdielectric")}, {}, "transmits light");
-    expect_nested_error("twosided", {d}, {{"allow_transmission", std::string("yes")}}, "allow_transmission");
+    expect_nested_error("twosided", {d}, {{"allow_transmission", std::string("yes")}},
+                        "allow_transmission");
     expect_nested_error("twosided", {d}, {{"reflectance", 0.3}}, "reflectance");
     // A nested object that is not a BSDF is not silently ignored.
     Properties props("twosided");
@@ -79,8 +83,10 @@ TEST(TwoSided, BackSideIsTheMirroredFrontSide) {
             EXPECT_EQ(bsdf->eval(BSDFContext(), front, wo), nested->eval(BSDFContext(), front, wo));
             EXPECT_EQ(bsdf->pdf(BSDFContext(), front, wo), nested->pdf(BSDFContext(), front, wo));
             // Back side: the front mirrored through the surface.
-            EXPECT_EQ(bsdf->eval(BSDFContext(), back, mirror(wo)), nested->eval(BSDFContext(), front, wo));
-            EXPECT_EQ(bsdf->pdf(BSDFContext(), back, mirror(wo)), nested->pdf(BSDFContext(), front, wo));
+            EXPECT_EQ(bsdf->eval(BSDFContext(), back, mirror(wo)),
+                      nested->eval(BSDFContext(), front, wo));
+            EXPECT_EQ(bsdf->pdf(BSDFContext(), back, mirror(wo)),
+                      nested->pdf(BSDFContext(), front, wo));
             // No light crosses the surface.
             EXPECT_TRUE(bsdf->eval(BSDFContext(), back, wo).is_black());
             EXPECT_TRUE(bsdf->eval(BSDFContext(), front, mirror(wo)).is_black());
@@ -109,7 +115,8 @@ TEST(TwoSided, SecondBSDFOnTheBack) {
     PCG32 rng(4);
     for (int i = 0; i < 200; ++i) {
         Vector3f wi = random_direction(rng, true), wo = random_direction(rng, true);
-        EXPECT_EQ(bsdf->eval(BSDFContext(), make_si(wi), wo), front->eval(BSDFContext(), make_si(wi), wo));
+        EXPECT_EQ(bsdf->eval(BSDFContext(), make_si(wi), wo),
+                  front->eval(BSDFContext(), make_si(wi), wo));
         EXPECT_EQ(bsdf->eval(BSDFContext(), make_si(mirror(wi)), mirror(wo)),
                   back->eval(BSDFContext(), make_si(wi), wo));
         EXPECT_EQ(bsdf->pdf(BSDFContext(), make_si(mirror(wi)), mirror(wo)),
@@ -128,7 +135,9 @@ TEST(TwoSided, ComponentIndicesAreShifted) {
     for (uint32_t c : {0u, 1u}) {
         EXPECT_TRUE(bsdf->eval(component_ctx(c), back, mirror(wo)).is_black()) << c;
         EXPECT_EQ(bsdf->pdf(component_ctx(c), back, mirror(wo)), 0.f) << c;
-        EXPECT_TRUE(bsdf->sample(component_ctx(c), back, 0.5f, Point2f(0.3f, 0.6f)).second.is_black()) << c;
+        EXPECT_TRUE(
+            bsdf->sample(component_ctx(c), back, 0.5f, Point2f(0.3f, 0.6f)).second.is_black())
+            << c;
     }
     EXPECT_TRUE(bsdf->eval(component_ctx(2), front, wo).is_black());
     EXPECT_TRUE(bsdf->sample(component_ctx(2), front, 0.5f, Point2f(0.3f, 0.6f)).second.is_black());
@@ -148,12 +157,15 @@ TEST(TwoSided, SampleWeightMatchesEvalPdf) {
     std::vector<std::shared_ptr<BSDF>> bsdfs = {
         make_nested("twosided", {make_bsdf("diffuse")}),
         make_nested("twosided", {rough_conductor(0.1)}),
-        make_nested("twosided", {make_bsdf("roughplastic", {{"distribution", std::string("ggx")}, {"alpha", 0.3}}),
-                       make_bsdf("plastic")}),
-        make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.3}})}, {{"allow_transmission", true}}),
+        make_nested("twosided", {make_bsdf("roughplastic",
+                                           {{"distribution", std::string("ggx")}, {"alpha", 0.3}}),
+                                 make_bsdf("plastic")}),
+        make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.3}})},
+                    {{"allow_transmission", true}}),
     };
     for (const auto &bsdf : bsdfs) {
-        EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 5), 1000) << bsdf->to_string();
+        EXPECT_GT(check_sample_eval_pdf(*bsdf, BSDFContext(), true, 2000, 5), 1000)
+            << bsdf->to_string();
         BSDFContext importance(TransportMode::Importance);
         EXPECT_GT(check_sample_eval_pdf(*bsdf, importance, true, 500, 6), 200) << bsdf->to_string();
     }
@@ -183,7 +195,8 @@ TEST(TwoSided, WhiteFurnaceOnBothSides) {
     }
     auto mirror_ish = make_nested("twosided", {make_bsdf("roughconductor", {{"alpha", 0.2}})});
     for (float theta : {20.f, 160.f}) {
-        Color3f albedo = furnace(*mirror_ish, BSDFContext(), direction_from_angles(theta, 30.f), 20000);
+        Color3f albedo =
+            furnace(*mirror_ish, BSDFContext(), direction_from_angles(theta, 30.f), 20000);
         EXPECT_LE(albedo.max(), 1.f + 5e-3f) << theta;
         EXPECT_GT(albedo.max(), 0.95f) << theta;
     }
@@ -213,16 +226,20 @@ void chi2_twosided(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32
 } // namespace
 
 TEST(BSDFSampling, TwoSidedFromTheBack) {
-    chi2_twosided(make_nested("twosided", {rough_conductor(0.3)}), normalize(Vector3f(0.3f, 0.2f, -0.7f)), 0,
-                  "roughconductor_back");
-    chi2_twosided(make_nested("twosided", {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
+    chi2_twosided(make_nested("twosided", {rough_conductor(0.3)}),
+                  normalize(Vector3f(0.3f, 0.2f, -0.7f)), 0, "roughconductor_back");
+    chi2_twosided(make_nested("twosided",
+                              {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
                   direction_from_angles(120.f, 40.f), 1, "roughplastic_back");
 }
 TEST(BSDFSampling, TwoSidedBackComponent) {
-    chi2_twosided(make_nested("twosided", {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
-                  direction_from_angles(140.f, 40.f), 2, "back_diffuse_component", component_ctx(2));
+    chi2_twosided(make_nested("twosided",
+                              {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
+                  direction_from_angles(140.f, 40.f), 2, "back_diffuse_component",
+                  component_ctx(2));
 }
 TEST(BSDFSampling, TwoSidedTransmission) {
-    chi2_twosided(make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.4}})}, {{"allow_transmission", true}}),
+    chi2_twosided(make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.4}})},
+                              {{"allow_transmission", true}}),
                   direction_from_angles(150.f, 0.f), 3, "roughdielectric_back");
 }

@@ -30,8 +30,8 @@ namespace {
 // Test plugins
 // ------------------------------------------------------------------------------------------------
 
-std::map<std::string, int> g_constructed;        ///< constructions per id
-std::vector<std::string> g_parameters_changed;   ///< ids, in call order
+std::map<std::string, int> g_constructed;      ///< constructions per id
+std::vector<std::string> g_parameters_changed; ///< ids, in call order
 
 /// Records its Properties and marks every entry queried.
 class RecorderBSDF final : public BSDF {
@@ -47,7 +47,9 @@ public:
     Color3f eval(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override {
         return Color3f(0.f);
     }
-    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override { return 0.f; }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override {
+        return 0.f;
+    }
     void parameters_changed() override {
         ++changed;
         g_parameters_changed.push_back(id());
@@ -70,7 +72,9 @@ public:
     Color3f eval(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override {
         return Color3f(0.f);
     }
-    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override { return 0.f; }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override {
+        return 0.f;
+    }
     double alpha;
     Color3f reflectance;
 };
@@ -86,7 +90,9 @@ public:
     Color3f eval(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override {
         return Color3f(0.f);
     }
-    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override { return 0.f; }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vector3f &) const override {
+        return 0.f;
+    }
 };
 
 /// Records its Properties (like RecorderBSDF) as a texture.
@@ -106,7 +112,8 @@ public:
     explicit FileTexture(const Properties &p) {
         std::string name = p.get_string("filename");
         path = file_resolver().resolve(name);
-        if (!fs::exists(path)) FACET_THROW_AT(p.location("filename"), "mesh file \"{}\" not found", name);
+        if (!fs::exists(path))
+            FACET_THROW_AT(p.location("filename"), "mesh file \"{}\" not found", name);
     }
     Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
     Color3f mean() const override { return Color3f(0.f); }
@@ -124,21 +131,27 @@ public:
 template <typename T> Object *make(const Properties &p) { return new T(p); }
 
 const PluginDescriptor TEST_PLUGINS[] = {
-    {FACET_ABI_VERSION, ObjectType::BSDF, "test_recorder", "records its properties", "", &make<RecorderBSDF>},
+    {FACET_ABI_VERSION, ObjectType::BSDF, "test_recorder", "records its properties", "",
+     &make<RecorderBSDF>},
     // 0.x upgrade tests need a BSDF called "diffuse"; this process never loads the real one.
-    {FACET_ABI_VERSION, ObjectType::BSDF, "diffuse", "records its properties", "", &make<RecorderBSDF>},
-    {FACET_ABI_VERSION, ObjectType::BSDF, "test_strict", "alpha and reflectance", "", &make<StrictBSDF>},
+    {FACET_ABI_VERSION, ObjectType::BSDF, "diffuse", "records its properties", "",
+     &make<RecorderBSDF>},
+    {FACET_ABI_VERSION, ObjectType::BSDF, "test_strict", "alpha and reflectance", "",
+     &make<StrictBSDF>},
     {FACET_ABI_VERSION, ObjectType::BSDF, "test_failing", "throws", "", &make<FailingBSDF>},
     {FACET_ABI_VERSION, ObjectType::Texture, "test_texture", "records", "", &make<RecorderTexture>},
     {FACET_ABI_VERSION, ObjectType::Texture, "test_file", "needs a file", "", &make<FileTexture>},
-    {FACET_ABI_VERSION, ObjectType::Integrator, "test_integrator", "records", "", &make<RecorderIntegrator>},
+    {FACET_ABI_VERSION, ObjectType::Integrator, "test_integrator", "records", "",
+     &make<RecorderIntegrator>},
 };
 
 // ------------------------------------------------------------------------------------------------
 // Helpers
 // ------------------------------------------------------------------------------------------------
 
-bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string &s, const std::string &part) {
+    return s.find(part) != std::string::npos;
+}
 
 /// The facet::Error thrown by `f`; a test failure when nothing (or something else) is thrown.
 Error error_of(const std::function<void()> &f) {
@@ -159,7 +172,8 @@ Error string_error(const std::string &xml, const LoadOptions &opts = {}) {
 }
 
 /// Loads `xml` and returns the root as the given test class (which must match).
-template <typename T> std::shared_ptr<T> load_as(const std::string &xml, const LoadOptions &opts = {}) {
+template <typename T>
+std::shared_ptr<T> load_as(const std::string &xml, const LoadOptions &opts = {}) {
     auto obj = std::dynamic_pointer_cast<T>(load_string(xml, opts));
     EXPECT_TRUE(obj != nullptr);
     return obj;
@@ -177,13 +191,15 @@ Properties root_props(const std::string &body, const LoadOptions &opts = {}) {
 
 void expect_matrix_near(const Matrix4f &a, const Matrix4f &b, float eps = 1e-5f) {
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) EXPECT_NEAR(a.m[i][j], b.m[i][j], eps) << "entry " << i << "," << j;
+        for (int j = 0; j < 4; ++j)
+            EXPECT_NEAR(a.m[i][j], b.m[i][j], eps) << "entry " << i << "," << j;
 }
 
 class XmlTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        for (const PluginDescriptor &d : TEST_PLUGINS) PluginRegistry::instance().register_static(&d);
+        for (const PluginDescriptor &d : TEST_PLUGINS)
+            PluginRegistry::instance().register_static(&d);
         static int counter = 0;
         m_dir = fs::temp_directory_path() /
                 ("facet_xml_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
@@ -217,9 +233,11 @@ TEST_F(XmlTest, MalformedXmlReportsPugixmlErrorWithLocation) {
     EXPECT_EQ(e.message(), "Parsing of XML file \"string\" failed: Start-end tags mismatch");
     EXPECT_EQ(e.location().to_string(), "string:3:3");
 
-    std::string path = write("broken.xml", "<scene version=\"3.0.0\">\n  <float name=\"a\" value=\"1\"/>\n  <oops\n");
+    std::string path = write(
+        "broken.xml", "<scene version=\"3.0.0\">\n  <float name=\"a\" value=\"1\"/>\n  <oops\n");
     Error f = error_of([&] { load_file(path); });
-    EXPECT_EQ(f.message(), "Parsing of XML file \"" + path + "\" failed: Error parsing start element tag");
+    EXPECT_EQ(f.message(),
+              "Parsing of XML file \"" + path + "\" failed: Error parsing start element tag");
     EXPECT_EQ(f.location().to_string(), path + ":3:8");
 }
 
@@ -294,7 +312,8 @@ TEST_F(XmlTest, TypoInParameterIsAnUnqueriedError) {
                       "</bsdf>\n";
     Error e = string_error(xml);
     EXPECT_EQ(e.location().to_string(), "string:1:2");
-    EXPECT_TRUE(contains(e.message(), "Found 1 unreferenced property in bsdf plugin of type \"test_strict\""))
+    EXPECT_TRUE(contains(e.message(),
+                         "Found 1 unreferenced property in bsdf plugin of type \"test_strict\""))
         << e.what();
     EXPECT_TRUE(contains(e.message(), "\"alpah\" (string:2:4)")) << e.what();
     // The parameter the plugin asked for and did not get is offered as the intended name.
@@ -313,8 +332,10 @@ TEST_F(XmlTest, WrongParameterTypeNamesTheEntry) {
                            "  <string name=\"alpha\" value=\"rough\"/>\n"
                            "</bsdf>\n");
     EXPECT_EQ(e.location().to_string(), "string:2:4");
-    EXPECT_TRUE(contains(e.message(), "failed to instantiate bsdf plugin of type \"test_strict\"")) << e.what();
-    EXPECT_TRUE(contains(e.message(), "parameter \"alpha\" has type string, but float was expected"))
+    EXPECT_TRUE(contains(e.message(), "failed to instantiate bsdf plugin of type \"test_strict\""))
+        << e.what();
+    EXPECT_TRUE(
+        contains(e.message(), "parameter \"alpha\" has type string, but float was expected"))
         << e.what();
 }
 
@@ -323,8 +344,8 @@ TEST_F(XmlTest, MissingFileIsReportedAtItsEntry) {
                                 "    <string name=\"filename\" value=\"missing.obj\"/>\n"
                                 "  </texture>\n"));
     EXPECT_EQ(e.location().to_string(), "string:3:6");
-    EXPECT_EQ(e.message(),
-              "failed to instantiate texture plugin of type \"test_file\": mesh file \"missing.obj\" not found");
+    EXPECT_EQ(e.message(), "failed to instantiate texture plugin of type \"test_file\": mesh file "
+                           "\"missing.obj\" not found");
 }
 
 TEST_F(XmlTest, InnerFailureIsNotWrappedTwice) {
@@ -416,7 +437,8 @@ TEST_F(XmlTest, RgbNeedsOneOrThreeValues) {
 
 TEST_F(XmlTest, PointValueAndXyzCannotBeMixed) {
     Error e = string_error(wrap("  <point name=\"p\" value=\"1, 2, 3\" x=\"1\"/>\n"));
-    EXPECT_EQ(e.message(), "<point> can have either a \"value\" attribute or x/y/z attributes, not both");
+    EXPECT_EQ(e.message(),
+              "<point> can have either a \"value\" attribute or x/y/z attributes, not both");
     EXPECT_EQ(e.location().to_string(), "string:2:4");
     e = string_error(wrap("  <vector name=\"p\" x=\"1\" y=\"2\"/>\n"));
     EXPECT_EQ(e.message(), "missing required attribute \"z\" in element <vector>");
@@ -457,9 +479,10 @@ TEST_F(XmlTest, DuplicatePropertyName) {
 
 TEST_F(XmlTest, SpectrumUniformPairsAndFile) {
     write("data/red.spd", "# wavelength value\n400 0.1\n500 0.2\n\n600 0.9\n");
-    std::string path = write("scene.xml", wrap("  <spectrum name=\"u\" value=\"0.5\"/>\n"
-                                               "  <spectrum name=\"p\" value=\"400:0.56, 500:0.18\"/>\n"
-                                               "  <spectrum name=\"f\" filename=\"data/red.spd\"/>\n"));
+    std::string path =
+        write("scene.xml", wrap("  <spectrum name=\"u\" value=\"0.5\"/>\n"
+                                "  <spectrum name=\"p\" value=\"400:0.56, 500:0.18\"/>\n"
+                                "  <spectrum name=\"f\" filename=\"data/red.spd\"/>\n"));
     auto root = std::dynamic_pointer_cast<RecorderBSDF>(load_file(path));
     ASSERT_TRUE(root);
     const Properties &p = root->props;
@@ -475,7 +498,8 @@ TEST_F(XmlTest, SpectrumUniformPairsAndFile) {
     EXPECT_GT(f.r, f.b);
 
     Error e = string_error(wrap("  <spectrum name=\"s\" value=\"1\" filename=\"a.spd\"/>\n"));
-    EXPECT_EQ(e.message(), "<spectrum> needs exactly one of the attributes \"value\" and \"filename\"");
+    EXPECT_EQ(e.message(),
+              "<spectrum> needs exactly one of the attributes \"value\" and \"filename\"");
     e = string_error(wrap("  <spectrum name=\"s\" filename=\"nothing_here.spd\"/>\n"));
     EXPECT_EQ(e.message(), "spectrum file \"nothing_here.spd\" not found");
     EXPECT_EQ(e.location().to_string(), "string:2:4");
@@ -495,7 +519,8 @@ Transform transform_of(const std::string &ops) {
 TEST_F(XmlTest, TransformOperationsAreLeftMultiplied) {
     Transform t = transform_of("    <translate x=\"1\"/>\n"
                                "    <rotate y=\"1\" angle=\"90\"/>\n");
-    Transform expected = Transform::rotate(Vector3f(0, 1, 0), 90.f) * Transform::translate(Vector3f(1, 0, 0));
+    Transform expected =
+        Transform::rotate(Vector3f(0, 1, 0), 90.f) * Transform::translate(Vector3f(1, 0, 0));
     expect_matrix_near(t.matrix, expected.matrix);
     // The translation happens first: the origin goes to (1,0,0) and is then rotated to (0,0,-1).
     Point3f p = t.apply_point(Point3f(0, 0, 0));
@@ -549,8 +574,10 @@ TEST_F(XmlTest, MatrixWith16Or9Values) {
 }
 
 TEST_F(XmlTest, LookAt) {
-    Transform t = transform_of("    <lookat origin=\"1, 2, 3\" target=\"1, 2, 4\" up=\"0, 1, 0\"/>\n");
-    expect_matrix_near(t.matrix, Transform::look_at(Point3f(1, 2, 3), Point3f(1, 2, 4), Vector3f(0, 1, 0)).matrix);
+    Transform t =
+        transform_of("    <lookat origin=\"1, 2, 3\" target=\"1, 2, 4\" up=\"0, 1, 0\"/>\n");
+    expect_matrix_near(
+        t.matrix, Transform::look_at(Point3f(1, 2, 3), Point3f(1, 2, 4), Vector3f(0, 1, 0)).matrix);
     // Without up one is chosen perpendicular to the view direction.
     Transform n = transform_of("    <lookat origin=\"0, 0, 0\" target=\"0, 0, -5\"/>\n");
     Vector3f dir = n.apply_vector(Vector3f(0, 0, 1));
@@ -598,11 +625,12 @@ TEST_F(XmlTest, UnnamedChildrenGetArgNames) {
 }
 
 TEST_F(XmlTest, ForwardReferenceSharesOneInstance) {
-    auto root = load_as<RecorderBSDF>(wrap("  <ref id=\"later\" name=\"first\"/>\n"
-                                           "  <bsdf type=\"test_recorder\" id=\"later\" name=\"second\"/>\n"
-                                           "  <bsdf type=\"test_recorder\" name=\"third\">\n"
-                                           "    <ref id=\"later\"/>\n"
-                                           "  </bsdf>\n"));
+    auto root =
+        load_as<RecorderBSDF>(wrap("  <ref id=\"later\" name=\"first\"/>\n"
+                                   "  <bsdf type=\"test_recorder\" id=\"later\" name=\"second\"/>\n"
+                                   "  <bsdf type=\"test_recorder\" name=\"third\">\n"
+                                   "    <ref id=\"later\"/>\n"
+                                   "  </bsdf>\n"));
     ASSERT_TRUE(root);
     auto first = root->props.get_object<RecorderBSDF>("first");
     auto second = root->props.get_object<RecorderBSDF>("second");
@@ -704,7 +732,8 @@ TEST_F(XmlTest, SubstitutionInTypeAndTransformAttributes) {
                                       "</bsdf>\n",
                                       opts);
     ASSERT_TRUE(root);
-    expect_matrix_near(root->props.get_transform("t").matrix, Transform::translate(Vector3f(2, 0, 0)).matrix);
+    expect_matrix_near(root->props.get_transform("t").matrix,
+                       Transform::translate(Vector3f(2, 0, 0)).matrix);
 }
 
 TEST_F(XmlTest, EscapedDollar) {
@@ -739,9 +768,10 @@ TEST_F(XmlTest, IncludedSceneIsSplicedAndObjectBecomesChild) {
                        "  <bsdf type=\"test_recorder\" id=\"shared\"/>\n"
                        "</scene>\n");
     write("tex.xml", "<texture version=\"3.0.0\" type=\"test_texture\"/>\n");
-    std::string main = write("main.xml", wrap("  <include filename=\"parts.xml\"/>\n"
-                                              "  <include filename=\"tex.xml\" name=\"reflectance\"/>\n"
-                                              "  <ref id=\"shared\" name=\"again\"/>\n"));
+    std::string main =
+        write("main.xml", wrap("  <include filename=\"parts.xml\"/>\n"
+                               "  <include filename=\"tex.xml\" name=\"reflectance\"/>\n"
+                               "  <ref id=\"shared\" name=\"again\"/>\n"));
     auto root = std::dynamic_pointer_cast<RecorderBSDF>(load_file(main));
     ASSERT_TRUE(root);
     const Properties &p = root->props;
@@ -756,10 +786,12 @@ TEST_F(XmlTest, IncludeResolutionOrder) {
     // Relative to the including file's folder first, then the search path.
     write("leaf.xml", "<bsdf version=\"3.0.0\" type=\"test_recorder\" id=\"top_leaf\"/>\n");
     write("sub/leaf.xml", "<bsdf version=\"3.0.0\" type=\"test_recorder\" id=\"sub_leaf\"/>\n");
-    write("sub/inner.xml", "<scene version=\"3.0.0\"><include filename=\"leaf.xml\" name=\"leaf\"/></scene>\n");
+    write("sub/inner.xml",
+          "<scene version=\"3.0.0\"><include filename=\"leaf.xml\" name=\"leaf\"/></scene>\n");
     write("lib/extra.xml", "<bsdf version=\"3.0.0\" type=\"test_recorder\" id=\"extra\"/>\n");
-    std::string main = write("main.xml", wrap("  <include filename=\"sub/inner.xml\"/>\n"
-                                              "  <include filename=\"extra.xml\" name=\"extra\"/>\n"));
+    std::string main =
+        write("main.xml", wrap("  <include filename=\"sub/inner.xml\"/>\n"
+                               "  <include filename=\"extra.xml\" name=\"extra\"/>\n"));
     LoadOptions opts;
     opts.search_path = {(m_dir / "lib").string()};
     auto root = std::dynamic_pointer_cast<RecorderBSDF>(load_file(main, opts));
@@ -773,8 +805,10 @@ TEST_F(XmlTest, IncludeResolutionOrder) {
 }
 
 TEST_F(XmlTest, IncludeCycleShowsTheChain) {
-    std::string a = write("a.xml", "<scene version=\"3.0.0\">\n  <include filename=\"b.xml\"/>\n</scene>\n");
-    std::string b = write("b.xml", "<scene version=\"3.0.0\">\n\n  <include filename=\"a.xml\"/>\n</scene>\n");
+    std::string a =
+        write("a.xml", "<scene version=\"3.0.0\">\n  <include filename=\"b.xml\"/>\n</scene>\n");
+    std::string b =
+        write("b.xml", "<scene version=\"3.0.0\">\n\n  <include filename=\"a.xml\"/>\n</scene>\n");
     Error e = error_of([&] { load_file(a); });
     EXPECT_EQ(e.message(), "include cycle detected: " + a + " -> " + b + " -> " + a);
     EXPECT_EQ(e.location().to_string(), b + ":3:4");
@@ -815,11 +849,11 @@ TEST_F(XmlTest, ErrorsInIncludedFilesCarryTheirFileName) {
 
 TEST_F(XmlTest, PathTagAddsASearchFolder) {
     write("common/meshes/sphere.obj", "v 0 0 0\n");
-    std::string scene = write("scenes/main.xml",
-                              "<texture version=\"3.0.0\" type=\"test_file\">\n"
-                              "  <path value=\"../common\"/>\n"
-                              "  <string name=\"filename\" value=\"meshes/sphere.obj\"/>\n"
-                              "</texture>\n");
+    std::string scene =
+        write("scenes/main.xml", "<texture version=\"3.0.0\" type=\"test_file\">\n"
+                                 "  <path value=\"../common\"/>\n"
+                                 "  <string name=\"filename\" value=\"meshes/sphere.obj\"/>\n"
+                                 "</texture>\n");
     std::vector<std::string> before = file_resolver().dirs();
     auto tex = std::dynamic_pointer_cast<FileTexture>(load_file(scene));
     ASSERT_TRUE(tex);
@@ -832,10 +866,10 @@ TEST_F(XmlTest, PathTagAddsASearchFolder) {
 
 TEST_F(XmlTest, SceneFolderIsSearchedForFiles) {
     write("scenes/mesh.obj", "v 0 0 0\n");
-    std::string scene = write("scenes/main.xml",
-                              "<texture version=\"3.0.0\" type=\"test_file\">\n"
-                              "  <string name=\"filename\" value=\"mesh.obj\"/>\n"
-                              "</texture>\n");
+    std::string scene =
+        write("scenes/main.xml", "<texture version=\"3.0.0\" type=\"test_file\">\n"
+                                 "  <string name=\"filename\" value=\"mesh.obj\"/>\n"
+                                 "</texture>\n");
     auto tex = std::dynamic_pointer_cast<FileTexture>(load_file(scene));
     ASSERT_TRUE(tex);
     EXPECT_TRUE(fs::equivalent(tex->path, m_dir / "scenes/mesh.obj"));
@@ -859,30 +893,32 @@ TEST_F(XmlTest, PathErrors) {
 // ------------------------------------------------------------------------------------------------
 
 TEST_F(XmlTest, OldVersionsAreUpgraded) {
-    auto root = load_as<RecorderBSDF>("<bsdf version=\"0.6.0\" type=\"test_recorder\">\n"
-                                      "  <default name=\"myValue\" value=\"3\"/>\n"
-                                      "  <float name=\"intIOR\" value=\"1.5\"/>\n"
-                                      "  <integer name=\"maxDepth\" value=\"$myValue\"/>\n"
-                                      "  <string name=\"fovAxis\" value=\"x\"/>\n"
-                                      "  <transform name=\"toWorld\">\n"
-                                      "    <lookAt origin=\"0, 0, 0\" target=\"0, 0, 1\" up=\"0, 1, 0\"/>\n"
-                                      "  </transform>\n"
-                                      "  <bsdf type=\"diffuse\" name=\"inner\">\n"
-                                      "    <rgb name=\"diffuseReflectance\" value=\"0.2\"/>\n"
-                                      "  </bsdf>\n"
-                                      "  <texture type=\"test_texture\" name=\"tex\">\n"
-                                      "    <float name=\"uoffset\" value=\"0.5\"/>\n"
-                                      "    <float name=\"uscale\" value=\"2\"/>\n"
-                                      "    <integer name=\"vscale\" value=\"3\"/>\n"
-                                      "  </texture>\n"
-                                      "</bsdf>\n");
+    auto root =
+        load_as<RecorderBSDF>("<bsdf version=\"0.6.0\" type=\"test_recorder\">\n"
+                              "  <default name=\"myValue\" value=\"3\"/>\n"
+                              "  <float name=\"intIOR\" value=\"1.5\"/>\n"
+                              "  <integer name=\"maxDepth\" value=\"$myValue\"/>\n"
+                              "  <string name=\"fovAxis\" value=\"x\"/>\n"
+                              "  <transform name=\"toWorld\">\n"
+                              "    <lookAt origin=\"0, 0, 0\" target=\"0, 0, 1\" up=\"0, 1, 0\"/>\n"
+                              "  </transform>\n"
+                              "  <bsdf type=\"diffuse\" name=\"inner\">\n"
+                              "    <rgb name=\"diffuseReflectance\" value=\"0.2\"/>\n"
+                              "  </bsdf>\n"
+                              "  <texture type=\"test_texture\" name=\"tex\">\n"
+                              "    <float name=\"uoffset\" value=\"0.5\"/>\n"
+                              "    <float name=\"uscale\" value=\"2\"/>\n"
+                              "    <integer name=\"vscale\" value=\"3\"/>\n"
+                              "  </texture>\n"
+                              "</bsdf>\n");
     ASSERT_TRUE(root);
     const Properties &p = root->props;
     EXPECT_DOUBLE_EQ(p.get_float("int_ior"), 1.5);
     EXPECT_EQ(p.get_int("max_depth"), 3);
     EXPECT_EQ(p.get_string("fov_axis"), "x");
-    expect_matrix_near(p.get_transform("to_world").matrix,
-                       Transform::look_at(Point3f(0, 0, 0), Point3f(0, 0, 1), Vector3f(0, 1, 0)).matrix);
+    expect_matrix_near(
+        p.get_transform("to_world").matrix,
+        Transform::look_at(Point3f(0, 0, 0), Point3f(0, 0, 1), Vector3f(0, 1, 0)).matrix);
     auto inner = p.get_object<RecorderBSDF>("inner");
     ASSERT_TRUE(inner);
     EXPECT_TRUE(inner->props.has("reflectance"));
@@ -891,7 +927,8 @@ TEST_F(XmlTest, OldVersionsAreUpgraded) {
     ASSERT_TRUE(tex);
     EXPECT_FALSE(tex->props.has("uoffset"));
     EXPECT_FALSE(tex->props.has("uscale"));
-    Transform expected = Transform::scale(Vector3f(2, 3, 1)) * Transform::translate(Vector3f(0.5f, 0, 0));
+    Transform expected =
+        Transform::scale(Vector3f(2, 3, 1)) * Transform::translate(Vector3f(0.5f, 0, 0));
     expect_matrix_near(tex->props.get_transform("to_uv").matrix, expected.matrix);
 }
 
@@ -905,7 +942,8 @@ TEST_F(XmlTest, UpgradeRenamingCanCollide) {
 }
 
 TEST_F(XmlTest, UpgradeIsPerSourceFile) {
-    write("old.xml", "<scene version=\"0.5.0\">\n  <float name=\"sampleCount\" value=\"1\"/>\n</scene>\n");
+    write("old.xml",
+          "<scene version=\"0.5.0\">\n  <float name=\"sampleCount\" value=\"1\"/>\n</scene>\n");
     std::string main = write("main.xml", wrap("  <include filename=\"old.xml\"/>\n"
                                               "  <float name=\"keepCase\" value=\"2\"/>\n"));
     auto root = std::dynamic_pointer_cast<RecorderBSDF>(load_file(main));
@@ -920,12 +958,13 @@ TEST_F(XmlTest, UpgradeIsPerSourceFile) {
 // ------------------------------------------------------------------------------------------------
 
 TEST_F(XmlTest, SceneRootHoldsItsChildren) {
-    std::string path = write("scene.xml", "<scene version=\"3.0.0\">\n"
-                                          "  <integrator type=\"test_integrator\">\n"
-                                          "    <integer name=\"max_depth\" value=\"5\"/>\n"
-                                          "  </integrator>\n"
-                                          "  <bsdf type=\"test_recorder\" id=\"unused_material\"/>\n"
-                                          "</scene>\n");
+    std::string path =
+        write("scene.xml", "<scene version=\"3.0.0\">\n"
+                           "  <integrator type=\"test_integrator\">\n"
+                           "    <integer name=\"max_depth\" value=\"5\"/>\n"
+                           "  </integrator>\n"
+                           "  <bsdf type=\"test_recorder\" id=\"unused_material\"/>\n"
+                           "</scene>\n");
     std::shared_ptr<Scene> scene = load_scene(path);
     ASSERT_TRUE(scene);
     auto integrator = std::dynamic_pointer_cast<RecorderIntegrator>(scene->integrator());

@@ -42,8 +42,8 @@ enum class BSDFFlags : uint32_t {
     NeedsDifferentials = 0x20000,
 
     Reflection = DiffuseReflection | DeltaReflection | Delta1DReflection | GlossyReflection,
-    Transmission = DiffuseTransmission | DeltaTransmission | Delta1DTransmission |
-                   GlossyTransmission | Null,
+    Transmission =
+        DiffuseTransmission | DeltaTransmission | Delta1DTransmission | GlossyTransmission | Null,
     Diffuse = DiffuseReflection | DiffuseTransmission,
     Glossy = GlossyReflection | GlossyTransmission,
     Smooth = Diffuse | Glossy,
@@ -52,8 +52,12 @@ enum class BSDFFlags : uint32_t {
     All = Diffuse | Glossy | Delta | Delta1D,
 };
 
-constexpr BSDFFlags operator|(BSDFFlags a, BSDFFlags b) { return BSDFFlags(uint32_t(a) | uint32_t(b)); }
-constexpr BSDFFlags operator&(BSDFFlags a, BSDFFlags b) { return BSDFFlags(uint32_t(a) & uint32_t(b)); }
+constexpr BSDFFlags operator|(BSDFFlags a, BSDFFlags b) {
+    return BSDFFlags(uint32_t(a) | uint32_t(b));
+}
+constexpr BSDFFlags operator&(BSDFFlags a, BSDFFlags b) {
+    return BSDFFlags(uint32_t(a) & uint32_t(b));
+}
 constexpr BSDFFlags operator~(BSDFFlags a) { return BSDFFlags(~uint32_t(a)); }
 inline BSDFFlags &operator|=(BSDFFlags &a, BSDFFlags b) { return a = a | b; }
 inline BSDFFlags &operator&=(BSDFFlags &a, BSDFFlags b) { return a = a & b; }
@@ -89,20 +93,27 @@ public:
 
     /// Samples wo given si.wi. `sample1` picks the lobe, `sample2` the direction.
     /// Returns the record and the weight f·|cos θo|/pdf (zero on failure).
-    virtual std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                                  float sample1, const Point2f &sample2) const = 0;
+    virtual std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx,
+                                                  const SurfaceInteraction &si, float sample1,
+                                                  const Point2f &sample2) const = 0;
     /// f(wi, wo)·|cos θo|; zero for delta lobes.
-    virtual Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const = 0;
+    virtual Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
+                         const Vector3f &wo) const = 0;
     /// Solid-angle density of sample(); zero for delta lobes.
-    virtual float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const = 0;
+    virtual float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+                      const Vector3f &wo) const = 0;
     virtual std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
                                                const Vector3f &wo) const {
         return {eval(ctx, si, wo), pdf(ctx, si, wo)};
     }
     /// Fraction of light passed straight through (wo = -wi) by Null lobes.
-    virtual Color3f eval_null_transmission(const SurfaceInteraction &si) const { return Color3f(0.f); }
+    virtual Color3f eval_null_transmission(const SurfaceInteraction &si) const {
+        return Color3f(0.f);
+    }
     /// Albedo for AOVs and denoisers.
-    virtual Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const { return Color3f(0.f); }
+    virtual Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const {
+        return Color3f(0.f);
+    }
 
     BSDFFlags flags() const { return m_flags; }
     BSDFFlags flags(size_t component) const { return m_components.at(component); }

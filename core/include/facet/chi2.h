@@ -42,14 +42,14 @@ struct Chi2Sample {
         Delta,  ///< a direction of a delta lobe: only its weight is checked
     };
     Kind kind = Kind::Failed;
-    Vector3f d;                ///< sampled unit direction
-    bool has_weight = false;   ///< `weight` is meaningful (checked for finiteness, summed)
-    bool has_value = false;    ///< `value` is meaningful: check weight == value / pdf
-    Color3f weight;            ///< what the routine returned
+    Vector3f d;              ///< sampled unit direction
+    bool has_weight = false; ///< `weight` is meaningful (checked for finiteness, summed)
+    bool has_value = false;  ///< `value` is meaningful: check weight == value / pdf
+    Color3f weight;          ///< what the routine returned
     /// Factor that turns `weight` into the fraction of energy carried (η² for radiance-mode
     /// refraction, whose weight carries the 1/η² radiance scaling).
     float energy_scale = 1.f;
-    Color3f value;             ///< eval(d), for the weight == value / pdf check (Smooth)
+    Color3f value; ///< eval(d), for the weight == value / pdf check (Smooth)
     float sampled_pdf = std::numeric_limits<float>::quiet_NaN(); ///< density the routine reported
     float pdf = std::numeric_limits<float>::quiet_NaN();         ///< pdf(d) from the pdf function
     /// Set by an adapter that found its routine inconsistent (e.g. eval_pdf != (eval, pdf)).
@@ -72,19 +72,19 @@ public:
 };
 
 struct Chi2Options {
-    int res = 32;                  ///< cos θ cells (made even); φ gets 2·res cells
-    uint64_t samples = 1000000;    ///< N
+    int res = 32;               ///< cos θ cells (made even); φ gets 2·res cells
+    uint64_t samples = 1000000; ///< N
     uint32_t seed = 0;
     /// Adaptive Simpson (the default) or the fixed composite Simpson rule on ires × ires points.
     /// The fixed rule is cheaper per cell but misses lobes narrower than its spacing (α = 0.05
     /// near the normal, say), which then reads as a wrong pdf.
     bool adaptive = true;
-    int ires = 7;                  ///< points per axis and cell of the fixed rule (made odd)
-    double tolerance = 1e-5;       ///< relative tolerance of the adaptive rule
-    int max_depth = 8;             ///< bisections per axis of the adaptive rule
-    double min_expected = 5.0;     ///< cells expecting less are pooled
-    double significance = 0.01;    ///< before the Šidák correction
-    uint32_t test_count = 1;       ///< number of tests of the family (Šidák)
+    int ires = 7;                   ///< points per axis and cell of the fixed rule (made odd)
+    double tolerance = 1e-5;        ///< relative tolerance of the adaptive rule
+    int max_depth = 8;              ///< bisections per axis of the adaptive rule
+    double min_expected = 5.0;      ///< cells expecting less are pooled
+    double significance = 0.01;     ///< before the Šidák correction
+    uint32_t test_count = 1;        ///< number of tests of the family (Šidák)
     double weight_tolerance = 1e-3; ///< relative, weight vs eval/pdf and sampled vs pdf()
     /// Float rounding allowance: up to this fraction of the samples may exceed weight_tolerance
     /// (rounding near singular configurations), but none may be off by more than gross_tolerance.
@@ -97,7 +97,7 @@ struct Chi2Result {
     double statistic = 0.0;
     int dof = 0;
     double p_value = 0.0;
-    double significance = 0.0;     ///< after the Šidák correction
+    double significance = 0.0; ///< after the Šidák correction
     /// Why the test failed (empty when it passed) and notes worth reading either way.
     std::vector<std::string> failures, notes;
 
@@ -106,12 +106,12 @@ struct Chi2Result {
     std::vector<double> observed, expected;
 
     uint64_t samples = 0, smooth = 0, delta = 0, failed = 0;
-    double pdf_integral = 0.0;     ///< ∫ pdf over the sphere
-    Color3f mean_weight;           ///< energy-scaled, over all samples (failures count as 0)
+    double pdf_integral = 0.0; ///< ∫ pdf over the sphere
+    Color3f mean_weight;       ///< energy-scaled, over all samples (failures count as 0)
     Color3f weight_stddev;
     uint64_t weight_mismatches = 0, pdf_mismatches = 0;
     double max_weight_error = 0.0, max_pdf_error = 0.0; ///< largest relative differences seen
-    std::string description;       ///< the adapter's to_string()
+    std::string description;                            ///< the adapter's to_string()
 
     /// Several lines: what was tested, the statistic, dof, p-value and the verdict.
     std::string summary() const;
@@ -141,8 +141,8 @@ double sidak_correction(double alpha, uint32_t test_count);
 
 struct PearsonResult {
     double statistic = 0.0;
-    int dof = 0;                ///< number of terms - 1
-    int pooled_cells = 0;       ///< cells that went into pools
+    int dof = 0;                    ///< number of terms - 1
+    int pooled_cells = 0;           ///< cells that went into pools
     bool zero_expected_hit = false; ///< a cell expecting nothing received samples
     size_t zero_expected_cell = 0;
 };
@@ -193,7 +193,8 @@ class EmitterAdapter : public Chi2Adapter {
 public:
     /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it.
     EmitterAdapter(const std::string &scene_xml, const Point3f &ref, size_t index = 0);
-    EmitterAdapter(std::shared_ptr<Scene> scene, std::shared_ptr<Emitter> emitter, const Point3f &ref);
+    EmitterAdapter(std::shared_ptr<Scene> scene, std::shared_ptr<Emitter> emitter,
+                   const Point3f &ref);
     ~EmitterAdapter() override;
 
     /// The scene for plugin `plugin` with `entries` (see chi2_object_xml): an `area` emitter is

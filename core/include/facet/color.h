@@ -20,11 +20,36 @@ struct Color3f {
     constexpr Color3f operator/(const Color3f &o) const { return {r / o.r, g / o.g, b / o.b}; }
     constexpr Color3f operator*(float s) const { return {r * s, g * s, b * s}; }
     constexpr Color3f operator/(float s) const { return {r / s, g / s, b / s}; }
-    Color3f &operator+=(const Color3f &o) { r += o.r; g += o.g; b += o.b; return *this; }
-    Color3f &operator-=(const Color3f &o) { r -= o.r; g -= o.g; b -= o.b; return *this; }
-    Color3f &operator*=(const Color3f &o) { r *= o.r; g *= o.g; b *= o.b; return *this; }
-    Color3f &operator*=(float s) { r *= s; g *= s; b *= s; return *this; }
-    Color3f &operator/=(float s) { r /= s; g /= s; b /= s; return *this; }
+    Color3f &operator+=(const Color3f &o) {
+        r += o.r;
+        g += o.g;
+        b += o.b;
+        return *this;
+    }
+    Color3f &operator-=(const Color3f &o) {
+        r -= o.r;
+        g -= o.g;
+        b -= o.b;
+        return *this;
+    }
+    Color3f &operator*=(const Color3f &o) {
+        r *= o.r;
+        g *= o.g;
+        b *= o.b;
+        return *this;
+    }
+    Color3f &operator*=(float s) {
+        r *= s;
+        g *= s;
+        b *= s;
+        return *this;
+    }
+    Color3f &operator/=(float s) {
+        r /= s;
+        g /= s;
+        b /= s;
+        return *this;
+    }
     constexpr bool operator==(const Color3f &o) const { return r == o.r && g == o.g && b == o.b; }
     constexpr bool operator!=(const Color3f &o) const { return !(*this == o); }
 

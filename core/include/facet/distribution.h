@@ -11,7 +11,9 @@ namespace facet {
 class DiscreteDistribution {
 public:
     DiscreteDistribution() = default;
-    explicit DiscreteDistribution(const std::vector<float> &weights) { build(weights.data(), weights.size()); }
+    explicit DiscreteDistribution(const std::vector<float> &weights) {
+        build(weights.data(), weights.size());
+    }
     DiscreteDistribution(const float *weights, size_t n) { build(weights, n); }
 
     void build(const float *weights, size_t n) {
@@ -49,7 +51,8 @@ private:
 class Distribution2D {
 public:
     Distribution2D() = default;
-    Distribution2D(const std::vector<float> &weights, int width, int height) : m_width(width), m_height(height) {
+    Distribution2D(const std::vector<float> &weights, int width, int height)
+        : m_width(width), m_height(height) {
         m_conditional.resize(size_t(height));
         std::vector<float> row_sums(static_cast<size_t>(height));
         for (int y = 0; y < height; ++y) {
@@ -73,8 +76,8 @@ public:
     float pdf(const Point2f &p) const {
         int x = std::clamp(int(p.x * float(m_width)), 0, m_width - 1);
         int y = std::clamp(int(p.y * float(m_height)), 0, m_height - 1);
-        return m_marginal.pmf(size_t(y)) * m_conditional[size_t(y)].pmf(size_t(x)) * float(m_width) *
-               float(m_height);
+        return m_marginal.pmf(size_t(y)) * m_conditional[size_t(y)].pmf(size_t(x)) *
+               float(m_width) * float(m_height);
     }
 
 private:

@@ -18,17 +18,21 @@ enum class EmitterFlags : uint32_t {
     SpatiallyVarying = 0x10,
     Delta = DeltaPosition | DeltaDirection,
 };
-constexpr EmitterFlags operator|(EmitterFlags a, EmitterFlags b) { return EmitterFlags(uint32_t(a) | uint32_t(b)); }
-constexpr EmitterFlags operator&(EmitterFlags a, EmitterFlags b) { return EmitterFlags(uint32_t(a) & uint32_t(b)); }
+constexpr EmitterFlags operator|(EmitterFlags a, EmitterFlags b) {
+    return EmitterFlags(uint32_t(a) | uint32_t(b));
+}
+constexpr EmitterFlags operator&(EmitterFlags a, EmitterFlags b) {
+    return EmitterFlags(uint32_t(a) & uint32_t(b));
+}
 constexpr bool has_flag(EmitterFlags a, EmitterFlags b) { return (uint32_t(a) & uint32_t(b)) != 0; }
 
 /// A light source.
 ///
-/// Conventions: sample_direction() samples a point on the emitter as seen from `ref` and returns the
-/// record (direction, distance, solid-angle pdf; pdf = 1 and delta = true for delta emitters) and the
-/// weight L·G/pdf that the integrator multiplies by the BSDF, without any visibility test.
-/// eval() gives the radiance arriving along a ray that hit the emitter: for area emitters `si` is the
-/// hit (si.wi in the local shading frame); for infinite emitters `si` is a miss record whose
+/// Conventions: sample_direction() samples a point on the emitter as seen from `ref` and returns
+/// the record (direction, distance, solid-angle pdf; pdf = 1 and delta = true for delta emitters)
+/// and the weight L·G/pdf that the integrator multiplies by the BSDF, without any visibility test.
+/// eval() gives the radiance arriving along a ray that hit the emitter: for area emitters `si` is
+/// the hit (si.wi in the local shading frame); for infinite emitters `si` is a miss record whose
 /// sh_frame is the identity and whose si.wi = -ray.d in world space.
 class Emitter : public Object {
 public:

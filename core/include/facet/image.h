@@ -19,8 +19,8 @@ struct Image {
 };
 
 struct ImageWriteOptions {
-    bool half = false;                          ///< float16 for EXR
-    std::string ocio_config;                    ///< "" = $OCIO, else the installed config
+    bool half = false;       ///< float16 for EXR
+    std::string ocio_config; ///< "" = $OCIO, else the installed config
     std::string display = "sRGB";
     std::string view = "Standard";
     std::map<std::string, std::string> metadata;

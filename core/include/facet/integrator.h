@@ -19,7 +19,8 @@ public:
 class SamplingIntegrator : public Integrator {
 public:
     /// Radiance arriving along `ray`. `aovs` has room for aov_names().size() floats.
-    virtual Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray, float *aovs) const = 0;
+    virtual Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray,
+                           float *aovs) const = 0;
     /// Extra channels this integrator writes (e.g. "albedo.R"); none by default.
     virtual std::vector<std::string> aov_names() const { return {}; }
 };

@@ -9,7 +9,7 @@ namespace facet {
 /// A point with a geometric normal (a reference point for emitter sampling).
 struct Interaction {
     Point3f p;
-    Normal3f n;    ///< geometric normal; zero for points in space
+    Normal3f n; ///< geometric normal; zero for points in space
     float t = Infinity;
 
     bool is_valid() const { return t != Infinity; }
@@ -23,10 +23,10 @@ struct Interaction {
 
 /// A ray-surface hit with everything shading needs.
 struct SurfaceInteraction : Interaction {
-    Frame sh_frame;        ///< shading frame (n = shading normal)
+    Frame sh_frame; ///< shading frame (n = shading normal)
     Point2f uv;
     Vector3f dp_du, dp_dv;
-    Vector3f wi;           ///< direction towards the ray origin, in the local shading frame
+    Vector3f wi; ///< direction towards the ray origin, in the local shading frame
     const Shape *shape = nullptr;
     uint32_t prim_index = 0;
     uint32_t instance_index = uint32_t(-1);
@@ -50,8 +50,8 @@ struct PositionSample {
 
 /// A direction sampled from a reference point towards an emitter.
 struct DirectionSample : PositionSample {
-    Vector3f d;              ///< unit direction from the reference point to p
-    float dist = 0.f;        ///< distance to p (Infinity for environment emitters)
+    Vector3f d;       ///< unit direction from the reference point to p
+    float dist = 0.f; ///< distance to p (Infinity for environment emitters)
     const Emitter *emitter = nullptr;
 };
 

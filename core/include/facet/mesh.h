@@ -17,15 +17,17 @@ public:
     BoundingBox3f bbox() const override { return m_bbox; }
     float surface_area() const override { return m_area; }
     RTCGeometry embree_geometry(RTCDevice device) const override;
-    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index, const Point2f &uv,
-                                     SurfaceInteraction &si) const override;
+    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
+                                     const Point2f &uv, SurfaceInteraction &si) const override;
     PositionSample sample_position(const Point2f &u) const override;
     bool is_mesh() const override { return true; }
     std::string to_string() const override;
 
     size_t vertex_count() const { return m_positions.size() / 3; }
     size_t face_count() const { return m_faces.size() / 3; }
-    Point3f vertex_position(size_t i) const { return {m_positions[3 * i], m_positions[3 * i + 1], m_positions[3 * i + 2]}; }
+    Point3f vertex_position(size_t i) const {
+        return {m_positions[3 * i], m_positions[3 * i + 1], m_positions[3 * i + 2]};
+    }
     bool has_vertex_normals() const { return !m_normals.empty(); }
     bool has_uvs() const { return !m_uvs.empty(); }
     bool has_vertex_colors() const { return !m_colors.empty(); }
@@ -46,7 +48,7 @@ protected:
     /// initialize() so the weights are those of the world-space triangles.
     void recompute_vertex_normals();
 
-    std::string m_name; ///< file name or plugin name, for messages
+    std::string m_name;             ///< file name or plugin name, for messages
     std::vector<float> m_positions; ///< 3 per vertex (+1 padding float for Embree after initialize)
     std::vector<float> m_normals;   ///< 3 per vertex or empty
     std::vector<float> m_uvs;       ///< 2 per vertex or empty

@@ -44,13 +44,16 @@ public:
 
     /// Loads the plugin library `<name>.so`; throws facet::Error (listing the known plugins of
     /// `expected` kind and the closest name) when it is missing or invalid.
-    const PluginDescriptor &descriptor(const std::string &name, ObjectType expected = ObjectType::Unknown);
+    const PluginDescriptor &descriptor(const std::string &name,
+                                       ObjectType expected = ObjectType::Unknown);
     /// Loads the library at `path` and checks it; returns its descriptor.
-    const PluginDescriptor &load_library(const std::string &path, ObjectType expected = ObjectType::Unknown);
+    const PluginDescriptor &load_library(const std::string &path,
+                                         ObjectType expected = ObjectType::Unknown);
 
     /// Creates an object and checks its kind. Unqueried properties are reported afterwards:
     /// an error unless `lenient`, in which case a warning.
-    std::shared_ptr<Object> create(ObjectType expected, const Properties &props, bool lenient = false);
+    std::shared_ptr<Object> create(ObjectType expected, const Properties &props,
+                                   bool lenient = false);
     template <typename T> std::shared_ptr<T> create_as(ObjectType expected, const Properties &props,
                                                        bool lenient = false) {
         return std::static_pointer_cast<T>(create(expected, props, lenient));
@@ -86,7 +89,13 @@ std::string closest_name(const std::string &name, const std::vector<std::string>
     extern "C" __attribute__((visibility("default"))) const ::facet::PluginDescriptor *            \
     facet_plugin_descriptor() {                                                                    \
         static const ::facet::PluginDescriptor desc{                                               \
-            ::facet::FACET_ABI_VERSION, ::facet::ObjectType::Kind, Name, Description, Doc,         \
-            [](const ::facet::Properties &props) -> ::facet::Object * { return new Class(props); }}; \
+            ::facet::FACET_ABI_VERSION,                                                            \
+            ::facet::ObjectType::Kind,                                                             \
+            Name,                                                                                  \
+            Description,                                                                           \
+            Doc,                                                                                   \
+            [](const ::facet::Properties &props) -> ::facet::Object * {                            \
+                return new Class(props);                                                           \
+            }};                                                                                    \
         return &desc;                                                                              \
     }

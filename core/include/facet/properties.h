@@ -37,7 +37,8 @@ public:
 
     // -- Setters (the loader's side) --------------------------------------------------------
     /// Adds an entry; a second entry of the same name is an error unless `overwrite` is set.
-    void set(const std::string &name, Value value, const Location &loc = {}, bool overwrite = false);
+    void set(const std::string &name, Value value, const Location &loc = {},
+             bool overwrite = false);
     void set_bool(const std::string &n, bool v) { set(n, v); }
     void set_int(const std::string &n, int64_t v) { set(n, v); }
     void set_float(const std::string &n, double v) { set(n, v); }

@@ -16,7 +16,9 @@ inline uint32_t hash32(uint32_t x) {
     return x;
 }
 
-inline uint32_t hash_combine(uint32_t a, uint32_t b) { return hash32(a ^ (hash32(b) + 0x9e3779b9U + (a << 6) + (a >> 2))); }
+inline uint32_t hash_combine(uint32_t a, uint32_t b) {
+    return hash32(a ^ (hash32(b) + 0x9e3779b9U + (a << 6) + (a >> 2)));
+}
 inline uint32_t hash64(uint64_t v) { return hash_combine(uint32_t(v), uint32_t(v >> 32)); }
 
 /// Uniform float in [0, 1) from a hash value (24 bits).
@@ -28,7 +30,11 @@ inline float to_unit_float(uint32_t h) { return float(h >> 8) * 0x1p-24f; }
 inline uint32_t permute(uint32_t i, uint32_t n, uint32_t seed) {
     if (n <= 1) return 0;
     uint32_t w = n - 1;
-    w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
     do {
         i ^= seed;
         i *= 0xe170893dU;

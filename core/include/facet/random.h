@@ -26,7 +26,10 @@ public:
     }
     /// Uniform in [0, 1): 23 random mantissa bits.
     float next_float() {
-        union { uint32_t u; float f; } x;
+        union {
+            uint32_t u;
+            float f;
+        } x;
         x.u = (next_uint32() >> 9) | 0x3f800000u;
         return x.f - 1.f;
     }

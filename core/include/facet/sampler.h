@@ -21,7 +21,10 @@ public:
     /// Starts a new pixel (sample index 0).
     virtual void seed(uint64_t seed_value) = 0;
     /// Moves to the next sample of the current pixel.
-    virtual void advance() { ++m_sample_index; m_dimension = 0; }
+    virtual void advance() {
+        ++m_sample_index;
+        m_dimension = 0;
+    }
     virtual float next_1d() = 0;
     virtual Point2f next_2d() = 0;
 

@@ -43,7 +43,9 @@ public:
 
     const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
     const std::vector<std::shared_ptr<Emitter>> &emitters() const { return m_emitters; }
-    const std::vector<std::shared_ptr<Emitter>> &environment_emitters() const { return m_environment; }
+    const std::vector<std::shared_ptr<Emitter>> &environment_emitters() const {
+        return m_environment;
+    }
     const std::vector<std::shared_ptr<Sensor>> &sensors() const { return m_sensors; }
     std::shared_ptr<Integrator> integrator() const { return m_integrator; }
     const BoundingBox3f &bbox() const { return m_bbox; }

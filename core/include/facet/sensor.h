@@ -21,7 +21,8 @@ public:
     ObjectType type() const override { return ObjectType::Sensor; }
 
     /// Ray through the film position `film_pos` in [0,1]² of the full film (x right, y down) and
-    /// the aperture sample; returns the ray (world space, unit direction) and its importance weight.
+    /// the aperture sample; returns the ray (world space, unit direction) and its importance
+    /// weight.
     virtual std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
                                                const Point2f &aperture_sample) const = 0;
     virtual bool needs_aperture_sample() const { return false; }

@@ -18,8 +18,8 @@ public:
     float surface_area() const override { return m_area; }
     /// Not attached to the scene by itself.
     RTCGeometry embree_geometry(RTCDevice) const override { return nullptr; }
-    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index, const Point2f &uv,
-                                     SurfaceInteraction &si) const override;
+    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
+                                     const Point2f &uv, SurfaceInteraction &si) const override;
     PositionSample sample_position(const Point2f &u) const override;
     std::string to_string() const override;
 

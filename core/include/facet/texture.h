@@ -21,7 +21,8 @@ public:
     virtual bool is_spatially_varying() const { return true; }
 };
 
-/// True for a texture that is present and varies over the surface (sets BSDFFlags::SpatiallyVarying).
+/// True for a texture that is present and varies over the surface (sets
+/// BSDFFlags::SpatiallyVarying).
 inline bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
 
 /// The texture behind a plain number, rgb or spectrum parameter.

@@ -47,8 +47,8 @@ template <typename T> void user_intersect(const RTCIntersectFunctionNArguments *
     for (unsigned i = 0; i < n; ++i) {
         if (!args->valid[i]) continue;
         UserHit h;
-        if (!shape->intersect_user(ray_origin(ray, n, i), ray_direction(ray, n, i), RTCRayN_tnear(ray, n, i),
-                                   RTCRayN_tfar(ray, n, i), h))
+        if (!shape->intersect_user(ray_origin(ray, n, i), ray_direction(ray, n, i),
+                                   RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), h))
             continue;
         RTCRayN_tfar(ray, n, i) = h.t;
         RTCHitN_Ng_x(hit, n, i) = h.ng.x;
@@ -70,8 +70,8 @@ template <typename T> void user_occluded(const RTCOccludedFunctionNArguments *ar
     for (unsigned i = 0; i < n; ++i) {
         if (!args->valid[i]) continue;
         UserHit h;
-        if (shape->intersect_user(ray_origin(ray, n, i), ray_direction(ray, n, i), RTCRayN_tnear(ray, n, i),
-                                  RTCRayN_tfar(ray, n, i), h))
+        if (shape->intersect_user(ray_origin(ray, n, i), ray_direction(ray, n, i),
+                                  RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), h))
             RTCRayN_tfar(ray, n, i) = -Infinity; // Embree's mark for "occluded"
     }
 }

@@ -22,9 +22,21 @@ template <typename T> struct Vec2 {
     constexpr Vec2 operator*(T s) const { return {x * s, y * s}; }
     constexpr Vec2 operator/(T s) const { return {x / s, y / s}; }
     constexpr Vec2 operator-() const { return {-x, -y}; }
-    Vec2 &operator+=(const Vec2 &o) { x += o.x; y += o.y; return *this; }
-    Vec2 &operator-=(const Vec2 &o) { x -= o.x; y -= o.y; return *this; }
-    Vec2 &operator*=(T s) { x *= s; y *= s; return *this; }
+    Vec2 &operator+=(const Vec2 &o) {
+        x += o.x;
+        y += o.y;
+        return *this;
+    }
+    Vec2 &operator-=(const Vec2 &o) {
+        x -= o.x;
+        y -= o.y;
+        return *this;
+    }
+    Vec2 &operator*=(T s) {
+        x *= s;
+        y *= s;
+        return *this;
+    }
     constexpr bool operator==(const Vec2 &o) const { return x == o.x && y == o.y; }
     constexpr bool operator!=(const Vec2 &o) const { return !(*this == o); }
 };
@@ -35,7 +47,8 @@ template <typename T> struct Vec3 {
     constexpr Vec3() = default;
     constexpr Vec3(T x_, T y_, T z_) : x(x_), y(y_), z(z_) {}
     constexpr explicit Vec3(T v) : x(v), y(v), z(v) {}
-    template <typename U> constexpr explicit Vec3(const Vec3<U> &o) : x(T(o.x)), y(T(o.y)), z(T(o.z)) {}
+    template <typename U> constexpr explicit Vec3(const Vec3<U> &o)
+        : x(T(o.x)), y(T(o.y)), z(T(o.z)) {}
     T &operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
     T operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
     constexpr Vec3 operator+(const Vec3 &o) const { return {x + o.x, y + o.y, z + o.z}; }
@@ -45,10 +58,30 @@ template <typename T> struct Vec3 {
     constexpr Vec3 operator*(T s) const { return {x * s, y * s, z * s}; }
     constexpr Vec3 operator/(T s) const { return {x / s, y / s, z / s}; }
     constexpr Vec3 operator-() const { return {-x, -y, -z}; }
-    Vec3 &operator+=(const Vec3 &o) { x += o.x; y += o.y; z += o.z; return *this; }
-    Vec3 &operator-=(const Vec3 &o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-    Vec3 &operator*=(T s) { x *= s; y *= s; z *= s; return *this; }
-    Vec3 &operator/=(T s) { x /= s; y /= s; z /= s; return *this; }
+    Vec3 &operator+=(const Vec3 &o) {
+        x += o.x;
+        y += o.y;
+        z += o.z;
+        return *this;
+    }
+    Vec3 &operator-=(const Vec3 &o) {
+        x -= o.x;
+        y -= o.y;
+        z -= o.z;
+        return *this;
+    }
+    Vec3 &operator*=(T s) {
+        x *= s;
+        y *= s;
+        z *= s;
+        return *this;
+    }
+    Vec3 &operator/=(T s) {
+        x /= s;
+        y /= s;
+        z /= s;
+        return *this;
+    }
     constexpr bool operator==(const Vec3 &o) const { return x == o.x && y == o.y && z == o.z; }
     constexpr bool operator!=(const Vec3 &o) const { return !(*this == o); }
 };
@@ -68,8 +101,12 @@ using Vector3d = Vec3<double>;
 template <typename T> constexpr T dot(const Vec3<T> &a, const Vec3<T> &b) {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-template <typename T> constexpr T dot(const Vec2<T> &a, const Vec2<T> &b) { return a.x * b.x + a.y * b.y; }
-template <typename T> inline T absdot(const Vec3<T> &a, const Vec3<T> &b) { return std::abs(dot(a, b)); }
+template <typename T> constexpr T dot(const Vec2<T> &a, const Vec2<T> &b) {
+    return a.x * b.x + a.y * b.y;
+}
+template <typename T> inline T absdot(const Vec3<T> &a, const Vec3<T> &b) {
+    return std::abs(dot(a, b));
+}
 template <typename T> constexpr Vec3<T> cross(const Vec3<T> &a, const Vec3<T> &b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
@@ -77,14 +114,18 @@ template <typename T> constexpr T squared_norm(const Vec3<T> &v) { return dot(v,
 template <typename T> inline T norm(const Vec3<T> &v) { return std::sqrt(dot(v, v)); }
 template <typename T> inline T norm(const Vec2<T> &v) { return std::sqrt(dot(v, v)); }
 template <typename T> inline Vec3<T> normalize(const Vec3<T> &v) { return v / norm(v); }
-template <typename T> inline Vec3<T> abs(const Vec3<T> &v) { return {std::abs(v.x), std::abs(v.y), std::abs(v.z)}; }
+template <typename T> inline Vec3<T> abs(const Vec3<T> &v) {
+    return {std::abs(v.x), std::abs(v.y), std::abs(v.z)};
+}
 template <typename T> inline Vec3<T> min(const Vec3<T> &a, const Vec3<T> &b) {
     return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
 template <typename T> inline Vec3<T> max(const Vec3<T> &a, const Vec3<T> &b) {
     return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
-template <typename T> inline T max_component(const Vec3<T> &v) { return std::max(v.x, std::max(v.y, v.z)); }
+template <typename T> inline T max_component(const Vec3<T> &v) {
+    return std::max(v.x, std::max(v.y, v.z));
+}
 template <typename T> inline bool is_finite(const Vec3<T> &v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

@@ -18,8 +18,9 @@ struct LoadOptions {
     std::vector<std::string> search_path;
 };
 
-/// Loads a Mitsuba 3 XML file (the whole grammar: objects, properties, transforms, ref, default, include, alias, path). The root may be a <scene> or any
-/// object tag. Errors are facet::Error with file:line:col.
+/// Loads a Mitsuba 3 XML file (the whole grammar: objects, properties, transforms, ref, default,
+/// include, alias, path). The root may be a <scene> or any object tag. Errors are facet::Error with
+/// file:line:col.
 std::shared_ptr<Object> load_file(const std::string &path, const LoadOptions &opts = {});
 /// The same for XML text; locations read "string:line:col".
 std::shared_ptr<Object> load_string(const std::string &xml, const LoadOptions &opts = {});

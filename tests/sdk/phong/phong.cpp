@@ -39,7 +39,8 @@ public:
         m_specular = props.texture("specular_reflectance", 0.2f);
         m_exponent = float(props.get_float("exponent", 30.0));
         if (!(m_exponent >= 0.f))
-            FACET_THROW_AT(props.location("exponent"), "exponent must be at least 0 (got {})", m_exponent);
+            FACET_THROW_AT(props.location("exponent"), "exponent must be at least 0 (got {})",
+                           m_exponent);
         float d = m_diffuse->mean().mean(), s = m_specular->mean().mean();
         m_specular_probability = d + s > 0.f ? s / (d + s) : 0.f;
         BSDFFlags glossy = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide;
@@ -52,7 +53,8 @@ public:
         BSDFSample bs;
         bool has_glossy = ctx.is_enabled(BSDFFlags::GlossyReflection, 0);
         bool has_diffuse = ctx.is_enabled(BSDFFlags::DiffuseReflection, 1);
-        if (Frame::cos_theta(si.wi) <= 0.f || (!has_glossy && !has_diffuse)) return {bs, Color3f(0.f)};
+        if (Frame::cos_theta(si.wi) <= 0.f || (!has_glossy && !has_diffuse))
+            return {bs, Color3f(0.f)};
 
         float p_glossy = lobe_probability(has_glossy, has_diffuse);
         if (sample1 < p_glossy) {
@@ -75,20 +77,23 @@ public:
         return {bs, eval(ctx, si, bs.wo) / bs.pdf};
     }
 
-    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
+    Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
+                 const Vector3f &wo) const override {
         float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Color3f(0.f);
         Color3f f(0.f);
         if (ctx.is_enabled(BSDFFlags::GlossyReflection, 0)) {
             float cos_alpha = dot(mirror(si.wi), wo);
             if (cos_alpha > 0.f)
-                f += m_specular->eval(si) * ((m_exponent + 2.f) * InvTwoPi * std::pow(cos_alpha, m_exponent));
+                f += m_specular->eval(si) *
+                     ((m_exponent + 2.f) * InvTwoPi * std::pow(cos_alpha, m_exponent));
         }
         if (ctx.is_enabled(BSDFFlags::DiffuseReflection, 1)) f += m_diffuse->eval(si) * InvPi;
         return f * cos_o;
     }
 
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const override {
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
+              const Vector3f &wo) const override {
         bool has_glossy = ctx.is_enabled(BSDFFlags::GlossyReflection, 0);
         bool has_diffuse = ctx.is_enabled(BSDFFlags::DiffuseReflection, 1);
         float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
@@ -106,8 +111,9 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("Phong[diffuse_reflectance = {}, specular_reflectance = {}, exponent = {}]",
-                           m_diffuse->to_string(), m_specular->to_string(), m_exponent);
+        return fmt::format(
+            "Phong[diffuse_reflectance = {}, specular_reflectance = {}, exponent = {}]",
+            m_diffuse->to_string(), m_specular->to_string(), m_exponent);
     }
 
 private:
