@@ -2,7 +2,8 @@
 // noise? The rule, applied per pixel and XYZ channel with N samples per pixel:
 //   z = |ours - ref| · sqrt(N / max(var, 1e-4)),  p = erfc(z / √2)
 // and with the Šidák-corrected level alpha = 1 - 0.99^(1 / pixels) the render agrees when at least
-// 99.75% of the pixel-channels have p > alpha.
+// 99.75% of the pixel-channels have p > alpha. The last line of the output is the verdict:
+//   PASS|FAIL agreeing=<%> required=<%> rel_error=<%> ratio=<mean Y ours / mean Y reference>
 
 #include "commands.h"
 
@@ -119,6 +120,10 @@ int compare_main(int argc, char **argv) {
     fmt::print("mean brightness (Y): ours {:.6g}, reference {:.6g}, relative difference {:+.3f}%\n",
                sum_ours / double(pixels), sum_ref / double(pixels), 100.0 * brightness);
     if (!z_path.empty()) write_image(z_path, z_img);
-    fmt::print("{}\n", ok ? "PASS" : "FAIL");
+    // The verdict in one stable line for scripts and test logs: the agreeing fraction and the
+    // relative error of the mean (mean brightness ratio - 1).
+    fmt::print("{} agreeing={:.3f}% required={:.2f}% rel_error={:+.3f}% ratio={:.6f}\n",
+               ok ? "PASS" : "FAIL", 100.0 * fraction, 100.0 * PassFraction, 100.0 * brightness,
+               1.0 + brightness);
     return ok ? 0 : 1;
 }
