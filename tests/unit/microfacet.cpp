@@ -301,3 +301,92 @@ TEST(MicrofacetParameters, RejectsBadParameters) {
     EXPECT_THROW(read_microfacet(textured, 0.1f, false), Error);
     EXPECT_NO_THROW(read_microfacet(textured, 0.1f, true));
 }
+
+namespace {
+
+/// The density of the normal that all-normals sampling draws for u, in double precision from u
+/// by the inverse-CDF formulas (REFERENCE §4), so that no float rounding of the normal enters.
+double pdf_from_u(const MicrofacetDistribution &distr, const Point2f &u) {
+    const double au = distr.alpha_u(), av = distr.alpha_v();
+    const bool ggx = distr.type() == MicrofacetType::GGX;
+    double phi, alpha_2;
+    if (au == av) {
+        phi = 2.0 * M_PI * u.y;
+        alpha_2 = au * au;
+    } else {
+        phi = std::atan(av / au * std::tan(2.0 * M_PI * u.y));
+        if (std::abs(u.y - 0.5) < 0.25) phi += M_PI;
+        alpha_2 = 1.0 / ((std::cos(phi) / au) * (std::cos(phi) / au) +
+                         (std::sin(phi) / av) * (std::sin(phi) / av));
+    }
+    double tan_2 = ggx ? alpha_2 * u.x / (1.0 - u.x) : -alpha_2 * std::log1p(-double(u.x));
+    double cos_3 = std::pow(1.0 + tan_2, -1.5);
+    return ggx ? 1.0 / (M_PI * au * av * cos_3 * (1.0 + tan_2 / alpha_2) * (1.0 + tan_2 / alpha_2))
+               : std::exp(-tan_2 / alpha_2) / (M_PI * au * av * cos_3);
+}
+
+/// pdf(wi, m) of the direction of m in double precision (D, the exact visible normalisation,
+/// wi·m), for visible-normal sampling, whose float chain from u to m is itself ill-conditioned
+/// near the horizon of the normals: there the density must be that of the normal returned.
+double pdf_of_direction(const MicrofacetDistribution &distr, const Vector3f &wi_f,
+                        const Vector3f &m_f) {
+    double n = std::sqrt(double(m_f.x) * m_f.x + double(m_f.y) * m_f.y + double(m_f.z) * m_f.z);
+    double mx = m_f.x / n, my = m_f.y / n, mz = m_f.z / n;
+    double au = distr.alpha_u(), av = distr.alpha_v();
+    double e = (mx / au) * (mx / au) + (my / av) * (my / av), c2 = mz * mz;
+    double D = distr.type() == MicrofacetType::Beckmann
+                   ? std::exp(-e / c2) / (M_PI * au * av * c2 * c2)
+                   : 1.0 / (M_PI * au * av * (e + c2) * (e + c2));
+    double wx = wi_f.x, wy = wi_f.y, wz = wi_f.z;
+    double t = ((au * wx) * (au * wx) + (av * wy) * (av * wy)) / (wz * wz);
+    double g1 = 1.0;
+    if (t > 0.0)
+        g1 = distr.type() == MicrofacetType::GGX ? 2.0 / (1.0 + std::sqrt(1.0 + t))
+                                                 : beckmann_g1_exact(1.0 / std::sqrt(t));
+    return D * g1 * std::max(0.0, wx * mx + wy * my + wz * mz) / wz;
+}
+
+} // namespace
+
+TEST(MicrofacetSampling, SampledPdfMatchesDoublePrecision) {
+    // sample() computes the density from tan²θ of the normal it draws (from the slope, for
+    // visible normals), not from that normal rebuilt in float: rebuilt, cos θm is rounded and
+    // D(m) inherits the rounding amplified (1.7e-4 relative for GGX all-normals sampling at
+    // α = 0.05). Checked against the density of the same draw in double precision, for incident
+    // directions down to cos θi = 0.05.
+    struct Case {
+        MicrofacetType type;
+        float alpha_u, alpha_v;
+        bool visible;
+    };
+    for (const Case &c :
+         {Case{MicrofacetType::GGX, 0.5f, 0.5f, false}, Case{MicrofacetType::GGX, 0.5f, 0.5f, true},
+          Case{MicrofacetType::GGX, 0.45f, 0.55f, false},
+          Case{MicrofacetType::GGX, 0.45f, 0.55f, true},
+          Case{MicrofacetType::GGX, 0.05f, 0.05f, false},
+          Case{MicrofacetType::GGX, 0.05f, 0.05f, true},
+          Case{MicrofacetType::Beckmann, 0.5f, 0.5f, false},
+          Case{MicrofacetType::Beckmann, 0.05f, 0.05f, false},
+          Case{MicrofacetType::Beckmann, 0.5f, 0.5f, true}}) {
+        MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, c.visible);
+        std::string name =
+            name_of(Config{c.type, c.alpha_u, c.alpha_v}) + (c.visible ? " visible" : " all");
+        PCG32 rng(21);
+        double worst = 0.0;
+        int checked = 0;
+        for (int i = 0; i < 200000; ++i) {
+            Vector3f wi =
+                warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+            Point2f u(rng.next_float(), rng.next_float());
+            if (wi.z < 0.05f) continue;
+            auto [m, pdf] = distr.sample(wi, u);
+            if (pdf == 0.f) continue;
+            double ref = c.visible ? pdf_of_direction(distr, wi, m) : pdf_from_u(distr, u);
+            if (ref < 1e-3) continue; // far in the tail, where relative errors are moot
+            worst = std::max(worst, std::abs(double(pdf) - ref) / ref);
+            ++checked;
+        }
+        EXPECT_GT(checked, 150000) << name;
+        EXPECT_LT(worst, 2e-5) << name << ": worst relative error of the sampled pdf";
+    }
+}
