@@ -14,8 +14,9 @@ ignored.
 | bsdf_samples | integer | shading_samples | BSDF samples per camera sample |
 | hide_emitters | boolean | false | Hide emitters (area lights and the environment) seen directly by the camera |
 
-`shading_samples` cannot be combined with `emitter_samples` or `bsdf_samples`; at least one
-sample of either kind is needed.
+`shading_samples` is only the default of the other two: with `shading_samples` 4 and
+`bsdf_samples` 1, the integrator takes 4 emitter samples and 1 BSDF sample. At least one sample
+of either kind is needed.
 
 ```xml
 <integrator type="direct">
@@ -52,11 +53,8 @@ uint32_t read_count(const Properties &props, const char *name, int64_t def) {
 class DirectIntegrator final : public SamplingIntegrator {
 public:
     explicit DirectIntegrator(const Properties &props) {
-        if (props.has("shading_samples") &&
-            (props.has("emitter_samples") || props.has("bsdf_samples")))
-            FACET_THROW_AT(props.location("shading_samples"),
-                           "direct: give either shading_samples or emitter_samples/bsdf_samples, "
-                           "not both");
+        // As in Mitsuba 3, shading_samples is only the default of the two counts: a scene may
+        // give it together with either of them (the one given wins).
         uint32_t shading = read_count(props, "shading_samples", 1);
         m_emitter_samples = read_count(props, "emitter_samples", shading);
         m_bsdf_samples = read_count(props, "bsdf_samples", shading);

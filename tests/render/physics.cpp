@@ -505,8 +505,6 @@ TEST(PathVsDirect, HiddenEnvironment) {
 TEST(Integrators, RejectBadParameters) {
     EXPECT_THROW(make_integrator("path", {{"max_depth", -2}}), Error);
     EXPECT_THROW(make_integrator("path", {{"rr_depth", 0}}), Error);
-    EXPECT_THROW(make_integrator("direct", {{"shading_samples", 2}, {"emitter_samples", 1}}),
-                 Error);
     EXPECT_THROW(make_integrator("direct", {{"emitter_samples", 0}, {"bsdf_samples", 0}}), Error);
     EXPECT_THROW(make_integrator("direct", {{"bsdf_samples", -1}}), Error);
 }
