@@ -172,13 +172,16 @@ int chi2_main(int argc, char **argv) {
 
     // emitter
     CommonOptions eo;
-    std::string emitter_name, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
+    std::string emitter_name, emitter_xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
     std::vector<std::string> emitter_params;
     CLI::App *emitter = app.add_subcommand(
         "emitter",
         "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
     emitter->add_option("name", emitter_name, "Emitter plugin name")->required();
     emitter->add_option("params", emitter_params, "Parameters, as for bsdf");
+    emitter->add_option("--xml", emitter_xml,
+                        "The emitter as XML text (an <emitter> or a whole <scene>), for "
+                        "parameters key=value cannot give (e.g. to_world)");
     emitter->add_option("--ref", ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
     emitter->add_option(
         "--shape", shape,
@@ -243,8 +246,17 @@ int chi2_main(int argc, char **argv) {
     if (emitter->parsed()) {
         add_plugin_dirs(eo.plugin_dirs);
         auto r = parse_floats(ref_text, 3, "--ref");
-        EmitterAdapter adapter(EmitterAdapter::scene_xml(emitter_name, emitter_params, shape),
-                               Point3f(r[0], r[1], r[2]));
+        std::string text;
+        if (!emitter_xml.empty()) {
+            if (!emitter_params.empty())
+                FACET_THROW("key=value parameters cannot be added to --xml");
+            text = emitter_xml.rfind("<scene", 0) == 0
+                       ? emitter_xml
+                       : "<scene version=\"3.0.0\">" + emitter_xml + "</scene>";
+        } else {
+            text = EmitterAdapter::scene_xml(emitter_name, emitter_params, shape);
+        }
+        EmitterAdapter adapter(text, Point3f(r[0], r[1], r[2]));
         return run(adapter, eo, slug("emitter", emitter_name, everything));
     }
     // microfacet
