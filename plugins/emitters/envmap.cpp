@@ -2,22 +2,35 @@ static const char *DOC = R"DOC(
 # envmap: environment map
 
 Light from infinitely far away, given by a latitude-longitude image (EXR, HDR, PNG, ... read
-through OpenImageIO; 8-bit images are decoded from sRGB). The image's top row is the +Y
-direction (up); u runs around the vertical axis. Directions are sampled in proportion to the
-map's luminance times the solid angle of each pixel, so bright skies and suns are found quickly.
+through OpenImageIO; 8-bit images are decoded from sRGB), with Mitsuba 3's conventions. A
+direction d (in the map's frame, after the inverse of `to_world`) has u = atan2(d.x, -d.z)/2π
+(wrapped to [0, 1); the u = 0 seam lies towards -Z, u = 1/4 towards +X) and v = acos(d.y)/π.
+Longitude is texel-centred and wraps: column i sits at u = (i + ½)/W and the lookup blends
+across the seam. Latitude is corner-aligned: row j sits at v = j/(H - 1), so the first row is
+exactly the +Y pole and the last row the -Y pole. An image needs at least 2x3 pixels.
+Negative pixel values are kept.
 
-| Parameter           | Type      | Default  | Description                                                   |
-|---------------------|-----------|----------|---------------------------------------------------------------|
-| filename            | string    | —        | Latitude-longitude image (required)                           |
-| scale               | float     | 1        | Multiplies the radiance                                       |
-| to_world            | transform | identity | Orientation of the map (rotation only)                        |
-| filter_type         | string    | bilinear | Lookup filter: bilinear or nearest                            |
-| importance_sampling | boolean   | true     | false: sample directions uniformly (facet extension, testing) |
+Directions are sampled in proportion to the luminance times sin θ on the same grid,
+interpolated bilinearly between grid points. With `mis_compensation` the map's mean luminance
+is subtracted first (clamped at zero; Karlík et al. 2019), which helps when the emitter is
+combined with BSDF sampling by MIS; it is skipped for near-constant maps.
+
+| Parameter           | Type      | Default  | Description                                                        |
+|---------------------|-----------|----------|--------------------------------------------------------------------|
+| filename            | string    | —        | Latitude-longitude image (required)                                |
+| scale               | float     | 1        | Multiplies the radiance                                            |
+| to_world            | transform | identity | Orientation of the map (rotation only)                             |
+| mis_compensation    | boolean   | false    | Sample only where the map is brighter than its mean luminance      |
+| filter_type         | string    | bilinear | Lookup filter: bilinear or nearest (facet extension)               |
+| importance_sampling | boolean   | true     | false: sample directions uniformly (facet extension, for testing)  |
 
 ```xml
 <emitter type="envmap">
     <string name="filename" value="sky.exr"/>
     <float name="scale" value="1.5"/>
+    <transform name="to_world">
+        <rotate y="1" angle="70"/>
+    </transform>
 </emitter>
 ```
 )DOC";
@@ -40,6 +53,9 @@ namespace {
 float srgb_to_linear(float v) {
     return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
+/// Floor of sin θ in the density (Mitsuba's float epsilon), so the poles keep a finite pdf.
+constexpr float SinThetaFloor = 0x1p-24f;
+
 bool is_display_encoded(const std::string &path) {
     std::string ext = path.substr(path.find_last_of('.') + 1);
     std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -56,6 +72,7 @@ public:
         m_path = file_resolver().resolve(filename);
         m_scale = float(props.get_float("scale", 1.0));
         m_to_world = props.get_transform("to_world", Transform());
+        m_mis_compensation = props.get_bool("mis_compensation", false);
         std::string filter = props.get_string("filter_type", "bilinear");
         if (filter != "bilinear" && filter != "nearest")
             FACET_THROW_AT(props.location("filter_type"),
@@ -69,25 +86,31 @@ public:
         } catch (const Error &e) {
             FACET_THROW_AT(props.location("filename"), "envmap: {}", e.what());
         }
-        if (img.width < 1 || img.height < 1)
-            FACET_THROW_AT(props.location("filename"), "envmap: \"{}\" is empty", m_path);
+        if (img.width < 2 || img.height < 3)
+            FACET_THROW_AT(props.location("filename"),
+                           "envmap: \"{}\" is {}x{} pixels; an environment map needs at least 2x3 "
+                           "(width x height)",
+                           m_path, img.width, img.height);
         bool decode = is_display_encoded(m_path);
         m_width = img.width;
         m_height = img.height;
+        // Grey (and grey + alpha) images are grey; an alpha channel is ignored.
+        int colour_channels = img.channels >= 3 ? 3 : 1;
         m_pixels.resize(size_t(m_width) * m_height);
         for (int y = 0; y < m_height; ++y)
             for (int x = 0; x < m_width; ++x) {
                 Color3f c;
                 for (int ch = 0; ch < 3; ++ch) {
-                    float v = img.at(x, y, std::min(ch, img.channels - 1));
+                    float v = img.at(x, y, std::min(ch, colour_channels - 1));
                     c[ch] = (decode ? srgb_to_linear(v) : v) * m_scale;
                 }
                 if (!c.is_finite())
                     FACET_THROW_AT(props.location("filename"),
                                    "envmap: \"{}\" has a non-finite pixel at ({}, {})", m_path, x,
                                    y);
-                m_pixels[size_t(y) * m_width + x] =
-                    Color3f(std::max(c.r, 0.f), std::max(c.g, 0.f), std::max(c.b, 0.f));
+                // Negative values are kept, as Mitsuba keeps them; only the sampling table
+                // clamps at zero.
+                m_pixels[size_t(y) * m_width + x] = c;
             }
         build_distribution();
         m_flags = EmitterFlags::Infinite | EmitterFlags::SpatiallyVarying;
@@ -101,8 +124,8 @@ public:
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
                                                          const Point2f &u) const override {
         DirectionSample ds;
-        Vector3f local = m_importance && m_cells.sum() > 0.0 ? uv_to_direction(sample_uv(u))
-                                                             : warp::square_to_uniform_sphere(u);
+        Vector3f local =
+            sampling_enabled() ? uv_to_direction(sample_uv(u)) : warp::square_to_uniform_sphere(u);
         ds.d = normalize(m_to_world.apply_vector(local));
         ds.dist = Infinity;
         ds.p = ref.p + ds.d * (2.f * m_radius + norm(ref.p - m_center));
@@ -126,12 +149,12 @@ public:
     }
 
     std::string to_string() const override {
-        return fmt::format("EnvironmentMap[\"{}\", {}x{}, scale={}]", m_path, m_width, m_height,
-                           m_scale);
+        return fmt::format("EnvironmentMap[\"{}\", {}x{}, scale={}, mis_compensation={}]", m_path,
+                           m_width, m_height, m_scale, m_mis_compensation);
     }
 
 private:
-    /// uv in [0,1]²: u = φ/2π around +Y measured from -Z towards +X, v = θ/π from +Y.
+    /// uv in [0,1]²: u = atan2(x, -z)/2π around +Y from -Z towards +X, v = θ/π from +Y.
     static Point2f direction_to_uv(const Vector3f &d) {
         float u = std::atan2(d.x, -d.z) * InvTwoPi;
         u -= std::floor(u);
@@ -143,90 +166,45 @@ private:
         return {std::sin(phi) * st, std::cos(theta), -std::cos(phi) * st};
     }
 
+    /// Grid position of uv: longitude texel-centred (column i at u = (i + ½)/W, wrapping),
+    /// latitude corner-aligned (row j at v = j/(H-1), the poles on the first and last rows).
+    /// Returns the lower grid indices (i ≤ W-1, j ≤ H-2) and the fractions towards the next.
+    void grid(const Point2f &uv, int &i, int &j, float &s, float &t) const {
+        float x = uv.x - 0.5f / float(m_width);
+        x = (x - std::floor(x)) * float(m_width);
+        float y = clamp(uv.y, 0.f, 1.f) * float(m_height - 1);
+        i = std::min(int(x), m_width - 1);
+        j = std::min(int(y), m_height - 2);
+        s = x - float(i);
+        t = y - float(j);
+    }
+
     const Color3f &pixel(int x, int y) const {
-        x = ((x % m_width) + m_width) % m_width; // wrap around in longitude
-        y = std::clamp(y, 0, m_height - 1);
+        if (x >= m_width) x -= m_width; // column W is column 0 again
         return m_pixels[size_t(y) * m_width + x];
     }
 
     Color3f lookup(const Vector3f &local) const {
-        Point2f uv = direction_to_uv(local);
-        float fx = uv.x * float(m_width), fy = uv.y * float(m_height);
-        if (!m_bilinear) return pixel(int(fx), int(fy));
-        fx -= 0.5f;
-        fy -= 0.5f;
-        int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
-        float tx = fx - float(x0), ty = fy - float(y0);
-        return (pixel(x0, y0) * (1.f - tx) + pixel(x0 + 1, y0) * tx) * (1.f - ty) +
-               (pixel(x0, y0 + 1) * (1.f - tx) + pixel(x0 + 1, y0 + 1) * tx) * ty;
+        int i, j;
+        float s, t;
+        grid(direction_to_uv(local), i, j, s, t);
+        if (!m_bilinear) return pixel(s < 0.5f ? i : i + 1, t < 0.5f ? j : j + 1);
+        return (pixel(i, j) * (1.f - s) + pixel(i + 1, j) * s) * (1.f - t) +
+               (pixel(i, j + 1) * (1.f - s) + pixel(i + 1, j + 1) * s) * t;
     }
 
     // -- Importance sampling ------------------------------------------------------------------
-    // The bilinear lookup is a bilinear patch between each 2×2 group of pixel centres, so the
-    // sampling density is built on those patches: cell (i, j) spans u from (i + ½)/W to
-    // (i + 1½)/W (wrapping around) and v from (j - ½)/H to (j + ½)/H (clamped to [0, 1]; the
-    // half cells at the poles are constant in v). A cell is picked in proportion to its mean
-    // luminance times its solid angle, and a point inside it in proportion to the bilinear
-    // luminance, so the density is zero exactly where the radiance is. With nearest lookups
-    // the cells are the pixels and the density is constant inside each.
+    // The table lives on the lookup's grid: (W + 1) × H values, column W repeating column 0,
+    // value (i, j) = max(luminance - offset, 0) · sin(π j / (H - 1)) (offset: the MIS
+    // compensation, else 0). The density over the shifted square (u - ½/W, v) is the bilinear
+    // interpolation of the table between grid points: a cell (i, j) of the W × (H - 1) grid is
+    // picked in proportion to the mean of its four corners and a point inside it in proportion
+    // to the bilinear patch. In solid angle, dω = 2π² sin θ du dv. With nearest lookups the
+    // same density still covers every direction whose radiance is not zero.
 
-    struct Cell {
-        float u0, du, v0, dv;
-        float a, b, c,
-            d; ///< luminance at the corners (u0,v0), (u0+du,v0), (u0,v0+dv), (u0+du,v0+dv)
-    };
+    bool sampling_enabled() const { return m_importance && m_total > 0.0; }
 
-    Cell cell(int i, int j) const {
-        Cell c;
-        if (!m_bilinear) {
-            c.u0 = float(i) / float(m_width);
-            c.du = 1.f / float(m_width);
-            c.v0 = float(j) / float(m_height);
-            c.dv = 1.f / float(m_height);
-            c.a = c.b = c.c = c.d = pixel(i, j).luminance();
-            return c;
-        }
-        c.u0 = (float(i) + 0.5f) / float(m_width);
-        c.du = 1.f / float(m_width);
-        float v0 = std::max(0.f, (float(j) - 0.5f) / float(m_height));
-        float v1 = std::min(1.f, (float(j) + 0.5f) / float(m_height));
-        c.v0 = v0;
-        c.dv = v1 - v0;
-        c.a = pixel(i, j - 1).luminance();
-        c.b = pixel(i + 1, j - 1).luminance();
-        c.c = pixel(i, j).luminance();
-        c.d = pixel(i + 1, j).luminance();
-        return c;
-    }
-
-    int cells_x() const { return m_width; }
-    int cells_y() const { return m_bilinear ? m_height + 1 : m_height; }
-
-    /// Cell holding uv, its index, and uv's position (s, t) inside it.
-    Cell locate(const Point2f &uv, size_t &index, float &s, float &t) const {
-        int i, j;
-        if (m_bilinear) {
-            float fx = uv.x * float(m_width) - 0.5f;
-            i = int(std::floor(fx));
-            j = std::clamp(int(std::floor(uv.y * float(m_height) + 0.5f)), 0, m_height);
-        } else {
-            i = int(uv.x * float(m_width));
-            j = std::clamp(int(uv.y * float(m_height)), 0, m_height - 1);
-        }
-        i = ((i % m_width) + m_width) % m_width;
-        index = size_t(j) * size_t(cells_x()) + size_t(i);
-        Cell c = cell(i, j);
-        float du = uv.x - c.u0;
-        du -= std::floor(du); // wrap across the seam
-        s = clamp(du / c.du, 0.f, 1.f);
-        t = c.dv > 0.f ? clamp((uv.y - c.v0) / c.dv, 0.f, 1.f) : 0.f;
-        return c;
-    }
-
-    static float bilinear(const Cell &c, float s, float t) {
-        return (1.f - s) * (1.f - t) * c.a + s * (1.f - t) * c.b + (1.f - s) * t * c.c +
-               s * t * c.d;
-    }
+    float table(int i, int j) const { return m_table[size_t(j) * size_t(m_width + 1) + size_t(i)]; }
 
     /// Inverse CDF of the density on [0, 1] proportional to the line from v0 to v1.
     static float sample_linear(float u, float v0, float v1) {
@@ -238,53 +216,75 @@ private:
     Point2f sample_uv(Point2f u) const {
         float uc = u.x;
         size_t index = m_cells.sample_reuse(uc);
-        Cell c = cell(int(index % size_t(cells_x())), int(index / size_t(cells_x())));
-        float t = sample_linear(u.y, 0.5f * (c.a + c.b), 0.5f * (c.c + c.d));
-        float s = sample_linear(uc, lerp(t, c.a, c.c), lerp(t, c.b, c.d));
-        float uu = c.u0 + s * c.du;
+        int i = int(index % size_t(m_width)), j = int(index / size_t(m_width));
+        float a = table(i, j), b = table(i + 1, j), c = table(i, j + 1), d = table(i + 1, j + 1);
+        float t = sample_linear(u.y, 0.5f * (a + b), 0.5f * (c + d));
+        float s = sample_linear(uc, lerp(t, a, c), lerp(t, b, d));
+        float uu = (float(i) + s + 0.5f) / float(m_width);
         uu -= std::floor(uu);
-        return {std::min(uu, OneMinusEpsilon), c.v0 + t * c.dv};
-    }
-
-    /// Density per unit solid angle at uv (local direction `local`): the cell's probability
-    /// spread by the bilinear luminance, over the Jacobian dω = 2π² sin θ du dv.
-    float pdf_solid_angle(const Point2f &uv, const Vector3f &local) const {
-        float s, t;
-        size_t index;
-        Cell c = locate(uv, index, s, t);
-        float mean = 0.25f * (c.a + c.b + c.c + c.d);
-        // sin θ straight from the direction: acos near the poles would lose precision.
-        float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
-        if (!(mean > 0.f) || !(sin_theta > 0.f)) return 0.f;
-        float pdf_uv = m_cells.pmf(index) / (c.du * c.dv) * bilinear(c, s, t) / mean;
-        return pdf_uv / (2.f * Pi * Pi * sin_theta);
+        return {std::min(uu, OneMinusEpsilon), (float(j) + t) / float(m_height - 1)};
     }
 
     float pdf_local(const Vector3f &local) const {
-        if (!(m_importance && m_cells.sum() > 0.0)) return InvFourPi;
-        return pdf_solid_angle(direction_to_uv(local), local);
+        if (!sampling_enabled()) return InvFourPi;
+        int i, j;
+        float s, t;
+        grid(direction_to_uv(local), i, j, s, t);
+        float value = (table(i, j) * (1.f - s) + table(i + 1, j) * s) * (1.f - t) +
+                      (table(i, j + 1) * (1.f - s) + table(i + 1, j + 1) * s) * t;
+        // sin θ straight from the direction (acos near the poles would lose precision),
+        // floored as in Mitsuba so that the poles keep a finite density.
+        float sin_theta = std::max(std::sqrt(local.x * local.x + local.z * local.z), SinThetaFloor);
+        return value * m_density_scale / (2.f * Pi * Pi * sin_theta);
     }
 
     void build_distribution() {
-        std::vector<float> weights(size_t(cells_x()) * size_t(cells_y()));
-        for (int j = 0; j < cells_y(); ++j)
-            for (int i = 0; i < cells_x(); ++i) {
-                Cell c = cell(i, j);
-                float solid_angle =
-                    2.f * Pi * c.du * (std::cos(c.v0 * Pi) - std::cos((c.v0 + c.dv) * Pi));
-                weights[size_t(j) * size_t(cells_x()) + size_t(i)] =
-                    0.25f * (c.a + c.b + c.c + c.d) * solid_angle;
-            }
-        m_cells.build(weights.data(), weights.size());
+        const int W = m_width, H = m_height;
+        std::vector<float> lum(size_t(W) * H);
+        double sum = 0.0;
+        float min_lum = Infinity;
+        for (size_t k = 0; k < lum.size(); ++k) {
+            lum[k] = m_pixels[k].luminance();
+            sum += double(lum[k]);
+            min_lum = std::min(min_lum, lum[k]);
+        }
+        // MIS compensation (Karlík et al. 2019): sample only where the map is brighter than its
+        // mean; skipped for near-constant maps, where it would leave (almost) nothing.
+        float offset = 0.f;
+        if (m_mis_compensation) {
+            offset = float(sum / double(lum.size()));
+            if (offset - min_lum <= 0.01f * offset) offset = 0.f;
+        }
+        m_table.assign(size_t(W + 1) * H, 0.f);
+        for (int j = 0; j < H; ++j) {
+            // Zero on the pole rows (sin of a float π is slightly negative).
+            float sin_theta = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
+            if (j == H - 1) sin_theta = 0.f;
+            for (int i = 0; i <= W; ++i)
+                m_table[size_t(j) * size_t(W + 1) + size_t(i)] =
+                    std::max(lum[size_t(j) * W + size_t(i % W)] - offset, 0.f) * sin_theta;
+        }
+        std::vector<float> cells(size_t(W) * size_t(H - 1));
+        for (int j = 0; j + 1 < H; ++j)
+            for (int i = 0; i < W; ++i)
+                cells[size_t(j) * W + size_t(i)] =
+                    0.25f * (table(i, j) + table(i + 1, j) + table(i, j + 1) + table(i + 1, j + 1));
+        m_cells.build(cells.data(), cells.size());
+        m_total = m_cells.sum();
+        // Density over the unit square = table value / (mean cell value).
+        m_density_scale = m_total > 0.0 ? float(double(cells.size()) / m_total) : 0.f;
     }
 
     std::string m_path;
     float m_scale = 1.f;
     Transform m_to_world;
-    bool m_bilinear = true, m_importance = true;
+    bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
     std::vector<Color3f> m_pixels;
+    std::vector<float> m_table;
     DiscreteDistribution m_cells;
+    double m_total = 0.0;
+    float m_density_scale = 0.f;
     Point3f m_center;
     float m_radius = 1.f;
 };

@@ -2,7 +2,8 @@
 // by an environment map. Every pixel then estimates the same number, ρ/π ∫ L(ω) cos θ dω over
 // the upper hemisphere, which the test integrates by quadrature of the emitter's own lookup.
 // Importance sampling and uniform sampling of the map must agree with it (and with each other)
-// within their noise, and importance sampling must be the less noisy one.
+// within their noise, and importance sampling must be the less noisy one. A map that varies by
+// row only has a closed form under Mitsuba's corner-aligned rows (row j at θ = πj/(H-1)).
 
 #include <facet/emitter.h>
 #include <facet/image.h>
@@ -32,6 +33,21 @@ std::string write_sky(const fs::path &dir) {
             for (int ch = 0; ch < 3; ++ch) img.at(x, y, ch) = c[ch];
         }
     std::string path = (dir / "sky.exr").string();
+    write_image(path, img);
+    return path;
+}
+
+/// A 4×3 map constant along each row: `zenith` on the first row (θ = 0), `horizon` on the
+/// second (θ = π/2), 0.1 on the last.
+std::string write_rows(const fs::path &dir, float zenith, float horizon) {
+    Image img(4, 3, 3);
+    for (int x = 0; x < img.width; ++x)
+        for (int ch = 0; ch < 3; ++ch) {
+            img.at(x, 0, ch) = zenith;
+            img.at(x, 1, ch) = horizon;
+            img.at(x, 2, ch) = 0.1f;
+        }
+    std::string path = (dir / "rows.exr").string();
     write_image(path, img);
     return path;
 }
@@ -137,4 +153,21 @@ TEST(EnvironmentMap, ImportanceAndUniformSamplingAgreeWithQuadrature) {
     // The sun holds most of the energy in a tiny solid angle: sampling by luminance must be
     // far less noisy than sampling the sphere uniformly.
     EXPECT_LT(is.luminance_stddev * 3.f, us.luminance_stddev);
+}
+
+TEST(EnvironmentMap, RowMapMatchesTheClosedFormOfCornerAlignedRows) {
+    // Rows at θ = 0 and π/2 with radiance a and b: over the upper hemisphere L(θ) = a + (b -
+    // a) 2θ/π, so a plane of albedo ρ facing up shows ρ/π ∫ L cos θ dω = ρ (a + b) / 2. Rows at
+    // pixel centres (θ = π/6 and π/2 for these rows) would show a different value.
+    fs::path dir = fs::temp_directory_path() / "facet-envmap-render";
+    fs::create_directories(dir);
+    const float a = 2.f, b = 0.5f, rho = 0.5f;
+    std::string map = write_rows(dir, a, b);
+    float expected = rho * (a + b) / 2.f;
+    for (bool importance : {true, false}) {
+        Stats s = render_stats(scene_xml(map, importance));
+        for (int ch = 0; ch < 3; ++ch)
+            EXPECT_NEAR(s.mean[ch], expected, 4.f * s.stderr_[ch] + 1e-3f * expected)
+                << (importance ? "importance" : "uniform") << ", channel " << ch;
+    }
 }

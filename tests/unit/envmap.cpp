@@ -1,6 +1,8 @@
-// The envmap emitter: the direction mapping (+Y is the top row, u turns around +Y), its pdf
-// integrating to one, and chi-square tests of its importance sampling on the maps Mitsuba uses
-// for the same purpose (a single bright pixel, a constant map, a tiny 3×2 map) and on a rotated
+// The envmap emitter with Mitsuba 3's conventions: u = atan2(x, -z)/2π with texel-centred,
+// wrapping columns; v = acos(y)/π with corner-aligned rows (the first and last rows on the
+// poles); the sampling table on the same grid; the size limits; negative texels; MIS
+// compensation. Then chi-square tests of its importance sampling on the maps Mitsuba uses for
+// the same purpose (a single bright pixel, a constant map, a tiny 3×3 map) and on a rotated
 // HDR sky.
 
 #include <facet/chi2.h>
@@ -57,25 +59,163 @@ std::shared_ptr<Scene> load(const std::string &xml) {
     return std::dynamic_pointer_cast<Scene>(load_string(xml));
 }
 
+/// Radiance the emitter shows towards direction d (seen from the scene).
+Color3f look(const Emitter &env, const Vector3f &d) {
+    SurfaceInteraction si;
+    si.wi = -normalize(d);
+    return env.eval(si);
+}
+
+/// The direction of (u, v) in the map's frame: θ = πv, φ = 2πu, d = (sin φ sin θ, cos θ,
+/// -cos φ sin θ).
+Vector3f direction(double u, double v) {
+    double phi = 2 * M_PI * u, theta = M_PI * v;
+    return Vector3f(float(std::sin(phi) * std::sin(theta)), float(std::cos(theta)),
+                    float(-std::cos(phi) * std::sin(theta)));
+}
+
+void expect_color_near(const Color3f &a, const Color3f &b, float tol) {
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(a[ch], b[ch], tol) << "channel " << ch;
+}
+
 } // namespace
 
 TEST(EnvironmentMap, TopRowIsUpAndUTurnsAroundY) {
-    // Left half red, right half green, top rows blue.
+    // Left half red, right half green, top row blue.
     std::string map = write_map("quadrants.exr", 8, 4, [](int x, int y) {
         if (y == 0) return Color3f(0, 0, 1);
         return x < 4 ? Color3f(1, 0, 0) : Color3f(0, 1, 0);
     });
     auto scene = load(scene_with(map, R"(<string name="filter_type" value="nearest"/>)"));
     const Emitter &env = *scene->environment_emitters().at(0);
-    auto look = [&](const Vector3f &d) {
-        SurfaceInteraction si;
-        si.wi = -normalize(d);
-        return env.eval(si);
-    };
-    EXPECT_EQ(look({0, 1, 0}), Color3f(0, 0, 1));
+    EXPECT_EQ(look(env, {0, 1, 0}), Color3f(0, 0, 1));
     // u = atan2(x, -z) / 2π: -Z is u = 0 (left edge), +X is u = 1/4 (left half), -X is u = 3/4.
-    EXPECT_EQ(look({1, -0.2f, 0}), Color3f(1, 0, 0));
-    EXPECT_EQ(look({-1, -0.2f, 0}), Color3f(0, 1, 0));
+    EXPECT_EQ(look(env, {1, -0.2f, 0}), Color3f(1, 0, 0));
+    EXPECT_EQ(look(env, {-1, -0.2f, 0}), Color3f(0, 1, 0));
+}
+
+TEST(EnvironmentMap, FirstAndLastRowsLieOnThePoles) {
+    // Every row its own colour: the first row is seen exactly at +Y and the last exactly at
+    // -Y, from any azimuth; row j is seen exactly at v = j / (H - 1).
+    const int H = 5;
+    std::string map = write_map("rows.exr", 6, H, [](int, int y) {
+        return Color3f(float(y), float(y * y), 1.f + 0.5f * float(y));
+    });
+    auto scene = load(scene_with(map));
+    const Emitter &env = *scene->environment_emitters().at(0);
+    auto row = [](int y) { return Color3f(float(y), float(y * y), 1.f + 0.5f * float(y)); };
+    EXPECT_EQ(look(env, {0, 1, 0}), row(0));
+    EXPECT_EQ(look(env, {0, -1, 0}), row(H - 1));
+    for (double u : {0.0, 0.13, 0.5, 0.77})
+        for (int j = 0; j < H; ++j)
+            expect_color_near(look(env, direction(u, double(j) / (H - 1))), row(j), 2e-4f);
+    // Half-way between rows 1 and 2 (v = 3/8): their mean. Pixel centres in latitude
+    // ((j + ½)/H) would give 5/8 of row 1 and 3/8 of row 2 here.
+    expect_color_near(look(env, direction(0.3, 1.5 / (H - 1))), (row(1) + row(2)) * 0.5f, 2e-4f);
+}
+
+TEST(EnvironmentMap, ColumnsAreTexelCentredAndWrapAcrossTheSeam) {
+    const int W = 8;
+    auto column = [](int x) { return Color3f(float(x), 10.f - float(x), 0.5f); };
+    std::string map = write_map("columns.exr", W, 3, [&](int x, int) { return column(x); });
+    auto scene = load(scene_with(map));
+    const Emitter &env = *scene->environment_emitters().at(0);
+    // Column i is seen exactly at u = (i + ½) / W.
+    for (int i = 0; i < W; ++i)
+        expect_color_near(look(env, direction((i + 0.5) / W, 0.5)), column(i), 2e-4f);
+    // On the u = 0 seam (towards -Z) the first and last columns blend half and half, and the
+    // radiance is continuous across it.
+    Color3f seam = (column(0) + column(W - 1)) * 0.5f;
+    expect_color_near(look(env, {0, 0, -1}), seam, 2e-4f);
+    expect_color_near(look(env, direction(1e-4, 0.5)), seam, 1e-2f);
+    expect_color_near(look(env, direction(1 - 1e-4, 0.5)), seam, 1e-2f);
+    // A quarter texel either side: 3/4 of the nearer column.
+    expect_color_near(look(env, direction(0.25 / W, 0.5)),
+                      column(0) * 0.75f + column(W - 1) * 0.25f, 2e-4f);
+    expect_color_near(look(env, direction(1 - 0.25 / W, 0.5)),
+                      column(W - 1) * 0.75f + column(0) * 0.25f, 2e-4f);
+}
+
+TEST(EnvironmentMap, RefusesMapsSmallerThanTwoByThree) {
+    for (auto [w, h] : {std::pair{2, 2}, std::pair{1, 5}, std::pair{16, 2}}) {
+        std::string map = write_map("small.exr", w, h, [](int, int) { return Color3f(1.f); });
+        try {
+            load(scene_with(map));
+            ADD_FAILURE() << w << "x" << h << " map accepted";
+        } catch (const std::exception &e) {
+            EXPECT_NE(std::string(e.what()).find("at least 2x3"), std::string::npos) << e.what();
+        }
+    }
+    std::string map = write_map("smallest.exr", 2, 3, [](int, int) { return Color3f(1.f); });
+    EXPECT_NO_THROW(load(scene_with(map)));
+}
+
+TEST(EnvironmentMap, KeepsNegativeTexels) {
+    std::string map = write_map("negative.exr", 4, 3, [](int x, int y) {
+        return (x == 1 && y == 1) ? Color3f(-2.f, 0.5f, 1.f) : Color3f(1.f);
+    });
+    auto scene = load(scene_with(map));
+    const Emitter &env = *scene->environment_emitters().at(0);
+    expect_color_near(look(env, direction(1.5 / 4, 0.5)), Color3f(-2.f, 0.5f, 1.f), 1e-5f);
+}
+
+TEST(EnvironmentMap, ConstantMapDensityFollowsTheRowGrid) {
+    // A constant map's table is sin θ_j on the rows θ_j = πj/(H-1), interpolated linearly in v.
+    // On a row the density is then (H - 1) / (2π² Σ_j ½(sin θ_j + sin θ_j+1)), the trapezoid
+    // rule's normalisation; for H = 3 (rows at 0, π/2, π) that is 1/π² on the equator, not the
+    // 1/4π of a uniform sphere.
+    std::string map = write_map("flat3.exr", 4, 3, [](int, int) { return Color3f(2.f); });
+    auto scene = load(scene_with(map));
+    const Emitter &env = *scene->environment_emitters().at(0);
+    Interaction ref;
+    DirectionSample ds;
+    ds.d = direction(0.3, 0.5);
+    EXPECT_NEAR(env.pdf_direction(ref, ds), 1.0 / (M_PI * M_PI), 1e-6);
+    // Half-way to the pole the table is ½ (linear in v) while sin θ = sin(π/4).
+    ds.d = direction(0.6, 0.25);
+    EXPECT_NEAR(env.pdf_direction(ref, ds), 0.5 / (M_PI * M_PI * std::sin(M_PI / 4)), 1e-6);
+}
+
+TEST(EnvironmentMap, MisCompensationSamplesOnlyAboveTheMean) {
+    // Left half 1, right half 3 (luminance): the mean is 2, so with compensation only the
+    // bright half (and the bilinear band along its edges) is sampled.
+    std::string map = write_map("halves.exr", 16, 9,
+                                [](int x, int) { return x < 8 ? Color3f(1.f) : Color3f(3.f); });
+    auto plain = load(scene_with(map));
+    auto comp = load(scene_with(map, R"(<boolean name="mis_compensation" value="true"/>)"));
+    const Emitter &e0 = *plain->environment_emitters().at(0);
+    const Emitter &e1 = *comp->environment_emitters().at(0);
+    Interaction ref;
+    DirectionSample ds;
+    ds.d = direction(4.5 / 16, 0.5); // well inside the dark half
+    EXPECT_GT(e0.pdf_direction(ref, ds), 0.f);
+    EXPECT_EQ(e1.pdf_direction(ref, ds), 0.f);
+    ds.d = direction(12.5 / 16, 0.5); // the bright half
+    EXPECT_GT(e1.pdf_direction(ref, ds), e0.pdf_direction(ref, ds));
+    // Radiance itself is untouched.
+    EXPECT_EQ(look(e0, ds.d), look(e1, ds.d));
+    for (float a : {0.1f, 0.4f, 0.8f}) {
+        auto [s, w] = e1.sample_direction(ref, Point2f(a, 0.3f + 0.5f * a));
+        ASSERT_GT(s.pdf, 0.f);
+        // Only cells touching the bright half are sampled (radiance above the dark half's 1).
+        EXPECT_GT(look(e1, s.d).r, 1.f) << "sampled a direction in the dark half";
+    }
+}
+
+TEST(EnvironmentMap, MisCompensationIsSkippedForNearConstantMaps) {
+    // mean - min = 0.5 % of the mean: compensation would leave almost nothing, so it is off.
+    std::string map = write_map("nearly-flat.exr", 8, 5, [](int x, int y) {
+        return (x == 3 && y == 2) ? Color3f(1.f + 0.005f * 40.f) : Color3f(1.f);
+    });
+    auto plain = load(scene_with(map));
+    auto comp = load(scene_with(map, R"(<boolean name="mis_compensation" value="true"/>)"));
+    Interaction ref;
+    DirectionSample ds;
+    for (double u : {0.1, 0.45, 0.9}) {
+        ds.d = direction(u, 0.6);
+        EXPECT_EQ(plain->environment_emitters().at(0)->pdf_direction(ref, ds),
+                  comp->environment_emitters().at(0)->pdf_direction(ref, ds));
+    }
 }
 
 TEST(EnvironmentMap, ScaleAndEvalMatchSampleWeight) {
@@ -110,7 +250,7 @@ TEST(EnvironmentMapChi2, ConstantMap) {
 
 TEST(EnvironmentMapChi2, TinyMap) {
     std::string map =
-        write_map("tiny.exr", 3, 2, [](int x, int y) { return Color3f(float(1 + x + 3 * y)); });
+        write_map("tiny.exr", 3, 3, [](int x, int y) { return Color3f(float(1 + x + 3 * y)); });
     expect_chi2_passes(scene_with(map), Point3f(0.f, 0.f, 0.f));
 }
 
@@ -130,5 +270,15 @@ TEST(EnvironmentMapChi2, UniformSamplingOption) {
     std::string map =
         write_map("grad.exr", 32, 16, [](int x, int) { return Color3f(0.1f + float(x)); });
     expect_chi2_passes(scene_with(map, R"(<boolean name="importance_sampling" value="false"/>)"),
+                       Point3f(0.f, 0.f, 0.f));
+}
+
+TEST(EnvironmentMapChi2, MisCompensation) {
+    std::string map = write_map("mis-sky.exr", 48, 24, [](int x, int y) {
+        if (x >= 30 && x < 33 && y >= 6 && y < 8) return Color3f(60.f, 50.f, 40.f);
+        return Color3f(0.2f + 0.05f * float(y), 0.4f, 0.3f + 0.02f * float(x));
+    });
+    expect_chi2_passes(scene_with(map, R"(<boolean name="mis_compensation" value="true"/>
+            <transform name="to_world"><rotate y="1" angle="70"/></transform>)"),
                        Point3f(0.f, 0.f, 0.f));
 }
