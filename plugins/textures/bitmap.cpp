@@ -20,7 +20,7 @@ value, or the luminance of a colour image.
 | wrap_mode | string | repeat | Behaviour outside [0, 1]²: repeat, mirror or clamp |
 | raw | boolean | false | Use 8-bit values as stored (no sRGB decoding), for non-colour data |
 | to_uv | transform | identity | Transform applied to the texture coordinates (its x, y affine part) |
-| format | string | variant | Accepted for compatibility (variant, fp16, fp32); pixels are always stored as 32-bit floats |
+| format | string | auto | Storage precision: auto (half precision for 8- and 16-bit images such as PNG or JPEG; EXR, HDR and PFM as stored), variant (32-bit float) or fp16 (half precision) |
 | accel | boolean | true | Accepted for compatibility; lookups always run on the CPU |
 
 ```xml
@@ -64,6 +64,17 @@ float srgb_to_linear(float v) {
     return std::pow((v + 0.055f) * (1.f / 1.055f), 2.4f);
 }
 
+/// v rounded to the nearest IEEE half-precision value (ties to even; overflow to infinity).
+float round_to_half(float v) {
+    if (!std::isfinite(v) || v == 0.f) return v;
+    float a = std::fabs(v);
+    if (a >= 65520.f) return std::copysign(Infinity, v);
+    int e;
+    std::frexp(a, &e); // a = m 2^e with m in [0.5, 1): 11 significant bits, subnormals below 2^-14
+    int spacing = std::max(e - 11, -24);
+    return std::copysign(std::ldexp(std::nearbyint(std::ldexp(a, -spacing)), spacing), v);
+}
+
 /// Formats whose pixels are scene-linear floating-point values.
 bool is_linear_format(const std::string &path) {
     std::string ext = std::filesystem::path(path).extension().string();
@@ -97,10 +108,10 @@ public:
             FACET_THROW_AT(props.location("wrap_mode"),
                            "bitmap: wrap_mode must be repeat, mirror or clamp, found \"{}\"", wrap);
         m_raw = props.get_bool("raw", false);
-        std::string format = props.get_string("format", "variant");
-        if (format != "variant" && format != "fp16" && format != "fp32")
+        std::string format = props.get_string("format", "auto");
+        if (format != "auto" && format != "variant" && format != "fp16")
             FACET_THROW_AT(props.location("format"),
-                           "bitmap: format must be variant, fp16 or fp32, found \"{}\"", format);
+                           "bitmap: format must be auto, variant or fp16, found \"{}\"", format);
         props.get_bool("accel", true);
 
         Transform to_uv = props.get_transform("to_uv", Transform());
@@ -117,7 +128,12 @@ public:
         }
         if (image.width <= 0 || image.height <= 0 || image.channels <= 0)
             FACET_THROW_AT(props.location("filename"), "bitmap: \"{}\" holds no pixels", m_path);
-        load_pixels(image, !m_raw && !is_linear_format(m_path));
+        // As in Mitsuba, `auto` stores images of 16 bits per channel or fewer in half precision
+        // (after decoding). Integer formats are; a half EXR already holds half values, and
+        // float HDR/PFM/EXR files keep 32 bits.
+        bool linear = is_linear_format(m_path);
+        bool half = format == "fp16" || (format == "auto" && !linear);
+        load_pixels(image, !m_raw && !linear, half);
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
@@ -149,8 +165,9 @@ public:
     }
 
 private:
-    /// Keeps grey (1 channel) or RGB (3), drops alpha, decodes sRGB, computes mean and max.
-    void load_pixels(const Image &image, bool decode_srgb) {
+    /// Keeps grey (1 channel) or RGB (3), drops alpha, decodes sRGB, rounds to half precision
+    /// if asked, computes mean and max.
+    void load_pixels(const Image &image, bool decode_srgb, bool half) {
         m_width = image.width;
         m_height = image.height;
         m_channels = image.channels <= 2 ? 1 : 3;
@@ -162,6 +179,7 @@ private:
             for (int c = 0; c < m_channels; ++c) {
                 float v = image.data[i * size_t(image.channels) + size_t(c)];
                 if (decode_srgb) v = srgb_to_linear(v);
+                if (half) v = round_to_half(v);
                 m_data[i * size_t(m_channels) + size_t(c)] = v;
                 sum[c] += double(v);
                 m_max = std::max(m_max, v);

@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <tuple>
@@ -60,6 +62,8 @@ protected:
     }
 
     /// Writes `img` to a PNG with the exact 8-bit codes round(255·v) (the Raw view).
+    /// (Read back with format = variant where a test needs the codes exactly: the default
+    /// stores 8-bit images in half precision.)
     void write_png_codes(const std::string &name, const Image &img) const {
         ImageWriteOptions raw;
         raw.view = "Raw";
@@ -71,9 +75,11 @@ protected:
         return PluginRegistry::instance().create_as<Texture>(ObjectType::Texture, props);
     }
     std::shared_ptr<Texture> make_bitmap(const std::string &file, const std::string &filter = "",
-                                         const std::string &wrap = "", bool raw = false) const {
+                                         const std::string &wrap = "", bool raw = false,
+                                         const std::string &format = "") const {
         Properties props("bitmap");
         props.set_string("filename", path(file));
+        if (!format.empty()) props.set_string("format", format);
         if (!filter.empty()) props.set_string("filter_type", filter);
         if (!wrap.empty()) props.set_string("wrap_mode", wrap);
         if (raw) props.set_bool("raw", true);
@@ -104,10 +110,12 @@ void expect_color_near(const Color3f &a, const Color3f &b, float tol, const std:
 } // namespace
 
 TEST_F(Bitmap, EightBitIsSrgbDecodedUnlessRaw) {
+    // format = variant keeps 32-bit floats, so the decoded values are exact (the default
+    // stores 8-bit images in half precision: FormatSelectsTheStoragePrecision).
     Image img = pattern();
     write_png_codes("codes.png", img);
-    auto decoded = make_bitmap("codes.png", "nearest");
-    auto raw = make_bitmap("codes.png", "nearest", "", true);
+    auto decoded = make_bitmap("codes.png", "nearest", "", false, "variant");
+    auto raw = make_bitmap("codes.png", "nearest", "", true, "variant");
     for (int y = 0; y < 2; ++y)
         for (int x = 0; x < 4; ++x) {
             Point2f uv = centre(x, y, 4, 2);
@@ -126,7 +134,7 @@ TEST_F(Bitmap, EightBitIsSrgbDecodedUnlessRaw) {
     for (float &v : grey.data) v = 0.5f;
     grey.at(1, 1, 0) = 0.05f;
     write_image(path("display.png"), grey);
-    auto back = make_bitmap("display.png", "nearest");
+    auto back = make_bitmap("display.png", "nearest", "", false, "variant");
     EXPECT_NEAR(back->eval(at_uv(0.25f, 0.25f)).g, 0.5f, 0.004f);
     EXPECT_NEAR(back->eval(at_uv(0.75f, 0.75f)).r, 0.05f, 0.002f);
 }
@@ -159,6 +167,46 @@ TEST_F(Bitmap, ExrIsLinearAndExact) {
     }
 }
 
+namespace {
+/// True when f is exactly a normal IEEE half value: its 13 lowest mantissa bits are zero.
+bool is_half_value(float f) {
+    uint32_t bits;
+    std::memcpy(&bits, &f, sizeof bits);
+    return std::fabs(f) >= 0x1p-14f && std::fabs(f) <= 65504.f && (bits & 0x1fffu) == 0;
+}
+} // namespace
+
+TEST_F(Bitmap, FormatSelectsTheStoragePrecision) {
+    // As in Mitsuba: `auto` (the default) stores images of 16 bits per channel or fewer in half
+    // precision after decoding, `fp16` always, `variant` never.
+    Image img = pattern();
+    write_png_codes("codes.png", img);
+    for (bool raw : {false, true})
+        for (const char *format : {"", "auto", "fp16"}) {
+            auto tex = make_bitmap("codes.png", "nearest", "", raw, format);
+            for (int y = 0; y < 2; ++y)
+                for (int x = 0; x < 4; ++x) {
+                    Point2f uv = centre(x, y, 4, 2);
+                    Color3f v = tex->eval(at_uv(uv.x, uv.y));
+                    for (int c = 0; c < 3; ++c) {
+                        float exact = raw ? img.at(x, y, c) : srgb_decode(img.at(x, y, c));
+                        EXPECT_TRUE(is_half_value(v[c])) << v[c] << " format " << format;
+                        EXPECT_NEAR(v[c], exact, exact * 0x1p-11f) << "format " << format;
+                    }
+                }
+        }
+    // A 32-bit EXR keeps its values under `auto` and `variant`, and is rounded by `fp16`.
+    Image lin(2, 2, 3);
+    lin.channel_names = {"R", "G", "B"};
+    for (float &v : lin.data) v = 0.1f;
+    write_image(path("float.exr"), lin);
+    EXPECT_EQ(make_bitmap("float.exr", "nearest")->eval(at_uv(0.2f, 0.2f)).r, 0.1f);
+    EXPECT_EQ(make_bitmap("float.exr", "nearest", "", false, "variant")->eval(at_uv(0.2f, 0.2f)).r,
+              0.1f);
+    EXPECT_EQ(make_bitmap("float.exr", "nearest", "", false, "fp16")->eval(at_uv(0.2f, 0.2f)).r,
+              0.0999755859375f); // the half nearest to 0.1
+}
+
 TEST_F(Bitmap, TopRowIsAtVZero) {
     // As in Mitsuba: uv (0, 0) is the top-left pixel, v grows downwards. (The OBJ loader flips
     // v, so in an OBJ file's own coordinates the top row is at v = 1.)
@@ -175,8 +223,8 @@ TEST_F(Bitmap, TopRowIsAtVZero) {
 TEST_F(Bitmap, NearestAndBilinear) {
     Image img = pattern();
     write_png_codes("p.png", img);
-    auto nearest = make_bitmap("p.png", "nearest", "clamp", true);
-    auto bilinear = make_bitmap("p.png", "bilinear", "clamp", true);
+    auto nearest = make_bitmap("p.png", "nearest", "clamp", true, "variant");
+    auto bilinear = make_bitmap("p.png", "bilinear", "clamp", true, "variant");
     auto px = [&](int x, int y) {
         return Color3f(img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2));
     };
@@ -216,7 +264,7 @@ TEST_F(Bitmap, WrapModes) {
     };
     for (const Case &c :
          {Case{"repeat", 3, 0, 1}, Case{"mirror", 0, 3, 2}, Case{"clamp", 0, 3, 3}}) {
-        auto tex = make_bitmap("w.png", "nearest", c.mode, true);
+        auto tex = make_bitmap("w.png", "nearest", c.mode, true, "variant");
         expect_color_near(tex->eval(at_uv(-0.5f / 4.f, row0)), px(c.left, 0), 1e-6f,
                           std::string(c.mode) + " left");
         expect_color_near(tex->eval(at_uv(4.5f / 4.f, row0)), px(c.right, 0), 1e-6f,
@@ -230,9 +278,9 @@ TEST_F(Bitmap, WrapModes) {
     }
     // Bilinear across the left edge (u = 0, x = −0.5): repeat blends pixels 3 and 0, mirror and
     // clamp see pixel 0 twice.
-    auto repeat = make_bitmap("w.png", "bilinear", "repeat", true);
-    auto mirror = make_bitmap("w.png", "bilinear", "mirror", true);
-    auto clamp_ = make_bitmap("w.png", "bilinear", "clamp", true);
+    auto repeat = make_bitmap("w.png", "bilinear", "repeat", true, "variant");
+    auto mirror = make_bitmap("w.png", "bilinear", "mirror", true, "variant");
+    auto clamp_ = make_bitmap("w.png", "bilinear", "clamp", true, "variant");
     expect_color_near(repeat->eval(at_uv(0.f, row0)), (px(3, 0) + px(0, 0)) * 0.5f, 1e-5f,
                       "bilinear repeat");
     expect_color_near(mirror->eval(at_uv(0.f, row0)), px(0, 0), 1e-5f, "bilinear mirror");
@@ -260,6 +308,7 @@ TEST_F(Bitmap, ToUvTransform) {
     props.set_string("filename", path("t.png"));
     props.set_string("filter_type", "nearest");
     props.set_bool("raw", true);
+    props.set_string("format", "variant");
     // uv' = (2u + 0.25, 0.5v): uv (0.2, 0.9) -> (0.65, 0.45) = pixel (2, 0).
     props.set_transform("to_uv", Transform::translate(Vector3f(0.25f, 0.f, 0.f)) *
                                      Transform::scale(Vector3f(2.f, 0.5f, 1.f)));
@@ -318,7 +367,8 @@ TEST_F(Bitmap, RejectsBadParameters) {
     std::vector<std::tuple<std::string, Properties::Value, std::string>> cases = {
         {"filter_type", std::string("trilinear"), "filter_type must be bilinear or nearest"},
         {"wrap_mode", std::string("wrap"), "wrap_mode must be repeat, mirror or clamp"},
-        {"format", std::string("fp64"), "format must be variant, fp16 or fp32"},
+        {"format", std::string("fp64"), "format must be auto, variant or fp16"},
+        {"format", std::string("fp32"), "format must be auto, variant or fp16"},
         {"raw", std::string("yes"), "raw"},
         {"to_uv", 2.0, "to_uv"},
         {"gamma", 2.2, "gamma"},
