@@ -145,13 +145,18 @@ Scene::Scene(const Properties &props) {
     if (m_sensors.empty())
         m_sensors.push_back(
             registry.create_as<Sensor>(ObjectType::Sensor, Properties("perspective")));
-    // Shapes without a BSDF (those inside shape groups included) share one default diffuse.
-    std::shared_ptr<BSDF> default_bsdf;
+    // Shapes without a BSDF (those inside shape groups included) share one default diffuse;
+    // as in Mitsuba, an emitting shape's default diffuse is black (it only emits).
+    std::shared_ptr<BSDF> default_bsdf, default_emitter_bsdf;
     auto give_default_bsdf = [&](Shape &shape) {
         if (shape.bsdf()) return;
-        if (!default_bsdf)
-            default_bsdf = registry.create_as<BSDF>(ObjectType::BSDF, Properties("diffuse"));
-        shape.set_bsdf(default_bsdf);
+        std::shared_ptr<BSDF> &bsdf = shape.emitter() ? default_emitter_bsdf : default_bsdf;
+        if (!bsdf) {
+            Properties props("diffuse");
+            if (shape.emitter()) props.set_float("reflectance", 0.0);
+            bsdf = registry.create_as<BSDF>(ObjectType::BSDF, props);
+        }
+        shape.set_bsdf(bsdf);
     };
     for (auto &shape : m_shapes) {
         if (auto group = dynamic_cast<const ShapeGroup *>(shape.get())) {

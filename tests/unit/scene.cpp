@@ -93,6 +93,26 @@ TEST(SceneBuild, DefaultsAreCreated) {
     EXPECT_NE(scene.to_string().find("Sphere"), std::string::npos);
 }
 
+TEST(SceneBuild, EmittingShapesGetABlackDefaultBSDF) {
+    // As in Mitsuba: a shape without a BSDF reflects as a diffuse of albedo 0.5, unless it
+    // emits; an emitter's default diffuse is black, so a light seen directly shows only its
+    // emission.
+    REQUIRE_PLUGINS();
+    Scene scene(rect_and_sphere(area_light(Color3f(4.f))));
+    ASSERT_EQ(scene.shapes().size(), 2u);
+    SurfaceInteraction si;
+    si.wi = normalize(Vector3f(0.3f, 0.f, 1.f));
+    Vector3f wo = normalize(Vector3f(-0.2f, 0.4f, 1.f));
+    for (const auto &shape : scene.shapes()) {
+        ASSERT_TRUE(shape->bsdf());
+        Color3f f = shape->bsdf()->eval(BSDFContext(), si, wo);
+        if (shape->emitter())
+            EXPECT_EQ(f, Color3f(0.f));
+        else
+            EXPECT_NEAR(f.g, 0.5f * InvPi * wo.z, 1e-6f);
+    }
+}
+
 TEST(SceneBuild, ChildrenAreCheckedAndOrdered) {
     REQUIRE_PLUGINS();
     // Top-level BSDFs are references only; emitters keep declaration order, area emitters
