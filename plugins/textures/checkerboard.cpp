@@ -2,14 +2,17 @@ static const char *DOC = R"DOC(
 # checkerboard: two-colour checkerboard
 
 A procedural checkerboard of 2 × 2 checks over the unit square of texture coordinates, repeated
-outside it: `color0` where u and v fall in the same half of [0, 1) (both below 0.5 or both
-above), `color1` elsewhere. `to_uv` scales, rotates or shifts the pattern (a 4 × 4 scale of 4
-gives 8 × 8 checks).
+outside it. Colour queries (a reflectance, a radiance) see `color0` where the fractional parts of
+u and v fall in the same half (both ≤ 0.5 or both > 0.5) and `color1` elsewhere. **Scalar
+queries (a roughness, a blend weight, a mask opacity) see the opposite squares**: `color0`
+where the halves differ. This is Mitsuba 3's convention (its scalar evaluation swaps the two
+colours) and scenes written for it depend on it. `to_uv` scales, rotates or shifts the pattern
+(a scale of 4 gives 8 × 8 checks); it acts on (u, v, 1), its z row and column are ignored.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
-| color0 | spectrum or texture | 0.4 | Colour of the checks whose u and v halves agree |
-| color1 | spectrum or texture | 0.2 | Colour of the other checks |
+| color0 | spectrum or texture | 0.4 | Colour of the checks whose u and v halves agree (for scalar queries: of the others) |
+| color1 | spectrum or texture | 0.2 | Colour of the other checks (for scalar queries: of those whose halves agree) |
 | to_uv | transform | identity | Transform applied to the texture coordinates (its x, y affine part) |
 
 ```xml
@@ -48,8 +51,9 @@ public:
         return in_color0(si) ? m_color0->eval(si) : m_color1->eval(si);
     }
 
+    /// Mitsuba 3 swaps the squares for scalar queries: color0 where the u and v halves differ.
     float eval_1(const SurfaceInteraction &si) const override {
-        return in_color0(si) ? m_color0->eval_1(si) : m_color1->eval_1(si);
+        return in_color0(si) ? m_color1->eval_1(si) : m_color0->eval_1(si);
     }
 
     /// Half of each colour over any whole number of periods.

@@ -7,6 +7,7 @@
 #include <facet/texture.h>
 #include <facet/xml.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 using namespace facet;
@@ -60,8 +61,11 @@ TEST(Checkerboard, DefaultPattern) {
                     EXPECT_EQ(tex->eval(at_uv(u + du, v + dv)), tex->eval(at_uv(u, v)))
                         << u + du << "," << v + dv;
     EXPECT_EQ(tex->eval(at_uv(-0.25f, 0.25f)), Color3f(0.2f));
-    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.1f, 0.1f)), 0.4f);
-    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.6f, 0.1f)), 0.2f);
+    // Scalar queries see the opposite squares (Mitsuba 3's eval_1): color1 where the halves agree.
+    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.1f, 0.1f)), 0.2f);
+    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.6f, 0.6f)), 0.2f);
+    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.6f, 0.1f)), 0.4f);
+    EXPECT_FLOAT_EQ(tex->eval_1(at_uv(0.1f, 0.6f)), 0.4f);
     EXPECT_NEAR(tex->mean().r, 0.3f, 1e-7f);
     EXPECT_EQ(tex->max(), 0.4f);
     EXPECT_TRUE(tex->is_spatially_varying());
@@ -126,7 +130,8 @@ TEST(Checkerboard, WorksAsABSDFParameter) {
     EXPECT_NEAR(bsdf->eval(BSDFContext(), at_uv(0.2f, 0.2f), up).r, 0.9f * InvPi, 1e-6f);
     EXPECT_NEAR(bsdf->eval(BSDFContext(), at_uv(0.7f, 0.2f), up).r, 0.1f * InvPi, 1e-6f);
 
-    // As a blend weight: weight 0 (color0) on one check, 1 (color1) on the other.
+    // As a blend weight (a scalar query, so the squares are swapped): weight 1 (color1) where the
+    // u and v halves agree, 0 (color0) where they differ.
     auto blend =
         std::dynamic_pointer_cast<BSDF>(load_string(R"(<bsdf version="3.0.0" type="blendbsdf">
         <texture type="checkerboard" name="weight">
@@ -137,6 +142,76 @@ TEST(Checkerboard, WorksAsABSDFParameter) {
         <bsdf type="diffuse"><float name="reflectance" value="0.6"/></bsdf>
     </bsdf>)"));
     ASSERT_TRUE(blend);
-    EXPECT_NEAR(blend->eval(BSDFContext(), at_uv(0.2f, 0.2f), up).r, 0.2f * InvPi, 1e-6f);
-    EXPECT_NEAR(blend->eval(BSDFContext(), at_uv(0.2f, 0.7f), up).r, 0.6f * InvPi, 1e-6f);
+    EXPECT_NEAR(blend->eval(BSDFContext(), at_uv(0.2f, 0.2f), up).r, 0.6f * InvPi, 1e-6f);
+    EXPECT_NEAR(blend->eval(BSDFContext(), at_uv(0.2f, 0.7f), up).r, 0.2f * InvPi, 1e-6f);
+}
+
+// Mitsuba 3 evaluates a checkerboard with eval() for colours and eval_1() for scalars, and the
+// two pick opposite squares: a checkerboard `alpha` and a checkerboard `reflectance` with the
+// same colours disagree at every point. Every scalar consumer must go through eval_1.
+TEST(Checkerboard, ScalarAndColourQueriesPickOppositeSquares) {
+    const char *checker = R"(<texture type="checkerboard" name="{}">
+            <float name="color0" value="{}"/>
+            <float name="color1" value="{}"/>
+        </texture>)";
+    auto with = [&](const char *name, const char *c0, const char *c1) {
+        return fmt::format(fmt::runtime(checker), name, c0, c1);
+    };
+    auto load_bsdf = [](const std::string &xml) {
+        auto bsdf = std::dynamic_pointer_cast<BSDF>(load_string(xml));
+        EXPECT_TRUE(bsdf);
+        return bsdf;
+    };
+    Vector3f wo = normalize(Vector3f(0.3f, -0.2f, 0.9f));
+    auto at = [&](float u, float v) {
+        SurfaceInteraction si = at_uv(u, v);
+        si.wi = normalize(Vector3f(-0.25f, 0.1f, 0.95f));
+        return si;
+    };
+    const float same[2] = {0.2f, 0.7f}, differ[2] = {0.7f, 0.2f};
+
+    // The colour query: reflectance 0.1 (color0) where the halves agree.
+    auto diffuse = load_bsdf(fmt::format(R"(<bsdf version="3.0.0" type="diffuse">{}</bsdf>)",
+                                         with("reflectance", "0.1", "0.3")));
+    EXPECT_NEAR(diffuse->eval(BSDFContext(), at(same[0], same[0]), wo).g, 0.1f * InvPi * wo.z,
+                1e-6f);
+    EXPECT_NEAR(diffuse->eval(BSDFContext(), at(differ[0], differ[1]), wo).g, 0.3f * InvPi * wo.z,
+                1e-6f);
+
+    // The scalar query, same colours: roughness 0.3 (color1) where the halves agree.
+    for (const char *type : {"roughconductor", "roughdielectric"}) {
+        auto textured = load_bsdf(fmt::format(R"(<bsdf version="3.0.0" type="{}">{}</bsdf>)", type,
+                                              with("alpha", "0.1", "0.3")));
+        auto rough = load_bsdf(fmt::format(
+            R"(<bsdf version="3.0.0" type="{}"><float name="alpha" value="0.3"/></bsdf>)", type));
+        auto smooth = load_bsdf(fmt::format(
+            R"(<bsdf version="3.0.0" type="{}"><float name="alpha" value="0.1"/></bsdf>)", type));
+        for (float u : {same[0], same[1]}) {
+            SurfaceInteraction si = at(u, u);
+            EXPECT_EQ(textured->eval(BSDFContext(), si, wo), rough->eval(BSDFContext(), si, wo))
+                << type;
+            EXPECT_NE(textured->eval(BSDFContext(), si, wo), smooth->eval(BSDFContext(), si, wo))
+                << type;
+        }
+        SurfaceInteraction si = at(differ[0], differ[1]);
+        EXPECT_EQ(textured->eval(BSDFContext(), si, wo), smooth->eval(BSDFContext(), si, wo))
+            << type;
+    }
+
+    // Anisotropic roughness: alpha_u and alpha_v are scalar queries too.
+    auto aniso =
+        load_bsdf(fmt::format(R"(<bsdf version="3.0.0" type="roughconductor">{}{}</bsdf>)",
+                              with("alpha_u", "0.05", "0.5"), with("alpha_v", "0.35", "0.06")));
+    auto aniso_same = load_bsdf(R"(<bsdf version="3.0.0" type="roughconductor">
+        <float name="alpha_u" value="0.5"/><float name="alpha_v" value="0.06"/></bsdf>)");
+    EXPECT_EQ(aniso->eval(BSDFContext(), at(same[0], same[0]), wo),
+              aniso_same->eval(BSDFContext(), at(same[0], same[0]), wo));
+
+    // Mask opacity: 1 (color1) where the halves agree, 0 (color0) where they differ.
+    auto mask = load_bsdf(fmt::format(R"(<bsdf version="3.0.0" type="mask">{}
+        <bsdf type="diffuse"><float name="reflectance" value="0.5"/></bsdf></bsdf>)",
+                                      with("opacity", "0", "1")));
+    EXPECT_NEAR(mask->eval(BSDFContext(), at(same[0], same[0]), wo).r, 0.5f * InvPi * wo.z, 1e-6f);
+    EXPECT_EQ(mask->eval(BSDFContext(), at(differ[0], differ[1]), wo), Color3f(0.f));
+    EXPECT_EQ(mask->eval_null_transmission(at(differ[0], differ[1])), Color3f(1.f));
 }
