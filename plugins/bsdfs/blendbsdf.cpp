@@ -9,7 +9,7 @@ weight is the blend's value over that density (so MIS sees exactly what was samp
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
-| weight | float or texture | 0.5 | Blend weight in [0, 1]: 0 = the first BSDF, 1 = the second (textures are clamped to [0, 1]) |
+| weight | float or texture | (required) | Blend weight in [0, 1]: 0 = the first BSDF, 1 = the second (textures are clamped to [0, 1]) |
 | (nested bsdf) | bsdf | — | Exactly two nested BSDFs, in order: first, second |
 
 Components: the first BSDF's components, then the second's; the flags are their union. A delta
@@ -55,11 +55,16 @@ public:
             FACET_THROW_AT(props.location(), "blendbsdf takes exactly two nested BSDFs, found {}",
                            count);
 
-        m_weight = props.texture("weight", 0.5f);
+        // Required, as in Mitsuba 3 (it has no default blend).
+        if (!props.has("weight"))
+            FACET_THROW_AT(props.location(),
+                           "blendbsdf needs a \"weight\" (a float or texture in [0, 1]: 0 gives "
+                           "the first nested BSDF, 1 the second)");
+        m_weight = props.texture("weight");
         if (!m_weight->is_spatially_varying()) {
             float value = m_weight->mean().mean();
             if (!(value >= 0.f && value <= 1.f))
-                FACET_THROW_AT(props.has("weight") ? props.location("weight") : props.location(),
+                FACET_THROW_AT(props.location("weight"),
                                "blendbsdf: weight must be in [0, 1], found {}", value);
         }
 

@@ -50,7 +50,9 @@ TEST(BlendBSDF, RejectsBadParameters) {
                         "weight must be in [0, 1], found 1.5");
     expect_nested_error("blendbsdf", {d, d}, {{"weight", -0.5}}, "weight must be in [0, 1]");
     expect_nested_error("blendbsdf", {d, d}, {{"weight", std::string("half")}}, "weight");
-    expect_nested_error("blendbsdf", {d, d}, {{"opacity", 0.5}}, "opacity");
+    // Mitsuba 3 has no default weight: leaving it out is an error that says what is expected.
+    expect_nested_error("blendbsdf", {d, d}, {}, "blendbsdf needs a \"weight\"");
+    expect_nested_error("blendbsdf", {d, d}, {{"weight", 0.5}, {"opacity", 0.5}}, "opacity");
 }
 
 TEST(BlendBSDF, ExtremeWeightsSelectOneBSDF) {
