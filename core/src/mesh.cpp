@@ -28,8 +28,19 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
         FACET_THROW("{}: {} normal floats for {} vertices", m_name, m_normals.size(), nv);
     if (!m_uvs.empty() && m_uvs.size() != 2 * nv)
         FACET_THROW("{}: {} texture coordinate floats for {} vertices", m_name, m_uvs.size(), nv);
-    if (!m_colors.empty() && m_colors.size() != 3 * nv)
-        FACET_THROW("{}: {} colour floats for {} vertices", m_name, m_colors.size(), nv);
+    if (!m_colors.empty()) {
+        if (m_colors.size() != 3 * nv)
+            FACET_THROW("{}: {} colour floats for {} vertices", m_name, m_colors.size(), nv);
+        add_attribute("vertex_color", 3, std::move(m_colors));
+        m_colors = {};
+    }
+    for (const Attribute &a : m_attributes) {
+        size_t count = a.per_face ? m_faces.size() / 3 : nv;
+        if (a.data.size() / a.channels != count || a.data.size() % a.channels != 0)
+            FACET_THROW("{}: attribute \"{}\" has {} values, expected {} ({} per {})", m_name,
+                        a.name, a.data.size(), count * a.channels, a.channels,
+                        a.per_face ? "face" : "vertex");
+    }
     for (size_t i = 0; i < m_faces.size(); ++i)
         if (m_faces[i] >= nv)
             FACET_THROW("{}: triangle {} uses vertex {}, but the mesh has only {} vertices", m_name,
@@ -125,6 +136,53 @@ void Mesh::recompute_vertex_normals() {
             m_normals[3 * i + 2] = float(n.z);
         }
     }
+}
+
+void Mesh::add_attribute(std::string name, uint32_t channels, std::vector<float> data) {
+    bool per_face = name.rfind("face_", 0) == 0;
+    if (!per_face && name.rfind("vertex_", 0) != 0)
+        FACET_THROW("{}: mesh attribute \"{}\" must start with vertex_ or face_", m_name, name);
+    if (channels < 1 || channels > 4)
+        FACET_THROW("{}: mesh attribute \"{}\" has {} channels (1 to 4 supported)", m_name, name,
+                    channels);
+    if (attribute(name)) FACET_THROW("{}: mesh attribute \"{}\" is defined twice", m_name, name);
+    m_attributes.push_back(Attribute{std::move(name), channels, per_face, std::move(data)});
+}
+
+const Mesh::Attribute *Mesh::attribute(const std::string &name) const {
+    for (const Attribute &a : m_attributes)
+        if (a.name == name) return &a;
+    return nullptr;
+}
+
+std::string Mesh::attribute_names() const {
+    if (m_attributes.empty()) return "none";
+    std::string out;
+    for (const Attribute &a : m_attributes) out += (out.empty() ? "" : ", ") + a.name;
+    return out;
+}
+
+void Mesh::eval_attribute(const Attribute &a, const SurfaceInteraction &si, float *out) const {
+    const uint32_t f = si.prim_index, c = a.channels;
+    if (a.per_face) {
+        for (uint32_t k = 0; k < c; ++k) out[k] = a.data[size_t(f) * c + k];
+        return;
+    }
+    const uint32_t i0 = m_faces[3 * f], i1 = m_faces[3 * f + 1], i2 = m_faces[3 * f + 2];
+    // Barycentric coordinates of si.p: the least-squares solution in the triangle's plane.
+    const Point3f p0 = vertex_position(i0);
+    const Vector3f e1 = vertex_position(i1) - p0, e2 = vertex_position(i2) - p0, r = si.p - p0;
+    float a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2), r1 = dot(r, e1), r2 = dot(r, e2);
+    float det = a11 * a22 - a12 * a12;
+    float b1 = 0.f, b2 = 0.f;
+    if (det != 0.f) {
+        b1 = (a22 * r1 - a12 * r2) / det;
+        b2 = (a11 * r2 - a12 * r1) / det;
+    }
+    float b0 = 1.f - b1 - b2;
+    const float *d0 = &a.data[size_t(i0) * c], *d1 = &a.data[size_t(i1) * c],
+                *d2 = &a.data[size_t(i2) * c];
+    for (uint32_t k = 0; k < c; ++k) out[k] = d0[k] * b0 + d1[k] * b1 + d2[k] * b2;
 }
 
 RTCGeometry Mesh::embree_geometry(RTCDevice device) const {
@@ -232,10 +290,10 @@ PositionSample Mesh::sample_position(const Point2f &u_) const {
 
 std::string Mesh::to_string() const {
     return fmt::format("Mesh[name=\"{}\", vertices={}, triangles={}, normals={}, uvs={}, "
-                       "colors={}, area={}, flip_normals={}, bsdf={}, emitter={}]",
+                       "attributes=[{}], area={}, flip_normals={}, bsdf={}, emitter={}]",
                        m_name, vertex_count(), face_count(), has_vertex_normals(), has_uvs(),
-                       has_vertex_colors(), m_area, m_flip_normals,
-                       m_bsdf ? m_bsdf->to_string() : "none", emitter_label());
+                       m_attributes.empty() ? std::string() : attribute_names(), m_area,
+                       m_flip_normals, m_bsdf ? m_bsdf->to_string() : "none", emitter_label());
 }
 
 } // namespace facet

@@ -15,7 +15,9 @@
 #include <facet/properties.h>
 #include <facet/resolver.h>
 #include <facet/scene.h>
+#include <facet/shape.h>
 #include <facet/spectrum.h>
+#include <facet/texture.h>
 #include <facet/transform.h>
 #include <facet/xml.h>
 
@@ -382,7 +384,44 @@ private:
                                 object_kind_name(node.kind), node.plugin));
             }
         }
+        check_shape_textures();
         return result;
+    }
+
+    /// Lets every texture reached from a shape (through its BSDF, emitter and their nested
+    /// objects, not through nested shapes) check that it can be evaluated on that shape.
+    void check_shape_textures() {
+        std::vector<size_t> seen(m_nodes.size(), NoNode); // the shape that last reached a node
+        std::vector<size_t> stack;
+        for (size_t index : m_created) {
+            const ObjectNode &shape_node = m_nodes[index];
+            if (shape_node.kind != ObjectType::Shape) continue;
+            const auto *shape = dynamic_cast<const Shape *>(shape_node.instance.get());
+            if (!shape) continue;
+            stack.assign(1, index);
+            while (!stack.empty()) {
+                size_t i = stack.back();
+                stack.pop_back();
+                for (const Entry &e : m_nodes[i].entries) {
+                    if (e.child == NoNode || seen[e.child] == index) continue;
+                    seen[e.child] = index;
+                    const ObjectNode &child = m_nodes[e.child];
+                    if (child.kind == ObjectType::Shape) continue;
+                    auto *texture = dynamic_cast<const Texture *>(child.instance.get());
+                    if (texture) {
+                        try {
+                            texture->check_shape(*shape);
+                        } catch (const Error &err) {
+                            throw Error(child.location,
+                                        fmt::format("{} (used by {} at {})", err.message(),
+                                                    shape_node.describe(),
+                                                    shape_node.location.to_string()));
+                        }
+                    }
+                    stack.push_back(e.child);
+                }
+            }
+        }
     }
 
     SourceFile *add_source(std::string name, fs::path dir, std::string canonical,

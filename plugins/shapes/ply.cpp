@@ -3,11 +3,23 @@ static const char *DOC = R"DOC(
 
 A triangle mesh read from a Stanford PLY file (ascii, binary_little_endian or
 binary_big_endian). Read from the `vertex` element: positions `x, y, z`; normals `nx, ny, nz`;
-texture coordinates `u, v` (also `s, t`, `texture_u, texture_v`, `texture_s, texture_t`); colours
-`r, g, b` or `red, green, blue` (integer types are scaled to [0, 1]). From the `face` element: the
-list `vertex_indices` (or `vertex_index`) of any integer type; polygons are split into triangle
-fans. Other elements and properties are skipped. Without normals in the file (and with
-`face_normals` off), smooth vertex normals are computed from the faces.
+texture coordinates `u, v` (also `s, t`, `texture_u, texture_v`, `texture_s, texture_t`). From the
+`face` element: the list `vertex_indices` (or `vertex_index`) of any integer type; polygons are
+split into triangle fans. Without normals in the file (and with `face_normals` off), smooth vertex
+normals are computed from the faces. Other elements are skipped.
+
+Every other property of the vertex and face elements becomes a named mesh attribute, read with
+the `mesh_attribute` texture, grouped as Mitsuba 3 groups them:
+- bare `r, g, b` or `red, green, blue` (optionally with `a` / `alpha`): `vertex_color` on
+  vertices, `face_color` on faces;
+- consecutive properties `<name>_<c>` whose one-letter suffixes run through one family,
+  `x y z w`, `r g b a`, `0 1 2 3` or `1 2 3 4`, with 1 or 3 members: `vertex_<name>` /
+  `face_<name>`, and `vertex_<name>_color` / `face_<name>_color` for the `r g b` family
+  (`color_0..2` gives `vertex_color`, `tint_r, tint_g, tint_b` gives `vertex_tint_color`, a face
+  property `weight_0` gives `face_weight`).
+Integer properties are kept as they are (a `uchar red` of 255 is 255, not 1; Mitsuba 3.8 does
+the same and warns): scale them with `mesh_attribute`'s `scale`. Properties that fit no group
+are skipped with a warning.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -80,26 +92,6 @@ size_t type_size(PlyType t) {
 }
 
 bool is_integer(PlyType t) { return t != PlyType::Float32 && t != PlyType::Float64; }
-
-/// Largest value of an integer type (colours are scaled by it).
-double type_max(PlyType t) {
-    switch (t) {
-    case PlyType::Int8:
-        return 127.0;
-    case PlyType::UInt8:
-        return 255.0;
-    case PlyType::Int16:
-        return 32767.0;
-    case PlyType::UInt16:
-        return 65535.0;
-    case PlyType::Int32:
-        return 2147483647.0;
-    case PlyType::UInt32:
-        return 4294967295.0;
-    default:
-        return 1.0;
-    }
-}
 
 struct PlyProperty {
     std::string name;
@@ -178,6 +170,9 @@ public:
         if (m_cur < m_end) ++m_cur;
         ++m_line;
     }
+
+    bool is_ascii() const { return m_format == PlyFormat::Ascii; }
+    size_t remaining() const { return size_t(m_end - m_cur); }
 
     std::string where() const {
         return m_format == PlyFormat::Ascii ? fmt::format("{}:{}", m_name, m_line + 1) : m_name;
@@ -321,6 +316,8 @@ private:
                 read_faces(el, reader);
                 have_faces = true;
             } else {
+                check_count(el, reader);
+                if (el.props.empty() && !reader.is_ascii()) continue;
                 for (size_t i = 0; i < el.count; ++i) {
                     for (const auto &prop : el.props) skip(prop, reader);
                     reader.end_element();
@@ -340,15 +337,151 @@ private:
         for (int64_t k = 0; k < int64_t(count); ++k) reader.read(prop.type, prop.name.c_str());
     }
 
+    /// A named attribute made of some of an element's properties (one per channel).
+    struct AttributeGroup {
+        std::string name;
+        std::vector<size_t> props; ///< property indices, in channel order
+        std::vector<float> data;
+    };
+
+    /**
+     * Mitsuba's grouping of the properties outside the reserved set into named attributes
+     * (`prefix` is "vertex_" or "face_"): bare r, g, b (or red, green, blue; with a or alpha)
+     * give `<prefix>color`; otherwise consecutive properties `<name>_<c>` with one-letter
+     * suffixes running through one family, x y z w, r g b a, 0 1 2 3 or 1 2 3 4, form
+     * `<prefix><name>` (with `_color` appended for the r g b a family); a group needs 1 or 3
+     * members. Properties that fit no group are skipped with a warning, as Mitsuba does.
+     */
+    std::vector<AttributeGroup> group_attributes(const PlyElement &el, const std::string &prefix,
+                                                 std::vector<char> &reserved) const {
+        std::vector<AttributeGroup> groups;
+        auto find = [&](const char *n) -> int {
+            for (size_t i = 0; i < el.props.size(); ++i)
+                if (!el.props[i].is_list && el.props[i].name == n) return int(i);
+            return -1;
+        };
+        auto integer_warning = [&](const AttributeGroup &g) {
+            if (g.props.size() >= 3 && is_integer(el.props[g.props[0]].type))
+                FACET_LOG(Warn,
+                          "{}: mesh attribute \"{}\" has integer fields: color attributes are "
+                          "expected to be in the [0, 1] range (the values are used as they are)",
+                          m_name, g.name);
+        };
+
+        const char *bare[2][4] = {{"r", "g", "b", "a"}, {"red", "green", "blue", "alpha"}};
+        for (auto &names : bare) {
+            int r = find(names[0]), g = find(names[1]), b = find(names[2]), a = find(names[3]);
+            if (r < 0 || g < 0 || b < 0) continue;
+            AttributeGroup group{prefix + "color", {size_t(r), size_t(g), size_t(b)}, {}};
+            if (a >= 0) group.props.push_back(size_t(a));
+            integer_warning(group);
+            groups.push_back(std::move(group));
+            break;
+        }
+        for (auto &names : bare)
+            for (const char *n : names)
+                if (int i = find(n); i >= 0) reserved[size_t(i)] = 1;
+
+        static const char *families[4] = {"xr01", "yg12", "zb23", "wa34"};
+        std::vector<std::string> seen;
+        AttributeGroup current;
+        std::string current_prefix;
+        int family = -1;
+        auto flush = [&]() {
+            if (family < 0) return;
+            size_t n = current.props.size();
+            if (n == 1 || n == 3) {
+                current.name = prefix + current_prefix + (family == 1 ? "_color" : "");
+                integer_warning(current);
+                seen.push_back(current_prefix);
+                groups.push_back(std::move(current));
+            } else {
+                FACET_LOG(Warn, "{}: attribute \"{}{}\" has {} fields (1 or 3 are needed); ignored",
+                          m_name, prefix, current_prefix, n);
+            }
+            current = AttributeGroup();
+            family = -1;
+        };
+        for (size_t i = 0; i < el.props.size(); ++i) {
+            const PlyProperty &p = el.props[i];
+            if (reserved[i]) continue;
+            if (p.is_list) {
+                FACET_LOG(Warn, "{}: list property \"{}\" of element {} ignored", m_name, p.name,
+                          el.name);
+                continue;
+            }
+            size_t pos = p.name.find_last_of('_');
+            if (pos == std::string::npos || pos + 2 != p.name.size()) {
+                FACET_LOG(Warn,
+                          "{}: property \"{}\" of element {} ignored (attributes are named "
+                          "<name>_<one-letter suffix>)",
+                          m_name, p.name, el.name);
+                flush();
+                continue;
+            }
+            std::string name = p.name.substr(0, pos);
+            char suffix = p.name[pos + 1];
+            if (family >= 0 && name != current_prefix) flush();
+            if (family < 0) {
+                if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+                    FACET_LOG(Warn, "{}: attribute \"{}\" seen before: property \"{}\" ignored",
+                              m_name, name, p.name);
+                    continue;
+                }
+                const char *f = std::strchr(families[0], suffix);
+                if (!f || suffix == 0) {
+                    FACET_LOG(Warn,
+                              "{}: property \"{}\" ignored (an attribute's first suffix is one "
+                              "of x, r, 0, 1)",
+                              m_name, p.name);
+                    continue;
+                }
+                family = int(f - families[0]);
+                current_prefix = name;
+                current.props.push_back(i);
+                continue;
+            }
+            size_t level = current.props.size();
+            if (level >= 4 || families[level][family] != suffix) {
+                FACET_LOG(Warn, "{}: attribute \"{}\" has an invalid suffix sequence; ignored",
+                          m_name, current_prefix);
+                seen.push_back(current_prefix);
+                current = AttributeGroup();
+                family = -1;
+                continue;
+            }
+            current.props.push_back(i);
+        }
+        flush();
+        for (const AttributeGroup &g : groups)
+            for (size_t i : g.props) reserved[i] = 1;
+        return groups;
+    }
+
+    /// A count from the header that the rest of the file cannot hold is an error (before any
+    /// allocation): every element takes at least one byte per property, and in binary files
+    /// exactly the sizes of its scalar properties plus the counts of its lists.
+    void check_count(const PlyElement &el, const PlyReader &reader) const {
+        size_t per_element = 0;
+        for (const PlyProperty &p : el.props)
+            per_element += reader.is_ascii() ? 1 : type_size(p.is_list ? p.count_type : p.type);
+        size_t need = 0;
+        if (__builtin_mul_overflow(el.count, std::max<size_t>(per_element, 1), &need) ||
+            need > reader.remaining() + (reader.is_ascii() || per_element == 0 ? 1 : 0))
+            FACET_THROW("{}: the header declares {} {} elements, more than the file holds", m_name,
+                        el.count, el.name);
+    }
+
     void read_vertices(const PlyElement &el, PlyReader &reader, bool flip_tex_coords) {
-        // Where each property goes: 0-2 position, 3-5 normal, 6-7 uv, 8-10 colour, -1 skipped.
+        // Where each property goes: 0-2 position, 3-5 normal, 6-7 uv, -1 elsewhere.
         std::vector<int> slot(el.props.size(), -1);
-        int found[11] = {};
+        std::vector<char> reserved(el.props.size(), 0);
+        int found[8] = {};
         auto assign = [&](size_t i, int s) {
             slot[i] = s;
             found[s] = 1;
+            reserved[i] = 1;
         };
-        PlyType color_type = PlyType::Float32;
         for (size_t i = 0; i < el.props.size(); ++i) {
             const auto &p = el.props[i];
             if (p.is_list) continue;
@@ -369,64 +502,71 @@ private:
                 assign(i, 6);
             else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t")
                 assign(i, 7);
-            else if (n == "r" || n == "red") {
-                assign(i, 8);
-                color_type = p.type;
-            } else if (n == "g" || n == "green")
-                assign(i, 9);
-            else if (n == "b" || n == "blue")
-                assign(i, 10);
         }
         if (!(found[0] && found[1] && found[2]))
             FACET_THROW("{}: the vertex element lacks x, y or z", m_name);
         bool normals = found[3] && found[4] && found[5];
         bool uvs = found[6] && found[7];
-        bool colors = found[8] && found[9] && found[10];
-        double color_scale = is_integer(color_type) ? 1.0 / type_max(color_type) : 1.0;
+        std::vector<AttributeGroup> groups = group_attributes(el, "vertex_", reserved);
+        check_count(el, reader);
 
         size_t n = el.count;
         m_positions.resize(3 * n);
         if (normals) m_normals.resize(3 * n);
         if (uvs) m_uvs.resize(2 * n);
-        if (colors) m_colors.resize(3 * n);
-        double values[11];
+        for (AttributeGroup &g : groups) g.data.reserve(g.props.size() * n);
+        std::vector<double> values(el.props.size(), 0.0);
+        double sv[8] = {};
         for (size_t v = 0; v < n; ++v) {
             for (size_t i = 0; i < el.props.size(); ++i) {
-                if (slot[i] < 0 || el.props[i].is_list)
+                if (el.props[i].is_list)
                     skip(el.props[i], reader);
                 else
-                    values[slot[i]] = reader.read(el.props[i].type, el.props[i].name.c_str());
+                    values[i] = reader.read(el.props[i].type, el.props[i].name.c_str());
+                if (slot[i] >= 0) sv[slot[i]] = values[i];
             }
             reader.end_element();
-            for (int k = 0; k < 3; ++k) m_positions[3 * v + k] = float(values[k]);
+            for (int k = 0; k < 3; ++k) m_positions[3 * v + k] = float(sv[k]);
             if (normals)
-                for (int k = 0; k < 3; ++k) m_normals[3 * v + k] = float(values[3 + k]);
+                for (int k = 0; k < 3; ++k) m_normals[3 * v + k] = float(sv[3 + k]);
             if (uvs) {
-                m_uvs[2 * v] = float(values[6]);
-                m_uvs[2 * v + 1] = flip_tex_coords ? 1.f - float(values[7]) : float(values[7]);
+                m_uvs[2 * v] = float(sv[6]);
+                m_uvs[2 * v + 1] = flip_tex_coords ? 1.f - float(sv[7]) : float(sv[7]);
             }
-            if (colors)
-                for (int k = 0; k < 3; ++k)
-                    m_colors[3 * v + k] = float(values[8 + k] * color_scale);
+            // Integer properties are kept raw (0..255 for uchar), as Mitsuba 3.8 does.
+            for (AttributeGroup &g : groups)
+                for (size_t i : g.props) g.data.push_back(float(values[i]));
         }
+        for (AttributeGroup &g : groups)
+            add_attribute(g.name, uint32_t(g.props.size()), std::move(g.data));
     }
 
     void read_faces(const PlyElement &el, PlyReader &reader) {
         int list = -1;
+        std::vector<char> reserved(el.props.size(), 0);
         for (size_t i = 0; i < el.props.size(); ++i)
             if (el.props[i].is_list &&
-                (el.props[i].name == "vertex_indices" || el.props[i].name == "vertex_index"))
+                (el.props[i].name == "vertex_indices" || el.props[i].name == "vertex_index")) {
                 list = int(i);
+                reserved[i] = 1;
+            }
         if (list < 0) FACET_THROW("{}: the face element has no vertex_indices list", m_name);
         if (!is_integer(el.props[size_t(list)].type))
             FACET_THROW("{}: vertex_indices must be integers", m_name);
+        std::vector<AttributeGroup> groups = group_attributes(el, "face_", reserved);
+        check_count(el, reader);
+
         m_faces.reserve(3 * el.count);
         std::vector<uint32_t> polygon;
+        std::vector<double> values(el.props.size(), 0.0);
         for (size_t f = 0; f < el.count; ++f) {
             for (size_t i = 0; i < el.props.size(); ++i) {
                 const auto &prop = el.props[i];
                 if (int(i) != list) {
-                    skip(prop, reader);
+                    if (prop.is_list)
+                        skip(prop, reader);
+                    else
+                        values[i] = reader.read(prop.type, prop.name.c_str());
                     continue;
                 }
                 double count = reader.read(prop.count_type, "a face's vertex count");
@@ -441,11 +581,17 @@ private:
                                     idx);
                     polygon.push_back(uint32_t(idx));
                 }
-                for (size_t k = 1; k + 1 < polygon.size(); ++k)
-                    m_faces.insert(m_faces.end(), {polygon[0], polygon[k], polygon[k + 1]});
             }
             reader.end_element();
+            // Polygons become triangle fans; each triangle carries the face's attributes.
+            for (size_t k = 1; k + 1 < polygon.size(); ++k) {
+                m_faces.insert(m_faces.end(), {polygon[0], polygon[k], polygon[k + 1]});
+                for (AttributeGroup &g : groups)
+                    for (size_t i : g.props) g.data.push_back(float(values[i]));
+            }
         }
+        for (AttributeGroup &g : groups)
+            add_attribute(g.name, uint32_t(g.props.size()), std::move(g.data));
     }
 };
 

@@ -30,13 +30,30 @@ public:
     }
     bool has_vertex_normals() const { return !m_normals.empty(); }
     bool has_uvs() const { return !m_uvs.empty(); }
-    bool has_vertex_colors() const { return !m_colors.empty(); }
+    bool has_vertex_colors() const { return attribute("vertex_color") != nullptr; }
     const std::vector<float> &positions() const { return m_positions; }
     const std::vector<float> &normals() const { return m_normals; }
     const std::vector<float> &uvs() const { return m_uvs; }
-    const std::vector<float> &colors() const { return m_colors; }
     const std::vector<uint32_t> &faces() const { return m_faces; }
     const std::string &name() const { return m_name; }
+
+    /// A named per-vertex or per-face quantity carried by the mesh (Mitsuba's mesh attributes:
+    /// `vertex_color`, `vertex_tint_color`, `face_weight`, ...), read by `mesh_attribute`.
+    struct Attribute {
+        std::string name;      ///< starts with "vertex_" or "face_"
+        uint32_t channels = 0; ///< values per vertex or face (1 to 4)
+        bool per_face = false; ///< name starts with "face_"
+        std::vector<float> data;
+    };
+    /// The attribute called `name`, or nullptr (no allocation: a linear search by name).
+    const Attribute *attribute(const std::string &name) const;
+    const std::vector<Attribute> &attributes() const { return m_attributes; }
+    /// The attribute names, comma-separated ("none" without any), for error messages.
+    std::string attribute_names() const;
+    /// `a` at the hit `si` on this mesh (si.prim_index, si.p): a vertex attribute interpolated
+    /// with the barycentric coordinates of si.p in its triangle, a face attribute constant over
+    /// the triangle. Writes a.channels values to `out`.
+    void eval_attribute(const Attribute &a, const SurfaceInteraction &si, float *out) const;
 
 protected:
     /// Checks the arrays (indices in range, finite positions; errors name `m_name`), applies
@@ -47,16 +64,20 @@ protected:
     /// whose file has none and `face_normals` is off (Mitsuba does the same). Call it after
     /// initialize() so the weights are those of the world-space triangles.
     void recompute_vertex_normals();
+    /// Adds a named attribute (loaders; before initialize(), which checks its size against the
+    /// vertex or face count). The name must start with vertex_ or face_ and be new.
+    void add_attribute(std::string name, uint32_t channels, std::vector<float> data);
 
     std::string m_name;             ///< file name or plugin name, for messages
     std::vector<float> m_positions; ///< 3 per vertex (+1 padding float for Embree after initialize)
     std::vector<float> m_normals;   ///< 3 per vertex or empty
     std::vector<float> m_uvs;       ///< 2 per vertex or empty
-    std::vector<float> m_colors;    ///< 3 per vertex or empty
+    std::vector<float> m_colors;    ///< 3 per vertex or empty; initialize() makes it vertex_color
     std::vector<uint32_t> m_faces;  ///< 3 per triangle
     bool m_flip_normals = false;
 
 private:
+    std::vector<Attribute> m_attributes;
     std::vector<float> m_area_cdf; ///< cumulative triangle areas, normalised
     float m_area = 0.f;
     BoundingBox3f m_bbox;

@@ -19,6 +19,10 @@ public:
     virtual Color3f mean() const = 0;
     virtual float max() const { return mean().max(); }
     virtual bool is_spatially_varying() const { return true; }
+    /// Called by the scene loader for every shape whose BSDF or emitter uses this texture
+    /// (directly or nested); throws facet::Error when the texture cannot be evaluated on it
+    /// (a `mesh_attribute` naming an attribute the shape lacks).
+    virtual void check_shape(const Shape &) const {}
 };
 
 /// True for a texture that is present and varies over the surface (sets
