@@ -148,6 +148,14 @@ public:
         return lookup<3>(uv).luminance();
     }
 
+    /// Gradient of eval_1 in (u, v): the slope of the bilinear interpolation (zero for the
+    /// nearest filter, which is piecewise constant), carried through to_uv by its transpose.
+    Vector2f eval_1_grad(const SurfaceInteraction &si) const override {
+        Vector2f g = m_channels == 1 ? lookup_grad<1>(to_uv(si.uv)) : lookup_grad<3>(to_uv(si.uv));
+        return {m_uv_matrix[0] * g.x + m_uv_matrix[3] * g.y,
+                m_uv_matrix[1] * g.x + m_uv_matrix[4] * g.y};
+    }
+
     Color3f mean() const override { return m_mean; }
     float max() const override { return m_max; }
 
@@ -245,6 +253,27 @@ private:
         int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
         return (pixel<C>(xa, ya) * (1.f - fx) + pixel<C>(xb, ya) * fx) * (1.f - fy) +
                (pixel<C>(xa, yb) * (1.f - fx) + pixel<C>(xb, yb) * fx) * fy;
+    }
+
+    /// Gradient of the scalar (grey or luminance) bilinear lookup with respect to the transformed
+    /// uv: the four pixels of lookup(), differentiated in x and y, times the resolution.
+    template <int C> Vector2f lookup_grad(const Point2f &uv) const {
+        if (m_filter == FilterType::Nearest) return Vector2f(0.f);
+        float x = uv.x * float(m_width) - 0.5f, y = uv.y * float(m_height) - 0.5f;
+        int x0 = floor_to_int(x), y0 = floor_to_int(y);
+        float fx = clamp(x - float(x0), 0.f, 1.f), fy = clamp(y - float(y0), 0.f, 1.f);
+        if (!std::isfinite(fx)) fx = 0.f;
+        if (!std::isfinite(fy)) fy = 0.f;
+        int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
+        int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
+        auto value = [&](int px, int py) {
+            Color3f c = pixel<C>(px, py);
+            return C == 1 ? c.r : c.luminance();
+        };
+        float f00 = value(xa, ya), f10 = value(xb, ya), f01 = value(xa, yb), f11 = value(xb, yb);
+        float dfdx = (1.f - fy) * (f10 - f00) + fy * (f11 - f01);
+        float dfdy = (1.f - fx) * (f01 - f00) + fx * (f11 - f10);
+        return {dfdx * float(m_width), dfdy * float(m_height)};
     }
 
     std::string m_filename, m_path;

@@ -56,6 +56,12 @@ public:
         return in_color0(si) ? m_color1->eval_1(si) : m_color0->eval_1(si);
     }
 
+    /// Piecewise: the gradient of the square's own texture (zero for plain colours); the steps
+    /// at the square edges have no gradient.
+    Vector2f eval_1_grad(const SurfaceInteraction &si) const override {
+        return in_color0(si) ? m_color0->eval_1_grad(si) : m_color1->eval_1_grad(si);
+    }
+
     /// Half of each colour over any whole number of periods.
     Color3f mean() const override { return (m_color0->mean() + m_color1->mean()) * 0.5f; }
     float max() const override { return std::max(m_color0->max(), m_color1->max()); }

@@ -3,6 +3,7 @@
 #include <facet/color.h>
 #include <facet/interaction.h>
 #include <facet/object.h>
+#include <facet/spectrum.h>
 
 #include <memory>
 
@@ -15,6 +16,9 @@ public:
     virtual Color3f eval(const SurfaceInteraction &si) const = 0;
     /// Scalar value (the mean of the channels unless the texture knows better).
     virtual float eval_1(const SurfaceInteraction &si) const { return eval(si).mean(); }
+    /// Gradient of eval_1 with respect to the surface's (u, v) (a height field's slope, for bump
+    /// mapping). Textures without one throw facet::Error; piecewise constant ones return zero.
+    virtual Vector2f eval_1_grad(const SurfaceInteraction &si) const;
     /// Average over the texture's domain.
     virtual Color3f mean() const = 0;
     virtual float max() const { return mean().max(); }
@@ -35,6 +39,7 @@ public:
     explicit ConstantTexture(const Color3f &value) : m_value(value) {}
     Color3f eval(const SurfaceInteraction &) const override { return m_value; }
     float eval_1(const SurfaceInteraction &) const override { return m_value.mean(); }
+    Vector2f eval_1_grad(const SurfaceInteraction &) const override { return Vector2f(0.f); }
     Color3f mean() const override { return m_value; }
     float max() const override { return m_value.max(); }
     bool is_spatially_varying() const override { return false; }
@@ -42,6 +47,27 @@ public:
 
 private:
     Color3f m_value;
+};
+
+/**
+ * A spectrum plugin (`<spectrum type="d65">`, uniform, regular, irregular, srgb, blackbody): a
+ * constant whose RGB value depends on what it describes, as in Mitsuba's RGB variants (a
+ * reflectance is D65-weighted and clamped to [0, 1], an emission only clamped at 0). The
+ * parameter that reads it asks for its kind: Properties::texture() and get_color() replace it
+ * by a ConstantTexture of value(kind).
+ */
+class SpectrumTexture : public Texture {
+public:
+    /// The RGB value for a parameter of kind `kind`; throws facet::Error when the spectrum
+    /// cannot describe such a quantity (an srgb reflectance outside [0, 1]).
+    virtual Color3f value(SpectrumKind kind) const = 0;
+    /// Used only where no parameter kind is known: the reflectance conversion.
+    Color3f eval(const SurfaceInteraction &) const override {
+        return value(SpectrumKind::Reflectance);
+    }
+    Vector2f eval_1_grad(const SurfaceInteraction &) const override { return Vector2f(0.f); }
+    Color3f mean() const override { return value(SpectrumKind::Reflectance); }
+    bool is_spatially_varying() const override { return false; }
 };
 
 } // namespace facet
