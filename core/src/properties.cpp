@@ -188,6 +188,16 @@ Transform Properties::get_transform(const std::string &name, const Transform &de
     return has(name) ? get_transform(name) : def;
 }
 
+Color3f Properties::spectrum_value(const SpectrumTexture &spectrum, const std::string &name,
+                                   const Location &loc, SpectrumKind kind) const {
+    try {
+        return spectrum.value(kind);
+    } catch (const Error &err) {
+        if (err.location().valid()) throw;
+        FACET_THROW_AT(loc.valid() ? loc : m_location, "parameter \"{}\": {}", name, err.message());
+    }
+}
+
 Color3f Properties::get_color(const std::string &name, SpectrumKind kind) const {
     const Entry &e = require(name);
     if (auto v = std::get_if<Color3f>(&e.value)) return *v;
@@ -202,6 +212,9 @@ Color3f Properties::get_color(const std::string &name, SpectrumKind kind) const 
                            name, err.message());
         }
     }
+    if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value))
+        if (auto spectrum = std::dynamic_pointer_cast<SpectrumTexture>(*obj))
+            return spectrum_value(*spectrum, name, e.location, kind);
     type_error(name, "rgb, spectrum or float");
 }
 
@@ -219,6 +232,10 @@ std::shared_ptr<Object> Properties::object_entry(const std::string &name) const 
 std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKind kind) const {
     const Entry &e = require(name);
     if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) {
+        // A spectrum plugin becomes the constant its use calls for (reflectance, emission, ...).
+        if (auto spectrum = std::dynamic_pointer_cast<SpectrumTexture>(*obj))
+            return std::make_shared<ConstantTexture>(
+                spectrum_value(*spectrum, name, e.location, kind));
         if (auto tex = std::dynamic_pointer_cast<Texture>(*obj)) return tex;
         type_error(name, "texture, rgb, spectrum or float");
     }

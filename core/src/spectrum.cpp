@@ -115,6 +115,24 @@ SpectrumData parse_spectrum_pairs(const std::string &text) {
     return s;
 }
 
+std::vector<double> parse_number_list(const std::string &text, const std::string &what) {
+    std::vector<double> values;
+    std::string token;
+    auto flush = [&] {
+        if (!token.empty()) values.push_back(parse_number(token, what));
+        token.clear();
+    };
+    for (char c : text) {
+        if (c == ',' || c == ' ' || c == '\t' || c == '\n' || c == '\r')
+            flush();
+        else
+            token += c;
+    }
+    flush();
+    if (values.empty()) FACET_THROW("{}: expected a list of numbers, found \"{}\"", what, text);
+    return values;
+}
+
 SpectrumData read_spd_file(const std::string &path) {
     std::ifstream in(path);
     if (!in) FACET_THROW("could not open spectrum file \"{}\"", path);

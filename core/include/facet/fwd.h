@@ -35,6 +35,7 @@ class Sensor;
 class Film;
 class Sampler;
 class Texture;
+class SpectrumTexture;
 class ReconstructionFilter;
 class Integrator;
 class Scene;

@@ -116,6 +116,9 @@ private:
     const Entry &require(const std::string &name) const;
     std::shared_ptr<Object> object_entry(const std::string &name) const;
     [[noreturn]] void type_error(const std::string &name, const char *expected) const;
+    /// A spectrum plugin's value for a parameter of kind `kind`; errors name the parameter.
+    Color3f spectrum_value(const SpectrumTexture &spectrum, const std::string &name,
+                           const Location &loc, SpectrumKind kind) const;
     void note_request(const std::string &name) const;
 
     std::string m_plugin_name, m_id;

@@ -29,6 +29,9 @@ struct SpectrumData {
 
 /// Parse "400:0.5, 500:0.7" or a single number; throws facet::Error on bad input.
 SpectrumData parse_spectrum_pairs(const std::string &text);
+/// Parse a list of numbers separated by commas and/or spaces ("0.1, 0.2 0.3"); `what` names
+/// the list in errors. Throws facet::Error on an empty list or a bad number.
+std::vector<double> parse_number_list(const std::string &text, const std::string &what);
 /// Read a .spd file ("wavelength value" per line, '#' comments).
 SpectrumData read_spd_file(const std::string &path);
 
