@@ -69,11 +69,12 @@ protected:
             Vector2f g = tex.eval_1_grad(at_uv(u, v));
             float du = (tex.eval_1(at_uv(u + h, v)) - tex.eval_1(at_uv(u - h, v))) / (2.f * h);
             float dv = (tex.eval_1(at_uv(u, v + h)) - tex.eval_1(at_uv(u, v - h))) / (2.f * h);
-            // A kink (texel centre) between the two probes makes the difference meaningless.
+            // A kink (texel centre) between the two probes makes the difference meaningless: the
+            // slope jumps there, while elsewhere it only drifts with the bilinear cross term.
             Vector2f gu = tex.eval_1_grad(at_uv(u + h, v)), gl = tex.eval_1_grad(at_uv(u - h, v));
             Vector2f gv = tex.eval_1_grad(at_uv(u, v + h)), gd = tex.eval_1_grad(at_uv(u, v - h));
-            if (std::abs(gu.x - gl.x) > 1e-3f * (1.f + std::abs(g.x)) ||
-                std::abs(gv.y - gd.y) > 1e-3f * (1.f + std::abs(g.y)))
+            if (std::abs(gu.x - gl.x) > 5e-2f * (1.f + std::abs(g.x)) ||
+                std::abs(gv.y - gd.y) > 5e-2f * (1.f + std::abs(g.y)))
                 continue;
             EXPECT_NEAR(g.x, du, 2e-2f * (1.f + std::abs(du))) << u << ", " << v;
             EXPECT_NEAR(g.y, dv, 2e-2f * (1.f + std::abs(dv))) << u << ", " << v;
