@@ -156,8 +156,9 @@ Image Film::develop() const {
         const double *src = m_storage.data() + i * nc;
         float *dst = img.data.data() + i * out_c;
         const double w = src[nc - 1];
-        // Filters with negative lobes could give a negative sum; treat it like no sample at all.
-        const double inv = w > 0.0 ? 1.0 / w : 0.0;
+        // Filters with negative lobes can give a negative sum: divide by it all the same (as
+        // Mitsuba does); only a pixel without any weight stays 0.
+        const double inv = w != 0.0 ? 1.0 / w : 0.0;
         int o = 0;
         for (int c = 0; c < 3; ++c) dst[o++] = float(src[c] * inv);
         if (m_alpha) dst[o++] = w > 0.0 ? 1.f : 0.f;
