@@ -97,9 +97,8 @@ public:
         if (std::abs(dot(ex, ey)) > tol * m_radius * ry ||
             std::abs(dot(ex, ez)) > tol * m_radius * m_length ||
             std::abs(dot(ey, ez)) > tol * ry * m_length)
-            FACET_LOG(Warn,
-                      "cylinder: to_world should not contain a shear; the area (and the "
-                      "density of area-light sampling) will be approximate");
+            FACET_LOG(Warn, "cylinder: to_world should not contain a shear; the area (and the "
+                            "density of area-light sampling) will be approximate");
         else if (std::abs(m_radius - ry) > tol * m_radius)
             FACET_LOG(Warn,
                       "cylinder: to_world should not scale the two directions across the axis "
@@ -233,5 +232,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Cylinder, Shape, "cylinder", "Exact open cylinder (analytic intersection)",
-                    DOC)
+FACET_EXPORT_PLUGIN(facet::Cylinder, Shape, "cylinder",
+                    "Exact open cylinder (analytic intersection)", DOC)

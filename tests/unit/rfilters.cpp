@@ -72,7 +72,8 @@ void expect_tabulates(const ReconstructionFilter &f, const std::function<double(
     const double r = f.radius();
     for (int i = -37; i < 37; ++i) {
         const double mid = r * (i + 0.5) / 31.0;
-        EXPECT_NEAR(f.eval(float(mid)), tabulated(exact, r, mid), 2e-6) << f.to_string() << " " << mid;
+        EXPECT_NEAR(f.eval(float(mid)), tabulated(exact, r, mid), 2e-6)
+            << f.to_string() << " " << mid;
     }
     for (double x = -1.2 * r; x <= 1.2 * r; x += 0.0137) {
         const double s = std::abs(x) * 31.0 / r;
@@ -192,8 +193,9 @@ TEST(Filters, NegativeLobesAreSummedWithTheirSign) {
         const int sx = x + block.border(), sy = block.border();
         return block.data()[(size_t(sy) * block.storage_size().x + sx) * nc + nc - 1];
     };
-    auto k = [](double x) { return tabulated([](double y) { return mn_reference(y, 0.0, 0.5); },
-                                             2.0, x); };
+    auto k = [](double x) {
+        return tabulated([](double y) { return mn_reference(y, 0.0, 0.5); }, 2.0, x);
+    };
     EXPECT_NEAR(weight(3), k(0.5), 1e-6); // offset 0.5, times k(0) = 1 along y
     EXPECT_NEAR(weight(4), k(0.5), 1e-6);
     EXPECT_NEAR(weight(2), k(1.5), 1e-6); // offset 1.5: negative
