@@ -161,6 +161,7 @@ public:
 
     int width() const { return m_width; }
     int height() const { return m_height; }
+    Point2i resolution() const override { return {m_width, m_height}; }
 
     std::string to_string() const override {
         static const char *filters[] = {"nearest", "bilinear"};

@@ -27,6 +27,9 @@ public:
     /// (directly or nested); throws facet::Error when the texture cannot be evaluated on it
     /// (a `mesh_attribute` naming an attribute the shape lacks).
     virtual void check_shape(const Shape &) const {}
+    /// Pixel resolution of a texture backed by an image ((1, 1) otherwise); the projector takes
+    /// its aspect ratio from it, as in Mitsuba 3.
+    virtual Point2i resolution() const { return {1, 1}; }
 };
 
 /// True for a texture that is present and varies over the surface (sets
