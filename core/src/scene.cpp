@@ -17,6 +17,8 @@
 
 namespace facet {
 
+SceneSensor::~SceneSensor() = default;
+
 namespace {
 
 /// Per-thread count of ray_intersect() and ray_test() calls, summed by Scene::ray_count() for
@@ -106,6 +108,7 @@ Scene::Scene(const Properties &props) {
             auto shape = std::static_pointer_cast<Shape>(obj);
             m_shapes.push_back(shape);
             if (auto emitter = shape->emitter_ptr()) m_emitters.push_back(emitter);
+            if (auto sensor = shape->sensor_ptr()) m_sensors.push_back(sensor);
             break;
         }
         case ObjectType::Emitter: {
@@ -189,6 +192,9 @@ Scene::Scene(const Properties &props) {
             FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));
 
         for (auto &emitter : m_emitters) emitter->set_scene(*this);
+        for (auto &sensor : m_sensors)
+            if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
+                needs_scene->set_scene(*this);
     } catch (...) {
         // The destructor does not run for a half-built object.
         rtcReleaseScene(m_rtc_scene);

@@ -1,9 +1,12 @@
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/logger.h>
+#include <facet/sensor.h>
 #include <facet/shape.h>
 
 namespace facet {
+
+ShapeSensor::~ShapeSensor() = default;
 
 Shape::Shape(const Properties &props) {
     for (const auto &[name, obj] : props.objects()) {
@@ -28,10 +31,24 @@ Shape::Shape(const Properties &props) {
             m_emitter->set_shape(this);
             break;
         }
+        case ObjectType::Sensor: {
+            auto *on_shape = dynamic_cast<ShapeSensor *>(obj.get());
+            if (!on_shape)
+                FACET_THROW_AT(loc,
+                               "shape \"{}\": a nested sensor must measure on the shape (e.g. "
+                               "irradiancemeter); \"{}\" is a sensor of its own",
+                               props.plugin_name(), name);
+            if (m_sensor)
+                FACET_THROW_AT(loc, "shape \"{}\" has more than one sensor (\"{}\" is the second)",
+                               props.plugin_name(), name);
+            m_sensor = std::static_pointer_cast<Sensor>(obj);
+            on_shape->attach_shape(this);
+            break;
+        }
         default:
             FACET_THROW_AT(loc,
-                           "shape \"{}\" cannot hold a nested {} (\"{}\"): only a bsdf and an "
-                           "emitter are accepted",
+                           "shape \"{}\" cannot hold a nested {} (\"{}\"): only a bsdf, an "
+                           "emitter and a sensor that measures on it are accepted",
                            props.plugin_name(), object_type_name(obj->type()), name);
         }
         props.mark_queried(name);

@@ -14,6 +14,14 @@
 
 namespace facet {
 
+/// A sensor that needs the finished scene (its bounds), such as `distant`: the scene calls
+/// set_scene() once it is built, as it does for emitters.
+class SceneSensor {
+public:
+    virtual ~SceneSensor();
+    virtual void set_scene(const Scene &scene) = 0;
+};
+
 /// The scene: shapes in one Embree scene, emitters, sensors and the integrator.
 /// Immutable once built; every query is thread-safe.
 class Scene : public Object {

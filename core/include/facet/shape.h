@@ -11,6 +11,15 @@
 
 namespace facet {
 
+/// A sensor that measures on the surface of the shape it is nested in (irradiancemeter, as in
+/// Mitsuba 3). The shape calls attach_shape() while it is constructed; the scene then renders
+/// the sensor like a top-level one.
+class ShapeSensor {
+public:
+    virtual ~ShapeSensor();
+    virtual void attach_shape(const Shape *shape) = 0;
+};
+
 /// Geometry. Plugins derive from Shape (exact primitives, Embree user geometry) or Mesh
 /// (triangles). The base class takes the nested `bsdf` and `emitter` children.
 class Shape : public Object {
@@ -50,6 +59,8 @@ public:
 
     const BSDF *bsdf() const { return m_bsdf.get(); }
     const Emitter *emitter() const { return m_emitter.get(); }
+    /// A nested sensor (see ShapeSensor), or nullptr.
+    std::shared_ptr<Sensor> sensor_ptr() const { return m_sensor; }
     std::shared_ptr<BSDF> bsdf_ptr() const { return m_bsdf; }
     std::shared_ptr<Emitter> emitter_ptr() const { return m_emitter; }
     /// The scene gives shapes without a BSDF a default diffuse one.
@@ -66,6 +77,7 @@ protected:
 
     std::shared_ptr<BSDF> m_bsdf;
     std::shared_ptr<Emitter> m_emitter;
+    std::shared_ptr<Sensor> m_sensor;
 };
 
 } // namespace facet
