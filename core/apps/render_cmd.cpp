@@ -188,6 +188,14 @@ int render_main(int argc, char **argv) {
             fmt::format("{}/{}", result.blocks_done, result.blocks_total);
     film.write(result.image, out, wopts);
 
+    if (result.timed_out) {
+        // The integrator's `timeout` is a request, not an interruption: success.
+        if (!opts.quiet)
+            fmt::print("Timeout reached after {} ({} of {} work units), wrote {}\n",
+                       format_seconds(result.seconds), result.blocks_done, result.blocks_total,
+                       out);
+        return 0;
+    }
     if (result.cancelled) {
         std::fprintf(stderr,
                      "facet: interrupted after %s: wrote the partial image (%zu of %zu blocks) "

@@ -66,6 +66,44 @@ void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
     }
 }
 
+void ImageBlock::splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter) {
+    if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return;
+    const float radius = filter.radius();
+    const Point2i s = storage_size();
+    const float px = pos.x - 0.5f - float(m_offset.x - m_border);
+    const float py = pos.y - 0.5f - float(m_offset.y - m_border);
+    const int x0 = std::max(0, int(std::ceil(px - radius)));
+    const int x1 = std::min(s.x - 1, int(std::floor(px + radius)));
+    const int y0 = std::max(0, int(std::ceil(py - radius)));
+    const int y1 = std::min(s.y - 1, int(std::floor(py + radius)));
+    if (x0 > x1 || y0 > y1) return;
+    const size_t nx = size_t(x1 - x0 + 1), ny = size_t(y1 - y0 + 1);
+    if (m_wx.size() < nx) m_wx.resize(nx);
+    if (m_wy.size() < ny) m_wy.resize(ny);
+    float sx = 0.f, sy = 0.f;
+    for (size_t i = 0; i < nx; ++i) sx += (m_wx[i] = filter.eval(px - float(x0 + int(i))));
+    for (size_t j = 0; j < ny; ++j) sy += (m_wy[j] = filter.eval(py - float(y0 + int(j))));
+    // A footprint cut by the block edge keeps its unnormalised share: only the whole-footprint
+    // sum is known to be the filter's integral over the pixels it covers.
+    const float norm = sx * sy;
+    if (!(norm != 0.f) || !std::isfinite(norm)) return;
+    const float inv = 1.f / norm;
+    const int nc = channel_count();
+    for (size_t j = 0; j < ny; ++j) {
+        const float wy = m_wy[j] * inv;
+        if (wy == 0.f) continue;
+        float *row = m_data.data() + (size_t(y0) + j) * size_t(s.x) * nc;
+        for (size_t i = 0; i < nx; ++i) {
+            const float w = m_wx[i] * wy;
+            if (w == 0.f) continue;
+            float *p = row + (size_t(x0) + i) * nc;
+            p[0] += w * L.r;
+            p[1] += w * L.g;
+            p[2] += w * L.b;
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Film
 
@@ -116,6 +154,28 @@ void Film::prepare(const std::vector<std::string> &aov_names) {
     m_aov_names = aov_names;
     size_t channels = 4 + aov_names.size();
     m_storage.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * channels, 0.0);
+    m_splats.clear();
+    m_splat_scale = 1.0;
+}
+
+void Film::put_splats(const ImageBlock &block) {
+    if (m_splats.empty()) m_splats.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * 3, 0.0);
+    const int nc = block.channel_count();
+    const Point2i s = block.storage_size();
+    const float *data = block.data().data();
+    const int bx = block.offset().x - block.border() - m_crop_offset.x;
+    const int by = block.offset().y - block.border() - m_crop_offset.y;
+    for (int y = 0; y < s.y; ++y) {
+        int cy = by + y;
+        if (cy < 0 || cy >= m_crop_size.y) continue;
+        for (int x = 0; x < s.x; ++x) {
+            int cx = bx + x;
+            if (cx < 0 || cx >= m_crop_size.x) continue;
+            const float *src = data + (size_t(y) * s.x + x) * nc;
+            double *dst = m_splats.data() + (size_t(cy) * m_crop_size.x + cx) * 3;
+            for (int c = 0; c < 3; ++c) dst[c] += double(src[c]);
+        }
+    }
 }
 
 void Film::put_block(const ImageBlock &block) {
@@ -150,18 +210,28 @@ Image Film::develop() const {
     img.channel_names = {"R", "G", "B"};
     if (m_alpha) img.channel_names.push_back("A");
     for (const auto &n : m_aov_names) img.channel_names.push_back(n);
-    if (m_storage.empty()) return img;
+    if (m_storage.empty() && m_splats.empty()) return img;
 
     for (size_t i = 0, n = size_t(m_crop_size.x) * m_crop_size.y; i < n; ++i) {
-        const double *src = m_storage.data() + i * nc;
         float *dst = img.data.data() + i * out_c;
+        const double *splat = m_splats.empty() ? nullptr : m_splats.data() + i * 3;
+        const bool splatted = splat && (splat[0] != 0.0 || splat[1] != 0.0 || splat[2] != 0.0);
+        if (m_storage.empty()) {
+            int o = 0;
+            for (int c = 0; c < 3; ++c) dst[o++] = float(splat[c] * m_splat_scale);
+            if (m_alpha) dst[o++] = splatted ? 1.f : 0.f;
+            for (int k = 0; k < naov; ++k) dst[o++] = 0.f;
+            continue;
+        }
+        const double *src = m_storage.data() + i * nc;
         const double w = src[nc - 1];
         // Filters with negative lobes can give a negative sum: divide by it all the same (as
         // Mitsuba does); only a pixel without any weight stays 0.
         const double inv = w != 0.0 ? 1.0 / w : 0.0;
         int o = 0;
-        for (int c = 0; c < 3; ++c) dst[o++] = float(src[c] * inv);
-        if (m_alpha) dst[o++] = w > 0.0 ? 1.f : 0.f;
+        for (int c = 0; c < 3; ++c)
+            dst[o++] = float(src[c] * inv + (splat ? splat[c] * m_splat_scale : 0.0));
+        if (m_alpha) dst[o++] = w > 0.0 || splatted ? 1.f : 0.f;
         for (int k = 0; k < naov; ++k) dst[o++] = float(src[3 + k] * inv);
     }
     return img;

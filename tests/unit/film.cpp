@@ -330,3 +330,45 @@ TEST(Film, HdrfilmFormatsAndErrors) {
     bad3.set_string("file_format", "tiff");
     EXPECT_NE(error_of([&] { make_film(bad3); }).find("openexr"), std::string::npos);
 }
+
+TEST(Film, SplatsKeepTheirEnergyAndAreScaledNotNormalised) {
+    // A light tracer's splats: the filter footprint sums to one, the weight channel is left
+    // alone, and develop() multiplies by the splat scale instead of dividing by weights.
+    auto g = make_filter("gaussian");
+    Properties fp;
+    fp.set_int("width", 8);
+    fp.set_int("height", 8);
+    auto film = make_film(fp);
+    film->prepare();
+    ImageBlock block;
+    block.reset({0, 0}, {8, 8}, ImageBlock::border_for(*g));
+    block.splat({4.3f, 3.8f}, Color3f(2.f, 1.f, 0.5f), *g);
+    block.splat({1.5f, 1.5f}, Color3f(4.f, 0.f, 0.f), *g);
+    for (int y = 0; y < block.storage_size().y; ++y)
+        for (int x = 0; x < block.storage_size().x; ++x) EXPECT_EQ(block_weight(block, x, y), 0.f);
+    film->put_splats(block);
+    film->set_splat_scale(0.25);
+    Image img = film->develop();
+    double red = 0.0, green = 0.0;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            red += img.at(x, y, 0);
+            green += img.at(x, y, 1);
+        }
+    EXPECT_NEAR(red, 0.25 * (2.0 + 4.0), 1e-5);
+    EXPECT_NEAR(green, 0.25 * 1.0, 1e-5);
+    EXPECT_GT(img.at(4, 3, 1), img.at(5, 4, 1)); // most of it in the pixel it landed in
+    EXPECT_EQ(img.at(7, 7, 0), 0.f);
+
+    // Splats add to what the weighted samples develop to.
+    ImageBlock samples;
+    samples.reset({0, 0}, {8, 8}, ImageBlock::border_for(*g));
+    samples.put({6.5f, 6.5f}, Color3f(1.f), *g);
+    film->put_block(samples);
+    Image both = film->develop();
+    EXPECT_NEAR(both.at(6, 6, 0), 1.f + img.at(6, 6, 0), 1e-6f);
+    EXPECT_NEAR(both.at(4, 3, 1), img.at(4, 3, 1), 1e-6f);
+    // prepare() clears the splats and the scale.
+    film->prepare();
+    EXPECT_EQ(film->develop().at(4, 3, 1), 0.f);
+}

@@ -29,6 +29,11 @@ public:
     /// The same with `aov_count()` extra values (`aovs` may be null when there are none).
     void put(const Point2f &pos, const Color3f &L, const float *aovs,
              const ReconstructionFilter &filter);
+    /// Splats L at `pos` for a light tracer: the filter weights over the footprint are normalised
+    /// to sum to one and only r, g, b receive them (the weight channel stays untouched), so the
+    /// energy of a splat lands on the film whatever the filter. Film::put_splats() takes the
+    /// result.
+    void splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter);
     const Point2i &offset() const { return m_offset; }
     const Point2i &size() const { return m_size; }
     int border() const { return m_border; }
@@ -74,6 +79,19 @@ public:
     /// Adds a finished block (the render loop calls this in a fixed order). Pixels outside the
     /// crop window (parts of the filter border) are dropped.
     void put_block(const ImageBlock &block);
+
+    /// Splatting path (light tracers). Adds the r, g, b channels of `block` (filled with
+    /// ImageBlock::splat) to a separate splat buffer; develop() adds that buffer, times
+    /// splat_scale, to the normalised image, so splats are not divided by sample weights.
+    ///
+    /// Determinism rule: a light tracer splits its light paths into a fixed number of work units
+    /// that does not depend on the thread count, seeds each path's sample stream from (seed, path
+    /// index), gives every unit its own block covering the crop window (plus the filter border)
+    /// and hands the blocks in strictly in unit order (BlockMerger in render.h): the same seed and
+    /// sample count give the same image for any number of threads.
+    void put_splats(const ImageBlock &block);
+    /// Factor applied to the splat buffer by develop() (1 / light paths per pixel).
+    void set_splat_scale(double scale) { m_splat_scale = scale; }
     /// Normalised linear RGB (plus alpha when the pixel format asks) of the crop window, followed
     /// by the AOV channels. Pixels without any sample weight are 0 (and alpha 0).
     virtual Image develop() const;
@@ -92,6 +110,8 @@ protected:
     std::shared_ptr<ReconstructionFilter> m_filter;
     std::vector<double> m_storage; ///< Σ w·L (3), Σ w·aov (per AOV) and Σ w per crop pixel
     std::vector<std::string> m_aov_names;
+    std::vector<double> m_splats; ///< Σ splatted r, g, b per crop pixel (empty: none)
+    double m_splat_scale = 1.0;
     bool m_half = true;   ///< component_format float16
     bool m_alpha = false; ///< pixel_format rgba
 };

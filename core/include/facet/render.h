@@ -5,35 +5,96 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <vector>
 
 namespace facet {
+
+class ImageBlock;
 
 struct RenderOptions {
     int threads = 0;   ///< 0 = all cores
     uint64_t seed = 0; ///< added to the sampler's seed
     int spp = 0;       ///< 0 = the sampler's sample_count
-    int block_size = 32;
+    /// Side of the square image blocks of a sampling integrator; 0 = the integrator's
+    /// `block_size` parameter (32 when that is 0 too).
+    int block_size = 0;
     bool progress = true; ///< progress line on a terminal (never when stderr is not a tty)
-    /// Set to true (e.g. by a signal handler) to stop after the blocks in flight.
+    /// Set to true (e.g. by a signal handler) to stop after the work units in flight.
     std::atomic<bool> *cancel = nullptr;
 };
 
 struct RenderResult {
     Image image; ///< developed film (crop window), plus AOV channels
     double seconds = 0.0;
-    bool cancelled = false;
+    bool cancelled = false; ///< stopped early by the cancel flag (Ctrl-C) or the timeout
+    bool timed_out = false; ///< stopped early by the integrator's `timeout`
+    /// Work units finished and in total: image blocks (times passes) of a sampling integrator,
+    /// light-path batches of a light tracer.
     size_t blocks_done = 0, blocks_total = 0;
-    uint64_t samples = 0; ///< camera samples taken
+    uint64_t samples = 0; ///< camera samples (or light paths) taken
 };
 
-/// Renders `sensor` of `scene` with the scene's integrator (a SamplingIntegrator) block by block
-/// on TBB threads. Deterministic: the same scene, seed and spp give the same image for any
-/// thread count.
+/// Renders `sensor` of `scene` with the scene's integrator (Integrator::render). Deterministic:
+/// the same scene, seed and spp give the same image for any thread count.
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts);
 
 /// Installs SIGINT/SIGHUP handlers that set `flag` (restored by uninstall_interrupt_handler).
 void install_interrupt_handler(std::atomic<bool> *flag);
 void uninstall_interrupt_handler();
+
+// ---------------------------------------------------------------------------------------------
+// Building blocks of integrators' render loops
+
+/// Seed of one sample stream (a pixel, a light path) from the render seed and an index.
+uint64_t sample_stream_seed(uint64_t seed, uint64_t index);
+
+/// Image blocks that finished, merged into the film strictly in index order, so the result does
+/// not depend on which thread finished first. Also recycles block memory. `splat` blocks go
+/// through Film::put_splats(), the others through Film::put_block().
+class BlockMerger {
+public:
+    BlockMerger(Film &film, bool splat = false);
+    ~BlockMerger();
+    std::unique_ptr<ImageBlock> acquire();
+    /// Hands in block `index` (each index in [0, n) exactly once, or not at all after a
+    /// cancellation); merges every block that is now next in order. Returns the number of blocks
+    /// handed in so far.
+    size_t submit(size_t index, std::unique_ptr<ImageBlock> block);
+    /// After a cancelled render: merges what is left, still in index order (gaps are skipped).
+    void flush();
+    size_t finished();
+
+private:
+    void merge(const ImageBlock &block);
+    Film &m_film;
+    bool m_splat;
+    std::mutex m_mutex;
+    std::map<size_t, std::unique_ptr<ImageBlock>> m_pending;
+    std::vector<std::unique_ptr<ImageBlock>> m_free;
+    size_t m_next = 0, m_finished = 0;
+};
+
+/// What run_work_units() did.
+struct WorkUnitsRun {
+    bool cancelled = false; ///< stopped by the cancel flag before every unit was taken
+    bool timed_out = false; ///< stopped by the timeout before every unit was taken
+    double seconds = 0.0;
+};
+
+/// Runs work units 0..count-1 on opts.threads threads (a TBB arena; every thread sets
+/// flush-to-zero). `make_worker` is called once per thread and returns the function that runs one
+/// unit; each thread takes the next unit index until none is left, the cancel flag is set or
+/// `timeout` seconds (if > 0) have passed since `start`. Units in flight are finished. The
+/// progress line counts finished units (the unit function returns the count done so far).
+WorkUnitsRun run_work_units(size_t count, const RenderOptions &opts, double timeout,
+                            const std::function<std::function<size_t(size_t)>()> &make_worker);
+
+/// Number of threads a render with `opts` uses.
+int render_thread_count(const RenderOptions &opts);
 
 } // namespace facet
