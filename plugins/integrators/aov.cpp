@@ -14,6 +14,9 @@ scalars. Types: `albedo`, `depth`, `position`, `uv`, `geo_normal`, `sh_normal`, 
 |------------|------------|---------|-------------------------------------------------|
 | aovs       | string     | —       | The list of `name:type` pairs (required)        |
 | (nested)   | integrator | —       | Integrator that renders the RGB channels        |
+| timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
+| samples_per_pass | integer | (all) | Render in passes over the image of this many samples per pixel (must divide the sample count) |
+| block_size | integer | 0 | Side of the square image blocks, in pixels; 0 chooses 32 |
 
 ```xml
 <integrator type="aov">
@@ -52,7 +55,7 @@ class AovIntegrator final : public SamplingIntegrator {
     };
 
 public:
-    explicit AovIntegrator(const Properties &props) {
+    explicit AovIntegrator(const Properties &props) : SamplingIntegrator(props) {
         std::string list = props.get_string("aovs");
         std::stringstream ss(list);
         std::string item;

@@ -4,7 +4,11 @@ static const char *DOC = R"DOC(
 Writes the distance along each camera ray to the first surface it hits (0 where the ray
 escapes) into all three channels. Useful for debugging scenes and as a depth pass.
 
-This plugin has no parameters.
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
+| samples_per_pass | integer | (all) | Render in passes over the image of this many samples per pixel (must divide the sample count) |
+| block_size | integer | 0 | Side of the square image blocks, in pixels; 0 chooses 32 |
 
 ```xml
 <integrator type="depth"/>
@@ -19,7 +23,7 @@ namespace facet {
 
 class DepthIntegrator final : public SamplingIntegrator {
 public:
-    explicit DepthIntegrator(const Properties &) {}
+    explicit DepthIntegrator(const Properties &props) : SamplingIntegrator(props) {}
 
     Color3f sample(const Scene &scene, Sampler &, const Ray &ray, float *) const override {
         SurfaceInteraction si;

@@ -13,6 +13,9 @@ ignored.
 | emitter_samples | integer | shading_samples | Emitter samples per camera sample |
 | bsdf_samples | integer | shading_samples | BSDF samples per camera sample |
 | hide_emitters | boolean | false | Hide emitters (area lights and the environment) seen directly by the camera |
+| timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
+| samples_per_pass | integer | (all) | Render in passes over the image of this many samples per pixel (must divide the sample count) |
+| block_size | integer | 0 | Side of the square image blocks, in pixels; 0 chooses 32 |
 
 `shading_samples` is only the default of the other two: with `shading_samples` 4 and
 `bsdf_samples` 1, the integrator takes 4 emitter samples and 1 BSDF sample. At least one sample
@@ -52,7 +55,7 @@ uint32_t read_count(const Properties &props, const char *name, int64_t def) {
 
 class DirectIntegrator final : public SamplingIntegrator {
 public:
-    explicit DirectIntegrator(const Properties &props) {
+    explicit DirectIntegrator(const Properties &props) : SamplingIntegrator(props) {
         // As in Mitsuba 3, shading_samples is only the default of the two counts: a scene may
         // give it together with either of them (the one given wins).
         uint32_t shading = read_count(props, "shading_samples", 1);

@@ -11,6 +11,9 @@ bounces, Russian roulette ends paths whose throughput has become small.
 | max_depth | integer | -1 | Longest path, in segments: -1 is unbounded, 1 shows only directly visible emitters, 2 adds direct illumination, 3 one indirect bounce, ... |
 | rr_depth | integer | 5 | Depth from which Russian roulette may end a path (at least 1) |
 | hide_emitters | boolean | false | Hide emitters (area lights and the environment) seen directly by the camera |
+| timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
+| samples_per_pass | integer | (all) | Render in passes over the image of this many samples per pixel (must divide the sample count) |
+| block_size | integer | 0 | Side of the square image blocks, in pixels; 0 chooses 32 |
 
 ```xml
 <integrator type="path">
@@ -36,7 +39,7 @@ namespace facet {
 
 class PathIntegrator final : public SamplingIntegrator {
 public:
-    explicit PathIntegrator(const Properties &props) {
+    explicit PathIntegrator(const Properties &props) : SamplingIntegrator(props) {
         int64_t max_depth = props.get_int("max_depth", -1);
         if (max_depth < -1)
             FACET_THROW_AT(props.location("max_depth"),

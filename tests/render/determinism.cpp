@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 #include <unistd.h>
 
 using namespace facet;
@@ -143,6 +144,28 @@ const PluginDescriptor *cancelling_descriptor() {
         "test integrator",
         "",
         [](const Properties &p) -> Object * { return new CancellingIntegrator(p); }};
+    return &desc;
+}
+
+/// Test integrator that takes 2 ms per sample and returns radiance 1 (for the timeout).
+class SlowIntegrator final : public SamplingIntegrator {
+public:
+    explicit SlowIntegrator(const Properties &p) : SamplingIntegrator(p) {}
+    Color3f sample(const Scene &, Sampler &, const Ray &, float *) const override {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        return Color3f(1.f);
+    }
+};
+
+const PluginDescriptor *slow_descriptor() {
+    static const PluginDescriptor desc{
+        FACET_ABI_VERSION,
+        ObjectType::Integrator,
+        "test_slow",
+        "test integrator",
+        "| timeout | float | -1 | |\n| samples_per_pass | integer | | |\n| block_size | integer | "
+        "0 | |\n",
+        [](const Properties &p) -> Object * { return new SlowIntegrator(p); }};
     return &desc;
 }
 
@@ -281,4 +304,74 @@ TEST(RenderLoop, InterruptHandlerSetsTheFlagOnce) {
     uninstall_interrupt_handler();
     sigaction(SIGINT, nullptr, &now);
     EXPECT_EQ(now.sa_handler, before.sa_handler);
+}
+
+TEST(RenderLoop, TimeoutDevelopsWhatIsDone) {
+    PluginRegistry::instance().register_static(slow_descriptor());
+    // 8x8 pixels in four 4x4 blocks of 16 pixels x 2 samples x 2 ms: 64 ms per block.
+    auto scene = load_temp_scene(
+        "timeout", scene_xml(R"(<integrator type="test_slow"><float name="timeout" value="0.03"/>
+                                <integer name="block_size" value="4"/></integrator>)",
+                             8, 2, "<rfilter type=\"box\"/>"));
+    RenderOptions opts;
+    opts.threads = 1;
+    opts.progress = false;
+    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
+    // The first block starts before the timeout and is finished; no other one starts.
+    EXPECT_TRUE(r.timed_out);
+    EXPECT_TRUE(r.cancelled);
+    EXPECT_EQ(r.blocks_total, 4u);
+    EXPECT_EQ(r.blocks_done, 1u);
+    EXPECT_LT(r.seconds, 1.0); // four blocks would take 0.26 s
+    ASSERT_EQ(r.image.width, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x)
+            EXPECT_EQ(r.image.at(x, y, 0), (x < 4 && y < 4) ? 1.f : 0.f) << x << "," << y;
+}
+
+TEST(RenderLoop, BlockSizeParameterIsHonouredAndDoesNotChangeTheImage) {
+    // Pixels seed their own sample streams, so with a box filter (no sample reaches a
+    // neighbouring block) the block size cannot change the image.
+    auto with_block = [](int block_size) {
+        return load_temp_scene(
+            "block", scene_xml(fmt::format(R"(<integrator type="path"><integer name="block_size"
+                               value="{}"/></integrator>)",
+                                           block_size),
+                               24, 4, "<rfilter type=\"box\"/>"));
+    };
+    auto s5 = with_block(5), s0 = with_block(0);
+    RenderResult a = render_with(*s5, 2, 0, /*block_size=*/0); // the integrator's block_size
+    EXPECT_EQ(a.blocks_total, 25u);                            // ceil(24 / 5)^2
+    RenderResult b = render_with(*s0, 2, 0, 0);                // 0: 32, one block
+    EXPECT_EQ(b.blocks_total, 1u);
+    RenderResult c = render_with(*s5, 2, 0, 7); // RenderOptions override the parameter
+    EXPECT_EQ(c.blocks_total, 16u);
+    EXPECT_TRUE(identical(a.image, b.image));
+    EXPECT_TRUE(identical(a.image, c.image));
+    EXPECT_THROW(with_block(-1), Error);
+}
+
+TEST(RenderLoop, SamplesPerPass) {
+    auto scene = load_temp_scene(
+        "passes", scene_xml(R"(<integrator type="path"><integer name="samples_per_pass" value="2"/>
+                     <integer name="max_depth" value="6"/><integer name="block_size" value="8"/></integrator>)",
+                            16, 6, "<rfilter type=\"box\"/>"));
+    RenderResult one = render_with(*scene, 1, 0, 0), two = render_with(*scene, 3, 0, 0);
+    EXPECT_EQ(one.blocks_total, 4u * 3u); // 4 blocks x 3 passes
+    EXPECT_EQ(one.samples, 16u * 16u * 6u);
+    EXPECT_TRUE(identical(one.image, two.image));
+    // The passes render the same picture as one pass (other noise).
+    auto single = load_temp_scene("single", scene_xml(PATH, 16, 6, "<rfilter type=\"box\"/>"));
+    RenderResult ref = render_with(*single, 2, 0, 0);
+    double ma = 0, mb = 0;
+    for (size_t i = 0; i < ref.image.data.size(); ++i) {
+        ma += one.image.data[i];
+        mb += ref.image.data[i];
+    }
+    EXPECT_NEAR(ma / mb, 1.0, 0.05);
+    // The sample count must be a multiple of samples_per_pass.
+    RenderOptions opts;
+    opts.progress = false;
+    opts.spp = 5;
+    EXPECT_THROW(render(*scene, *scene->sensors().at(0), opts), Error);
 }
