@@ -32,4 +32,17 @@ Sensor::Sensor(const Properties &props) {
         m_sampler = registry.create_as<Sampler>(ObjectType::Sampler, Properties("independent"));
 }
 
+std::pair<DirectionSample, Color3f> Sensor::sample_direction(const Interaction &,
+                                                             const Point2f &) const {
+    FACET_THROW("{} does not support sampling a direction towards it (needed by light tracers "
+                "such as ptracer); use a perspective, thinlens or orthographic sensor",
+                to_string());
+}
+
+float Sensor::pdf_direction(const Interaction &, const DirectionSample &) const {
+    FACET_THROW("{} does not support sampling a direction towards it (needed by light tracers "
+                "such as ptracer); use a perspective, thinlens or orthographic sensor",
+                to_string());
+}
+
 } // namespace facet

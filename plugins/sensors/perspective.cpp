@@ -69,6 +69,7 @@ public:
         m_tan_x = float(std::tan(0.5 * m_x_fov * 3.14159265358979323846 / 180.0));
         m_tan_y = float(double(m_tan_x) / aspect);
         m_origin = m_to_world.apply_point(Point3f(0.f));
+        m_world_to_local = m_to_world.inverse();
     }
 
     std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
@@ -84,6 +85,41 @@ public:
         return {ray, Color3f(1.f)};
     }
 
+    bool supports_direction_sampling() const override { return true; }
+
+    /// Pinhole importance: with a uniform film position and weight 1 per camera ray, the
+    /// importance per solid angle is We = 1 / (A cos^4 theta) (A = 4 tan_x tan_y, the film's
+    /// area on the plane z = 1); times the camera's cos theta and the 1/dist^2 of the connection.
+    std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                         const Point2f &) const override {
+        DirectionSample ds;
+        ds.p = m_origin;
+        ds.delta = true;
+        const Vector3f to_camera = m_origin - ref.p;
+        const float dist2 = dot(to_camera, to_camera);
+        if (!(dist2 > 0.f)) return {ds, Color3f(0.f)};
+        const float dist = std::sqrt(dist2);
+        ds.dist = dist;
+        ds.d = to_camera / dist;
+        const Vector3f local = m_world_to_local.apply_vector(ref.p - m_origin);
+        if (!(local.z > 0.f)) return {ds, Color3f(0.f)};
+        const float ln = norm(local);
+        // Camera rays span near_clip / cos theta .. far_clip / cos theta: depths near..far.
+        if (local.z < m_near_clip || local.z > m_far_clip) return {ds, Color3f(0.f)};
+        const float u = 0.5f * (1.f - local.x / (local.z * m_tan_x)) - m_principal_offset.x;
+        const float v = 0.5f * (1.f - local.y / (local.z * m_tan_y)) - m_principal_offset.y;
+        if (!(u >= 0.f && u < 1.f && v >= 0.f && v < 1.f)) return {ds, Color3f(0.f)};
+        const Point2i size = m_film->size();
+        ds.uv = Point2f(u * float(size.x), v * float(size.y));
+        ds.pdf = 1.f;
+        const float cos_theta = local.z / ln;
+        const float importance =
+            1.f / (4.f * m_tan_x * m_tan_y * cos_theta * cos_theta * cos_theta);
+        return {ds, Color3f(importance / dist2)};
+    }
+
+    float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
+
     std::string to_string() const override {
         return fmt::format(
             "PerspectiveCamera[x_fov={:.4f}, near_clip={}, far_clip={}, origin=({}, {}, {}), "
@@ -98,6 +134,7 @@ private:
     float m_tan_x = 1.f, m_tan_y = 1.f;
     Point2f m_principal_offset;
     Point3f m_origin;
+    Transform m_world_to_local;
 };
 
 } // namespace facet

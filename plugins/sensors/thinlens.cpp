@@ -57,6 +57,8 @@ public:
         if (!(m_near_clip > 0.f) || !(m_far_clip > m_near_clip))
             FACET_THROW_AT(props.location(),
                            "the clipping planes must satisfy 0 < near_clip < far_clip");
+        m_world_to_local = m_to_world.inverse();
+        m_forward = normalize(m_to_world.apply_vector(Vector3f(0.f, 0.f, 1.f)));
     }
 
     bool needs_aperture_sample() const override { return true; }
@@ -77,6 +79,55 @@ public:
         return {ray, Color3f(1.f)};
     }
 
+    bool supports_direction_sampling() const override { return true; }
+
+    /// A uniform point on the lens (as sample_ray draws it) connected to ref; the film position
+    /// is where the ray from that lens point through ref crosses the plane in focus. With uniform
+    /// film and lens samples of weight 1 the importance is We = 1 / (A pi r^2 cos^4 theta)
+    /// (A = 4 tan_x tan_y), so We / pdf_solid_angle = 1 / (A cos^3 theta dist^2), as for a
+    /// pinhole at the lens point.
+    std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                         const Point2f &u) const override {
+        DirectionSample ds;
+        const Point3f local = m_world_to_local.apply_point(ref.p);
+        const Point2f lens = warp::square_to_uniform_disk_concentric(u) * m_aperture_radius;
+        const Point3f lens_p(lens.x, lens.y, 0.f);
+        ds.p = m_to_world.apply_point(lens_p);
+        ds.n = m_forward;
+        ds.delta = !(m_aperture_radius > 0.f);
+        const Vector3f to_lens = ds.p - ref.p;
+        const float dist2 = dot(to_lens, to_lens);
+        if (!(dist2 > 0.f)) return {ds, Color3f(0.f)};
+        ds.dist = std::sqrt(dist2);
+        ds.d = to_lens / ds.dist;
+        if (local.z < m_near_clip || local.z > m_far_clip) return {ds, Color3f(0.f)};
+        const Vector3f w = local - lens_p;
+        if (!(w.z > 0.f)) return {ds, Color3f(0.f)};
+        const float t = m_focus_distance / w.z;
+        const float fx = lens_p.x + w.x * t, fy = lens_p.y + w.y * t;
+        const float fu = 0.5f * (1.f - fx / (m_focus_distance * m_tan_x));
+        const float fv = 0.5f * (1.f - fy / (m_focus_distance * m_tan_y));
+        if (!(fu >= 0.f && fu < 1.f && fv >= 0.f && fv < 1.f)) return {ds, Color3f(0.f)};
+        const Point2i size = m_film->size();
+        ds.uv = Point2f(fu * float(size.x), fv * float(size.y));
+        const float cos_theta = w.z / norm(w);
+        ds.pdf = ds.delta ? 1.f : dist2 / (cos_theta * Pi * m_aperture_radius * m_aperture_radius);
+        const float weight =
+            1.f / (4.f * m_tan_x * m_tan_y * cos_theta * cos_theta * cos_theta * dist2);
+        return {ds, Color3f(weight)};
+    }
+
+    float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
+        if (!(m_aperture_radius > 0.f)) return 0.f;
+        const Point3f lens = m_world_to_local.apply_point(ds.p);
+        if (lens.x * lens.x + lens.y * lens.y > m_aperture_radius * m_aperture_radius) return 0.f;
+        const Vector3f w = m_world_to_local.apply_point(ref.p) - Point3f(lens.x, lens.y, 0.f);
+        const float dist2 = dot(w, w);
+        if (!(w.z > 0.f) || !(dist2 > 0.f)) return 0.f;
+        const float cos_theta = w.z / std::sqrt(dist2);
+        return dist2 / (cos_theta * Pi * m_aperture_radius * m_aperture_radius);
+    }
+
     std::string to_string() const override {
         return fmt::format(
             "ThinLensCamera[aperture_radius={}, focus_distance={}, film={}, sampler={}]",
@@ -87,6 +138,8 @@ private:
     float m_tan_x = 1.f, m_tan_y = 1.f;
     float m_aperture_radius = 0.f, m_focus_distance = 1.f;
     float m_near_clip = 1e-2f, m_far_clip = 1e4f;
+    Transform m_world_to_local;
+    Vector3f m_forward{0.f, 0.f, 1.f};
 };
 
 } // namespace facet

@@ -2,6 +2,7 @@
 
 #include <facet/color.h>
 #include <facet/film.h>
+#include <facet/interaction.h>
 #include <facet/object.h>
 #include <facet/properties.h>
 #include <facet/ray.h>
@@ -26,6 +27,23 @@ public:
     virtual std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
                                                const Point2f &aperture_sample) const = 0;
     virtual bool needs_aperture_sample() const { return false; }
+
+    /// Importance sampling of the sensor from a point in the scene (light tracing): samples a
+    /// point on the sensor's aperture that sees `ref`. Returns the record (ds.p on the aperture,
+    /// ds.d the unit direction from ref to ds.p, ds.dist, ds.pdf the solid-angle density seen
+    /// from ref, or 1 with ds.delta for a pinhole; ds.uv the continuous position on the full film
+    /// in pixels, x right, y down, pixel centres at .5) and the weight We/pdf: the importance
+    /// towards ref, with the sensor's cosine and the 1/dist² of the connection, over the density.
+    /// The caller multiplies by f·|cos| at ref and tests visibility. A zero weight (and pdf 0)
+    /// means ref is outside the field of view or the clipping range.
+    ///
+    /// Not every sensor supports it: the default throws (check supports_direction_sampling()).
+    virtual std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                                 const Point2f &u) const;
+    /// Solid-angle density of sample_direction() for ds (0 for delta sensors).
+    virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const;
+    /// Whether sample_direction() and pdf_direction() are implemented.
+    virtual bool supports_direction_sampling() const { return false; }
 
     Film &film() const { return *m_film; }
     Sampler &sampler() const { return *m_sampler; }
