@@ -1,0 +1,294 @@
+static const char *DOC = R"DOC(
+# ptracer: particle tracer
+
+Traces paths from the emitters (light tracing) and connects every surface vertex to the sensor,
+splatting the contribution into the pixel it lands on. Emitters seen directly by the camera are
+counted by a separate connection from a point sampled on the emitter to the sensor. Each sample
+is one light path (plus one emitter connection); a render takes width x height x spp samples,
+so the spp counts light paths per pixel as in Mitsuba. After `rr_depth` bounces, Russian roulette
+ends paths whose throughput has become small.
+
+The image does not depend on the thread count: the light paths of each pass are split into a
+fixed number of work units that splat into their own image buffers, merged in unit order, and
+every path's random numbers are seeded from (seed, path index).
+
+The sensor must support sampling a direction towards it (perspective, thinlens, orthographic);
+every emitter must be able to emit rays (area, point, spot, directional, directionalarea, ...).
+Emitters at infinity seen directly by the camera are not counted.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| max_depth | integer | -1 | Longest path, in segments: -1 is unbounded, 1 shows only directly visible emitters, 2 adds direct illumination, ... |
+| rr_depth | integer | 5 | Depth from which Russian roulette may end a path (at least 1) |
+| hide_emitters | boolean | false | Do not count emitters seen directly by the camera |
+| samples_per_pass | integer | (all) | Split the light paths into passes of this many per pixel (must divide the sample count) |
+| timeout | float | -1 | Stop after this many seconds and develop what is done; <= 0: no limit |
+
+```xml
+<integrator type="ptracer">
+    <integer name="max_depth" value="8"/>
+</integrator>
+```
+)DOC";
+
+#include <facet/bsdf.h>
+#include <facet/emitter.h>
+#include <facet/film.h>
+#include <facet/integrator.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/shape.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+namespace facet {
+
+class ParticleTracer final : public Integrator {
+public:
+    explicit ParticleTracer(const Properties &props) {
+        int64_t max_depth = props.get_int("max_depth", -1);
+        if (max_depth < -1)
+            FACET_THROW_AT(props.location("max_depth"),
+                           "ptracer: max_depth must be -1 (unbounded) or a value >= 0, got {}",
+                           max_depth);
+        m_max_depth = max_depth == -1 ? std::numeric_limits<uint32_t>::max()
+                                      : uint32_t(std::min<int64_t>(max_depth, 0xfffffffe));
+        int64_t rr_depth = props.get_int("rr_depth", 5);
+        if (rr_depth <= 0)
+            FACET_THROW_AT(props.location("rr_depth"),
+                           "ptracer: rr_depth must be a value greater than zero, got {}", rr_depth);
+        m_rr_depth = uint32_t(std::min<int64_t>(rr_depth, 0xffffffff));
+        m_hide_emitters = props.get_bool("hide_emitters", false);
+        m_samples_per_pass = read_samples_per_pass(props);
+        m_timeout = read_timeout(props);
+    }
+
+    RenderResult render(const Scene &scene, const Sensor &sensor,
+                        const RenderOptions &opts) const override {
+        const auto start = std::chrono::steady_clock::now();
+        if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
+        if (!sensor.supports_direction_sampling())
+            FACET_THROW("ptracer: the sensor {} cannot be connected to (it does not support "
+                        "sampling a direction towards it)",
+                        sensor.to_string());
+        Film &film = sensor.film();
+        std::unique_ptr<Sampler> base_sampler = sensor.sampler().clone();
+        if (opts.spp > 0) base_sampler->set_sample_count(uint32_t(opts.spp));
+        base_sampler->seed(0);
+        const uint32_t spp = std::max(base_sampler->sample_count(), 1u);
+        const uint32_t spp_per_pass =
+            m_samples_per_pass > 0 ? std::min(m_samples_per_pass, spp) : spp;
+        if (spp % spp_per_pass != 0)
+            FACET_THROW("ptracer: the sample count ({}) must be a multiple of samples_per_pass "
+                        "({})",
+                        spp, spp_per_pass);
+        const uint32_t passes = spp / spp_per_pass;
+        const uint64_t seed = opts.seed + sensor.sampler().base_seed();
+        const Point2i film_size = film.size();
+        const uint64_t paths_per_pass =
+            uint64_t(film_size.x) * uint64_t(film_size.y) * uint64_t(spp_per_pass);
+        film.prepare({});
+        // The importance of the sensors integrates to one over the whole film: every pixel
+        // receives spp times its value from width x height x spp paths.
+        film.set_splat_scale(1.0 / double(spp));
+
+        for (const auto &e : scene.emitters())
+            if (has_flag(e->flags(), EmitterFlags::Infinite) &&
+                !has_flag(e->flags(), EmitterFlags::DeltaDirection))
+                FACET_THROW("ptracer: the emitter {} is at infinity; the particle tracer supports "
+                            "only emitters that can emit rays (area, point, spot, directional, "
+                            "directionalarea, ...)",
+                            e->to_string());
+
+        // A fixed number of work units per pass, whatever the thread count (determinism).
+        const uint64_t units_per_pass = std::min<uint64_t>(UnitsPerPass, paths_per_pass);
+        const size_t total = size_t(units_per_pass) * passes;
+        const int border = ImageBlock::border_for(film.rfilter());
+        const ReconstructionFilter &filter = film.rfilter();
+        FACET_LOG(Info, "Starting particle tracing ({}x{}, {} light paths per pixel{}, {} threads)",
+                  film.crop_size().x, film.crop_size().y, spp,
+                  passes > 1 ? fmt::format(" in {} passes", passes) : "",
+                  render_thread_count(opts));
+
+        BlockMerger merger(film, /*splat=*/true);
+        std::atomic<uint64_t> paths_done{0};
+        const bool have_emitters = !scene.emitters().empty();
+        auto make_worker = [&]() -> std::function<size_t(size_t)> {
+            auto sampler = std::shared_ptr<Sampler>(base_sampler->clone());
+            return [&, sampler](size_t index) -> size_t {
+                const uint64_t pass = index / units_per_pass, unit = index % units_per_pass;
+                const uint64_t begin = paths_per_pass * unit / units_per_pass,
+                               end = paths_per_pass * (unit + 1) / units_per_pass;
+                std::unique_ptr<ImageBlock> block = merger.acquire();
+                block->reset(film.crop_offset(), film.crop_size(), border);
+                if (have_emitters)
+                    for (uint64_t i = begin; i < end; ++i) {
+                        sampler->seed(sample_stream_seed(seed, pass * paths_per_pass + i));
+                        trace(scene, sensor, *sampler, *block, filter);
+                    }
+                paths_done += end - begin;
+                return merger.submit(index, std::move(block));
+            };
+        };
+        WorkUnitsRun run = run_work_units(total, opts, m_timeout, make_worker);
+        merger.flush();
+
+        RenderResult result;
+        result.blocks_total = total;
+        result.blocks_done = merger.finished();
+        result.cancelled = (run.cancelled || run.timed_out) && result.blocks_done < total;
+        result.timed_out = run.timed_out && result.blocks_done < total;
+        result.samples = paths_done.load();
+        // A partial render develops what was traced: the scale follows the paths done.
+        if (result.cancelled && result.samples > 0)
+            film.set_splat_scale(double(film_size.x) * double(film_size.y) /
+                                 double(result.samples));
+        if (result.timed_out)
+            FACET_LOG(Warn, "Timeout of {:.2f}s reached after {} of {} work units", m_timeout,
+                      result.blocks_done, total);
+        else if (result.cancelled)
+            FACET_LOG(Warn, "Rendering cancelled after {} of {} work units", result.blocks_done,
+                      total);
+        result.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.image = film.develop();
+        return result;
+    }
+
+    std::string to_string() const override {
+        return fmt::format("ParticleTracer[max_depth = {}, rr_depth = {}, hide_emitters = {}]",
+                           m_max_depth == std::numeric_limits<uint32_t>::max()
+                               ? std::string("-1")
+                               : std::to_string(m_max_depth),
+                           m_rr_depth, m_hide_emitters);
+    }
+
+private:
+    static constexpr uint64_t UnitsPerPass = 64;
+
+    /// One sample: the emitter connection (directly visible emitters) and one light path.
+    void trace(const Scene &scene, const Sensor &sensor, Sampler &sampler, ImageBlock &block,
+               const ReconstructionFilter &filter) const {
+        const auto &emitters = scene.emitters();
+        const float n_emitters = float(emitters.size());
+        auto pick = [&](float u) {
+            size_t i = std::min(size_t(u * n_emitters), emitters.size() - 1);
+            return emitters[i].get();
+        };
+        if (m_max_depth != 0 && !m_hide_emitters)
+            connect_emitter(scene, sensor, *pick(sampler.next_1d()), n_emitters, sampler, block,
+                            filter);
+
+        const Emitter &emitter = *pick(sampler.next_1d());
+        const Point2f u_dir = sampler.next_2d(), u_pos = sampler.next_2d();
+        auto [ray, power] = emitter.sample_ray(u_pos, u_dir);
+        Color3f throughput = power * n_emitters;
+        if (throughput.is_black() || !throughput.is_finite()) return;
+
+        const BSDFContext ctx(TransportMode::Importance);
+        SurfaceInteraction si;
+        if (!scene.ray_intersect(ray, si)) return;
+        float eta = 1.f;
+        for (uint32_t depth = 1; depth < m_max_depth;) {
+            const BSDF *bsdf = si.bsdf();
+            if (!bsdf) return;
+            // ---- Connect this vertex to the sensor ----
+            {
+                auto [ds, importance] = sensor.sample_direction(si, sampler.next_2d());
+                if (!importance.is_black()) {
+                    const Vector3f wo = si.to_local(ds.d);
+                    const float correction = shading_correction(si, ds.d, wo);
+                    if (correction > 0.f && !scene.ray_test(si.spawn_ray_to(ds.p))) {
+                        Color3f f = bsdf->eval(ctx, si, wo);
+                        Color3f value = throughput * f * importance * correction;
+                        if (!value.is_black() && value.is_finite())
+                            block.splat(ds.uv, value, filter);
+                    }
+                }
+            }
+
+            // ---- BSDF sampling: the next segment of the light path ----
+            const float sample1 = sampler.next_1d();
+            const Point2f sample2 = sampler.next_2d();
+            auto [bs, weight] = bsdf->sample(ctx, si, sample1, sample2);
+            if (weight.is_black()) return;
+            const Vector3f wo_world = si.to_world(bs.wo);
+            const float correction = shading_correction(si, wo_world, bs.wo);
+            if (!(correction > 0.f)) return;
+            throughput *= weight * correction;
+            eta *= bs.eta;
+            const float throughput_max = throughput.max();
+            if (!(throughput_max > 0.f) || !std::isfinite(throughput_max)) return;
+
+            Ray next = si.spawn_ray(wo_world);
+            if (!scene.ray_intersect(next, si)) return;
+            ++depth;
+            // ---- Russian roulette (on the power the path carries, as Mitsuba does) ----
+            if (depth > m_rr_depth) {
+                const float q = std::min(throughput.max() * eta * eta, 0.95f);
+                if (!(sampler.next_1d() < q)) return;
+                throughput /= q;
+            }
+        }
+    }
+
+    /// Adjoint shading-normal correction |cos_sh(wi) (wo . n_g)| / |cos_sh(wo) (wi . n_g)|
+    /// (Veach 1997, eq. 5.19), or 0 when wi or wo lies on different sides for the geometric and
+    /// the shading normal (light leaks).
+    static float shading_correction(const SurfaceInteraction &si, const Vector3f &wo_world,
+                                    const Vector3f &wo_local) {
+        const float wi_dot_ng = dot(si.n, si.to_world(si.wi));
+        const float wo_dot_ng = dot(si.n, wo_world);
+        const float cos_wi = Frame::cos_theta(si.wi), cos_wo = Frame::cos_theta(wo_local);
+        if (!(wi_dot_ng * cos_wi > 0.f) || !(wo_dot_ng * cos_wo > 0.f)) return 0.f;
+        return std::abs((cos_wi * wo_dot_ng) / (cos_wo * wi_dot_ng));
+    }
+
+    /// Emitters seen directly: a point on the emitter's shape connected to the sensor, weighted
+    /// by the emitted radiance towards the sensor and the emitter's cosine.
+    void connect_emitter(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
+                         float n_emitters, Sampler &sampler, ImageBlock &block,
+                         const ReconstructionFilter &filter) const {
+        const Point2f u_pos = sampler.next_2d(), u_sensor = sampler.next_2d();
+        // Point and spot lights are invisible to a camera; only emitters on shapes are seen.
+        const Shape *shape = emitter.shape();
+        if (emitter.is_delta() || !shape) return;
+        PositionSample ps = shape->sample_position(u_pos);
+        if (!(ps.pdf > 0.f)) return;
+        SurfaceInteraction si;
+        si.p = ps.p;
+        si.n = ps.n;
+        si.uv = ps.uv;
+        si.sh_frame = Frame(ps.n);
+        si.shape = shape;
+        si.t = 0.f;
+        auto [ds, importance] = sensor.sample_direction(si, u_sensor);
+        if (importance.is_black()) return;
+        si.wi = si.to_local(ds.d);
+        const float cos_theta = Frame::cos_theta(si.wi);
+        if (!(cos_theta > 0.f)) return;
+        Color3f L = emitter.eval(si);
+        if (L.is_black()) return;
+        if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
+        Color3f value = L * (cos_theta * n_emitters / ps.pdf) * importance;
+        if (value.is_finite()) block.splat(ds.uv, value, filter);
+    }
+
+    uint32_t m_max_depth;
+    uint32_t m_rr_depth;
+    bool m_hide_emitters;
+    uint32_t m_samples_per_pass = 0;
+    double m_timeout = -1.0;
+};
+
+} // namespace facet
+
+FACET_EXPORT_PLUGIN(facet::ParticleTracer, Integrator, "ptracer",
+                    "Particle tracer: light paths connected to the sensor", DOC)
