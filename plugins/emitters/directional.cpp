@@ -22,6 +22,7 @@ unit area on a surface perpendicular to the direction.
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/scene.h>
+#include <facet/warp.h>
 
 namespace facet {
 
@@ -47,6 +48,17 @@ public:
 
     void set_scene(const Scene &scene) override {
         m_radius = std::max(scene.bbox().bounding_sphere_radius(), 1e-3f);
+        if (scene.bbox().valid()) m_center = scene.bbox().center();
+    }
+
+    /// Emitted rays (light tracing): a uniform point on the disk of the scene's bounding sphere
+    /// that faces the light, one radius up-beam of the centre, travelling along the direction;
+    /// the weight irradiance x disk area is the power each ray carries.
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &) const override {
+        const Frame frame(m_direction);
+        const Point2f p = warp::square_to_uniform_disk_concentric(u_pos) * m_radius;
+        const Point3f o = m_center - m_direction * m_radius + frame.s * p.x + frame.t * p.y;
+        return {Ray(o, m_direction), m_irradiance * (Pi * m_radius * m_radius)};
     }
 
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
@@ -75,6 +87,7 @@ private:
     Color3f m_irradiance;
     Vector3f m_direction;
     float m_radius = 1.f;
+    Point3f m_center{0.f, 0.f, 0.f};
 };
 
 } // namespace facet

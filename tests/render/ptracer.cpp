@@ -1,6 +1,7 @@
 // The particle tracer: the same image for any thread count, and the same picture as the path
 // tracer on a scene with an area light seen directly and a point light (a two-sample test of
-// independent renders of each), plus the directionalarea emitter that only it can render.
+// independent renders of each), plus the directionalarea emitter that only it can render and a
+// directional light.
 
 #include <facet/integrator.h>
 #include <facet/render.h>
@@ -245,4 +246,37 @@ TEST(ParticleTracer, DirectionalAreaLightsTheFloorBelowIt) {
         }
     // rho E / pi = 0.5 * 3 / pi for the red channel; the estimate has 16 x 16 x 256 paths.
     EXPECT_NEAR(inside / n_inside, 0.5 * 3.0 / Pi, 0.03 * 0.5 * 3.0 / Pi);
+}
+
+TEST(ParticleTracer, DirectionalLightOnADiffuseFloor) {
+    // Sunlight of irradiance 2 at 60 degrees from the normal on a floor of reflectance 0.5:
+    // radiance rho E cos / pi everywhere the camera looks.
+    const char *xml = R"(<scene version="3.0.0">
+    <integrator type="ptracer"><integer name="max_depth" value="2"/></integrator>
+    <sensor type="orthographic">
+        <transform name="to_world">
+            <scale x="2" y="2" z="1"/>
+            <lookat origin="0, 1, 0" target="0, 0, 0" up="0, 0, -1"/>
+        </transform>
+        <sampler type="independent"><integer name="sample_count" value="256"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="16"/><integer name="height" value="16"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <emitter type="directional">
+        <vector name="direction" value="0.8660254, -0.5, 0"/>
+        <rgb name="irradiance" value="2"/>
+    </emitter>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
+    </shape>
+</scene>)";
+    auto scene = load_temp_scene("sun", xml);
+    Image img = render_with(*scene, 2).image;
+    double mean = 0.0;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) mean += img.at(x, y, 1) / 256.0;
+    EXPECT_NEAR(mean, 0.5 * 2.0 * 0.5 / Pi, 0.03 * 0.5 * 2.0 * 0.5 / Pi);
 }
