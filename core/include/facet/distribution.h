@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/assert.h>
 #include <facet/vector.h>
 
 #include <algorithm>
@@ -27,11 +28,15 @@ public:
     size_t size() const { return m_cdf.empty() ? 0 : m_cdf.size() - 1; }
     /// Sum of the weights before normalisation.
     double sum() const { return m_sum; }
-    float pmf(size_t i) const { return float(m_cdf[i + 1] - m_cdf[i]); }
+    float pmf(size_t i) const {
+        FACET_ASSERT(i < size());
+        return float(m_cdf[i + 1] - m_cdf[i]);
+    }
 
     /// Index for u in [0,1); `u` is rescaled to a fresh uniform variate within the entry.
     size_t sample_reuse(float &u) const {
         size_t n = size();
+        FACET_ASSERT(n > 0 && u >= 0.f && u <= 1.f);
         auto it = std::upper_bound(m_cdf.begin() + 1, m_cdf.end(), double(u));
         size_t i = std::min(size_t(it - m_cdf.begin()) - 1, n - 1);
         // Skip zero-probability entries that upper_bound may land on at the boundaries.

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/assert.h>
 #include <facet/vector.h>
 
 namespace facet {
@@ -19,11 +20,21 @@ struct Frame {
     Vector3f s{1, 0, 0}, t{0, 1, 0}, n{0, 0, 1};
 
     Frame() = default;
-    Frame(const Vector3f &s_, const Vector3f &t_, const Vector3f &n_) : s(s_), t(t_), n(n_) {}
-    explicit Frame(const Vector3f &n_) : n(n_) { coordinate_system(n, s, t); }
+    Frame(const Vector3f &s_, const Vector3f &t_, const Vector3f &n_) : s(s_), t(t_), n(n_) {
+        FACET_ASSERT(is_unit(s) && is_unit(t) && is_unit(n));
+        FACET_ASSERT(std::abs(dot(s, n)) < 1e-3f && std::abs(dot(t, n)) < 1e-3f);
+    }
+    /// The normal must be a unit vector (the basis built from it is orthonormal only then).
+    explicit Frame(const Vector3f &n_) : n(n_) {
+        FACET_ASSERT(is_unit(n));
+        coordinate_system(n, s, t);
+    }
 
     Vector3f to_local(const Vector3f &v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }
     Vector3f to_world(const Vector3f &v) const { return s * v.x + t * v.y + n * v.z; }
+
+    /// |v| = 1 up to float rounding of normalised or interpolated vectors.
+    static bool is_unit(const Vector3f &v) { return std::abs(dot(v, v) - 1.f) < 1e-3f; }
 
     static float cos_theta(const Vector3f &v) { return v.z; }
     static float cos_theta_2(const Vector3f &v) { return v.z * v.z; }

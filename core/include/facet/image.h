@@ -1,5 +1,7 @@
 #pragma once
 
+#include <facet/assert.h>
+
 #include <map>
 #include <string>
 #include <vector>
@@ -14,8 +16,14 @@ struct Image {
 
     Image() = default;
     Image(int w, int h, int c) : width(w), height(h), channels(c), data(size_t(w) * h * c, 0.f) {}
-    float &at(int x, int y, int c) { return data[(size_t(y) * width + x) * channels + c]; }
-    float at(int x, int y, int c) const { return data[(size_t(y) * width + x) * channels + c]; }
+    float &at(int x, int y, int c) {
+        FACET_ASSERT(x >= 0 && x < width && y >= 0 && y < height && c >= 0 && c < channels);
+        return data[(size_t(y) * width + x) * channels + c];
+    }
+    float at(int x, int y, int c) const {
+        FACET_ASSERT(x >= 0 && x < width && y >= 0 && y < height && c >= 0 && c < channels);
+        return data[(size_t(y) * width + x) * channels + c];
+    }
 };
 
 struct ImageWriteOptions {
