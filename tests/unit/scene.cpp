@@ -18,22 +18,6 @@ using namespace facet;
 
 namespace {
 
-/// The scene needs the default plugins (path, perspective, diffuse) and these tests use a few more.
-bool have_plugins() {
-    static const bool ok = [] {
-        auto names = PluginRegistry::instance().available();
-        for (const char *n : {"path", "perspective", "diffuse", "area", "point", "constant",
-                              "rectangle", "sphere", "disk", "cube"})
-            if (std::find(names.begin(), names.end(), n) == names.end()) return false;
-        return true;
-    }();
-    return ok;
-}
-
-#define REQUIRE_PLUGINS()                                                                          \
-    if (!have_plugins())                                                                           \
-    GTEST_SKIP() << "the default plugins (path, perspective, diffuse, ...) are not built"
-
 std::shared_ptr<Object> create(ObjectType kind, const std::string &type, Properties props = {}) {
     props.set_plugin_name(type);
     return PluginRegistry::instance().create(kind, props);
@@ -78,7 +62,6 @@ template <typename F> std::string error_of(F &&f) {
 } // namespace
 
 TEST(SceneBuild, DefaultsAreCreated) {
-    REQUIRE_PLUGINS();
     Scene scene(rect_and_sphere());
     ASSERT_EQ(scene.shapes().size(), 2u);
     EXPECT_TRUE(scene.integrator());
@@ -114,7 +97,6 @@ TEST(SceneBuild, EmittingShapesGetABlackDefaultBSDF) {
 }
 
 TEST(SceneBuild, ChildrenAreCheckedAndOrdered) {
-    REQUIRE_PLUGINS();
     // Top-level BSDFs are references only; emitters keep declaration order, area emitters
     // coming with their shape.
     Properties props = rect_and_sphere(area_light(Color3f(1.f)));
@@ -158,7 +140,6 @@ TEST(SceneBuild, ChildrenAreCheckedAndOrdered) {
 }
 
 TEST(SceneQuery, IntersectionRecords) {
-    REQUIRE_PLUGINS();
     Scene scene(rect_and_sphere());
     SurfaceInteraction si;
     // The floor, from above.
@@ -254,13 +235,9 @@ void check_spawned_rays(const Transform &to_world, float radius_world, uint64_t 
 
 } // namespace
 
-TEST(SpawnRay, NoSelfIntersectionAtUnitScale) {
-    REQUIRE_PLUGINS();
-    check_spawned_rays(Transform(), 1.f, 1);
-}
+TEST(SpawnRay, NoSelfIntersectionAtUnitScale) { check_spawned_rays(Transform(), 1.f, 1); }
 
 TEST(SpawnRay, NoSelfIntersectionAtLargeCoordinates) {
-    REQUIRE_PLUGINS();
     check_spawned_rays(Transform::translate(Vector3f(1e4f, -2e4f, 1e4f)), 1.f, 2);
     check_spawned_rays(Transform::translate(Vector3f(1e4f, 1e4f, 3e4f)) *
                            Transform::rotate(Vector3f(1, 2, 3), 37.f) *
@@ -269,14 +246,12 @@ TEST(SpawnRay, NoSelfIntersectionAtLargeCoordinates) {
 }
 
 TEST(SpawnRay, NoSelfIntersectionAtSmallScale) {
-    REQUIRE_PLUGINS();
     check_spawned_rays(Transform::translate(Vector3f(0.3f, 0.2f, -0.1f)) *
                            Transform::scale(Vector3f(1e-2f, 1e-2f, 1e-2f)),
                        1e-2f, 4);
 }
 
 TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
-    REQUIRE_PLUGINS();
     // A floor (z = 0) and a wall (x = 0) crossing it.
     Properties floor;
     floor.set_transform("to_world", Transform::scale(Vector3f(2, 2, 1)));
@@ -324,7 +299,6 @@ TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
 }
 
 TEST(SceneEmitters, SampleAndPdfAgree) {
-    REQUIRE_PLUGINS();
     const Color3f radiance(2.f, 3.f, 4.f);
     Properties props = rect_and_sphere(area_light(radiance));
     Properties point;
@@ -374,7 +348,6 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
 }
 
 TEST(SceneEmitters, EnvironmentIsEvaluatedOnMisses) {
-    REQUIRE_PLUGINS();
     Properties props = rect_and_sphere();
     Properties sky;
     sky.set_color("radiance", Color3f(0.5f, 0.25f, 0.125f));
@@ -390,10 +363,6 @@ TEST(SceneEmitters, EnvironmentIsEvaluatedOnMisses) {
 }
 
 TEST(SceneQuery, InstancesDispatchToTheGroupMembers) {
-    REQUIRE_PLUGINS();
-    auto names = PluginRegistry::instance().available();
-    if (std::find(names.begin(), names.end(), "instance") == names.end())
-        GTEST_SKIP() << "instance plugin not built";
     Properties ball;
     ball.set_float("radius", 0.5);
     Properties group("shapegroup");
