@@ -1,3 +1,4 @@
+#include <facet/assert.h>
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/integrator.h>
@@ -237,16 +238,17 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m_rtc_scene, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-        si.t = Infinity;
-        si.shape = nullptr;
+        escaped(ray, si);
         return false;
     }
     const Point2f uv(rh.hit.u, rh.hit.v);
     if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
         // A hit inside an instanced group: geomID is the member of the group.
+        FACET_ASSERT(rh.hit.instID[0] < m_geometry_shapes.size());
         m_geometry_shapes[rh.hit.instID[0]]->compute_instance_interaction(
             ray, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, uv, si);
     } else {
+        FACET_ASSERT(rh.hit.geomID < m_geometry_shapes.size());
         m_geometry_shapes[rh.hit.geomID]->compute_surface_interaction(ray, rh.ray.tfar,
                                                                       rh.hit.primID, uv, si);
     }
@@ -305,16 +307,17 @@ float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample
     return ds.emitter->pdf_direction(ref, ds) / float(m_emitters.size());
 }
 
-Color3f Scene::eval_environment(const Ray &ray) const {
-    Color3f result(0.f);
-    if (m_environment.empty()) return result;
-    SurfaceInteraction si;
+void Scene::escaped(const Ray &ray, SurfaceInteraction &si) {
     si.p = ray.o;
+    si.n = Normal3f(0.f);
     si.t = Infinity;
     si.sh_frame = Frame();
-    si.wi = -ray.d;
-    for (const auto &emitter : m_environment) result += emitter->eval(si);
-    return result;
+    si.uv = Point2f(0.f, 0.f);
+    si.dp_du = si.dp_dv = Vector3f(0.f);
+    si.wi = -ray.d; // local: the frame is the identity
+    si.shape = nullptr;
+    si.prim_index = 0;
+    si.instance_index = uint32_t(-1);
 }
 
 std::string Scene::to_string() const {

@@ -144,7 +144,8 @@ public:
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
-        Vector3f local = normalize(m_to_world.inverse().apply_vector(-si.wi));
+        // si is the record of a ray that left the scene: wi points back along it (local frame).
+        Vector3f local = normalize(m_to_world.inverse().apply_vector(-si.to_world(si.wi)));
         return lookup(local);
     }
 

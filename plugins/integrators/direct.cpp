@@ -81,7 +81,7 @@ public:
 
         // ---- Emitters seen directly ----
         if (!m_hide_emitters) {
-            if (!hit) return environment_mis(scene, ray, si, 0.f, true);
+            if (!hit) return environment_mis(scene, si, si, 0.f, true);
             if (const Emitter *emitter = si.emitter()) result += emitter->eval(si);
         }
         if (!hit) return result;
@@ -117,7 +117,7 @@ public:
             SurfaceInteraction si_bsdf;
             if (!scene.ray_intersect(bsdf_ray, si_bsdf)) {
                 result += bsdf_weight *
-                          environment_mis(scene, bsdf_ray, si, bs.pdf * m_frac_bsdf, delta,
+                          environment_mis(scene, si_bsdf, si, bs.pdf * m_frac_bsdf, delta,
                                           m_frac_emitter) *
                           m_weight_bsdf;
                 continue;

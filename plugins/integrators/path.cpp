@@ -77,7 +77,7 @@ public:
             if (!hit) {
                 if (count_emission)
                     result += throughput *
-                              environment_mis(scene, ray, prev_si, prev_bsdf_pdf, prev_bsdf_delta);
+                              environment_mis(scene, si, prev_si, prev_bsdf_pdf, prev_bsdf_delta);
                 break;
             }
             if (count_emission) {

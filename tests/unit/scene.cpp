@@ -3,6 +3,7 @@
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/integrator.h>
+#include <facet/mis.h>
 #include <facet/plugin.h>
 #include <facet/random.h>
 #include <facet/scene.h>
@@ -347,19 +348,46 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
     EXPECT_FALSE(weight2.is_black());
 }
 
-TEST(SceneEmitters, EnvironmentIsEvaluatedOnMisses) {
+TEST(SceneEmitters, EnvironmentIsSeenThroughTheMissRecord) {
     Properties props = rect_and_sphere();
     Properties sky;
     sky.set_color("radiance", Color3f(0.5f, 0.25f, 0.125f));
     props.set_object("sky", create(ObjectType::Emitter, "constant", sky));
     Scene scene(props);
     ASSERT_EQ(scene.environment_emitters().size(), 1u);
-    Color3f env = scene.eval_environment(Ray(Point3f(0, 0, 5), Vector3f(0, 0, 1)));
+
+    // The miss fills the record of the escaped ray: wi local (identity frame), pointing back.
+    const Vector3f d = normalize(Vector3f(0.3f, -0.2f, 0.9f));
+    const Ray ray(Point3f(0, 0, 5), d);
+    SurfaceInteraction escaped;
+    escaped.shape = scene.shapes().front().get(); // stale fields of an earlier hit are reset
+    escaped.t = 1.f;
+    ASSERT_FALSE(scene.ray_intersect(ray, escaped));
+    EXPECT_FALSE(escaped.is_valid());
+    EXPECT_EQ(escaped.shape, nullptr);
+    Vector3f back = escaped.to_world(escaped.wi);
+    EXPECT_NEAR(back.x, -d.x, 1e-6f);
+    EXPECT_NEAR(back.y, -d.y, 1e-6f);
+    EXPECT_NEAR(back.z, -d.z, 1e-6f);
+
+    // Unweighted (camera ray or delta bounce): the sky radiance.
+    Color3f env = environment_mis(scene, escaped, escaped, 0.f, true);
     EXPECT_NEAR(env.r, 0.5f, 1e-6f);
     EXPECT_NEAR(env.g, 0.25f, 1e-6f);
     EXPECT_NEAR(env.b, 0.125f, 1e-6f);
+    // After a BSDF sample: weighted against emitter sampling (the sky is the only emitter, its
+    // directions have density 1/4π); equal densities weigh 1/2.
+    Interaction ref;
+    ref.p = ray.o;
+    float em_pdf = InvFourPi / float(scene.emitters().size());
+    Color3f half = environment_mis(scene, escaped, ref, em_pdf, false);
+    EXPECT_NEAR(half.r, 0.25f, 1e-6f);
+    Color3f third = environment_mis(scene, escaped, ref, em_pdf, false, 0.5f);
+    EXPECT_NEAR(third.r, 0.5f * 0.8f, 1e-6f); // (1)² / ((1)² + (1/2)²) = 0.8
+
     Scene empty_env(rect_and_sphere());
-    EXPECT_TRUE(empty_env.eval_environment(Ray(Point3f(0, 0, 5), Vector3f(0, 0, 1))).is_black());
+    ASSERT_FALSE(empty_env.ray_intersect(ray, escaped));
+    EXPECT_TRUE(environment_mis(empty_env, escaped, escaped, 0.f, true).is_black());
 }
 
 TEST(SceneQuery, InstancesDispatchToTheGroupMembers) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/assert.h>
 #include <facet/emitter.h>
 #include <facet/interaction.h>
 #include <facet/scene.h>
@@ -12,6 +13,7 @@ namespace facet {
 /// Power heuristic (β = 2, Veach 1997 eq. 9.13) for the strategy with density `a` against one
 /// with density `b`; 0 where both vanish.
 inline float mis_weight(float a, float b) {
+    FACET_ASSERT(a >= 0.f && b >= 0.f);
     a *= a;
     b *= b;
     float w = a / (a + b);
@@ -31,25 +33,27 @@ inline DirectionSample direction_to(const SurfaceInteraction &si, const Interact
     return ds;
 }
 
-/// Radiance of the infinite emitters along `ray`, which left the scene from `ref` after a BSDF
-/// sample of density `bsdf_pdf`. Each emitter is weighted against the density with which emitter
+/// Radiance of the infinite emitters seen by a ray that left the scene from `ref` after a BSDF
+/// sample of density `bsdf_pdf`; `escaped` is the record Scene::ray_intersect() filled on the
+/// miss (Scene::escaped()). Each emitter is weighted against the density with which emitter
 /// sampling picks it and this direction (times `emitter_fraction`, the share of emitter samples
 /// when several strategies are mixed), since an emitter sample only ever carries its own
-/// emitter's radiance. After a delta lobe (`delta`) nothing is weighted.
-inline Color3f environment_mis(const Scene &scene, const Ray &ray, const Interaction &ref,
-                               float bsdf_pdf, bool delta, float emitter_fraction = 1.f) {
+/// emitter's radiance. After a delta lobe or for a camera ray (`delta`) nothing is weighted and
+/// `ref` is not read.
+inline Color3f environment_mis(const Scene &scene, const SurfaceInteraction &escaped,
+                               const Interaction &ref, float bsdf_pdf, bool delta,
+                               float emitter_fraction = 1.f) {
+    FACET_ASSERT(!escaped.is_valid() && !escaped.shape);
     const auto &emitters = scene.environment_emitters();
     if (emitters.empty()) return Color3f(0.f);
-    SurfaceInteraction miss; // t = Infinity, identity shading frame
-    miss.wi = -ray.d;
-    DirectionSample ds;
-    ds.d = ray.d;
+    DirectionSample ds; // the emitter-sampling record of the same direction
+    ds.d = -escaped.to_world(escaped.wi);
     ds.dist = Infinity;
-    ds.p = ref.p + ray.d;
-    ds.n = -ray.d;
+    ds.p = ref.p + ds.d;
+    ds.n = -ds.d;
     Color3f result(0.f);
     for (const auto &emitter : emitters) {
-        Color3f L = emitter->eval(miss);
+        Color3f L = emitter->eval(escaped);
         if (L.is_black()) continue;
         float w = 1.f;
         if (!delta) {

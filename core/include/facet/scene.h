@@ -32,8 +32,13 @@ public:
     ~Scene() override;
     ObjectType type() const override { return ObjectType::Scene; }
 
-    /// Closest hit; fills si and returns true, or returns false (si.t stays Infinity).
+    /// Closest hit: fills si and returns true. On a miss returns false and makes si the record
+    /// of a ray that left the scene (escaped()), which environment emitters' eval() reads.
     bool ray_intersect(const Ray &ray, SurfaceInteraction &si) const;
+    /// The record of a ray that left the scene, the one route to the environment emitters: t =
+    /// Infinity, no shape, p = the ray's origin, the identity shading frame and wi = -ray.d in it
+    /// (local, like every wi; the world direction towards the origin is si.to_world(si.wi)).
+    static void escaped(const Ray &ray, SurfaceInteraction &si);
     /// Any hit in [ray.mint, ray.maxt] (rtcOccluded1).
     bool ray_test(const Ray &ray) const;
     /// Number of ray_intersect() and ray_test() calls so far, all threads and scenes together
@@ -46,11 +51,10 @@ public:
                                                                  bool test_visibility) const;
     /// Density of sample_emitter_direction() for ds (selection probability included).
     float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const;
-    /// Radiance of the infinite emitters along a ray that left the scene.
-    Color3f eval_environment(const Ray &ray) const;
 
     const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
     const std::vector<std::shared_ptr<Emitter>> &emitters() const { return m_emitters; }
+    /// The infinite emitters, the ones a ray that left the scene sees (facet/mis.h).
     const std::vector<std::shared_ptr<Emitter>> &environment_emitters() const {
         return m_environment;
     }
