@@ -1,6 +1,7 @@
 # Run with cmake -P by the `sdk` ctest: installs the facet build into a scratch prefix, builds
 # plugins out of tree against that installation exactly as a user would, and checks that the
-# installed `facet` loads them with -a (render and chi2).
+# installed `facet` loads them with -a (render and chi2) and that a test program of the plugin's
+# author links the installed facet::testing.
 # Inputs: -DBUILD_DIR=<facet build> -DSOURCE_DIR=<facet source> -DWORK=<scratch folder>
 #         -DCXX=<C++ compiler> [-DLAUNCHER=<compiler launcher, e.g. ccache>]
 
@@ -38,7 +39,8 @@ endfunction()
 
 # 1. The installation: headers, libfacet, plugins, the command and the CMake package.
 step("install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${PREFIX})
-foreach(f bin/facet include/facet/bsdf.h include/facet/plugin.h lib/cmake/facet/facetConfig.cmake
+foreach(f bin/facet include/facet/bsdf.h include/facet/plugin.h include/facet/chi2.h
+          include/facet/compare.h lib/cmake/facet/facetConfig.cmake
           lib/cmake/facet/FacetPlugin.cmake lib/facet/plugins/diffuse.so)
     if(NOT EXISTS ${PREFIX}/${f})
         message(FATAL_ERROR "the installation lacks ${f}")
@@ -62,6 +64,11 @@ endif()
 step("chi2 of the plugin" ${FACET} chi2 bsdf phong -a ${WORK}/phong-build --theta 40 --tests 2)
 step("chi2 of the plugin, sharp lobe" ${FACET} chi2 bsdf phong exponent=300
      specular_reflectance=0.6 diffuse_reflectance=0.3 -a ${WORK}/phong-build --theta 70 --tests 2)
+# The plugin's own test program, linked against the installed facet::testing.
+step("chi2 through facet::testing" ${WORK}/phong-build/phong_chi2 ${WORK}/phong-build)
+if(NOT STEP_OUTPUT MATCHES "verdict: accepted")
+    message(FATAL_ERROR "phong_chi2 printed no accepted verdict")
+endif()
 # $FACET_PLUGIN_PATH works as well as -a.
 step("render through FACET_PLUGIN_PATH" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PATH=${WORK}/phong-build
      ${FACET} render ${SOURCE_DIR}/tests/sdk/phong/scene.xml -o ${WORK}/phong2.exr -q -D spp=1)
