@@ -2,6 +2,7 @@
 // its p-value, and the pictures and tables written when a test fails. Adapters are in
 // chi2_adapters.cpp.
 
+#include <facet/assert.h>
 #include <facet/chi2.h>
 #include <facet/image.h>
 #include <facet/logger.h>
@@ -310,29 +311,17 @@ CellIntegral integrate_cell(const Chi2Adapter &adapter, const Chi2Options &opts,
 
 } // namespace
 
-Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
-    Chi2Options opts = opts_in;
-    Chi2Result res;
-    res.description = adapter.to_string();
-    if (opts.res < 2) FACET_THROW("chi2: res must be at least 2 (got {})", opts.res);
-    if (opts.samples == 0 || opts.samples > uint64_t(0xffffffffu))
-        FACET_THROW("chi2: the sample count must be in [1, 2^32) (got {})", opts.samples);
-    if (opts.res % 2 == 1) {
-        // An even count puts a cell edge on the horizon, where many pdfs jump.
-        res.notes.push_back(fmt::format("res {} rounded up to {} (even)", opts.res, opts.res + 1));
-        ++opts.res;
-    }
-    int dim = adapter.sample_dim();
-    if (dim < 1 || dim > 8) FACET_THROW("chi2: sample_dim must be in [1, 8] (got {})", dim);
+namespace {
 
-    const int cos_res = opts.res, phi_res = 2 * opts.res;
+// run_chi2() in four steps: histogram (sampling and per-sample checks), integrate (expected
+// counts), pool (Pearson's statistic on pooled cells), verdict (p-value and global checks).
+
+/// Step 1: draws the samples, bins the smooth ones into res.observed and checks each one.
+/// Samples go in fixed chunks, so every sum is taken in the same order on any thread count.
+Findings histogram(const Chi2Adapter &adapter, const Chi2Options &opts, Chi2Result &res) {
+    const int dim = adapter.sample_dim(), phi_res = res.phi_res, cos_res = res.cos_res;
     const size_t cells = size_t(cos_res) * phi_res;
     const uint64_t n = opts.samples;
-    res.cos_res = cos_res;
-    res.phi_res = phi_res;
-    res.samples = n;
-
-    // 1. Samples, in fixed chunks so that every sum is taken in the same order on any thread count.
     const uint64_t chunk = 1 << 14;
     const size_t chunks = size_t((n + chunk - 1) / chunk);
     std::vector<Findings> findings(chunks);
@@ -370,6 +359,7 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
             double c = std::clamp(double(s.d.z), -1.0, 1.0);
             int ip = std::clamp(int((phi + kPi) / (2.0 * kPi) * phi_res), 0, phi_res - 1);
             int jc = std::clamp(int((c + 1.0) * 0.5 * cos_res), 0, cos_res - 1);
+            FACET_ASSERT(size_t(jc) * phi_res + ip < cells);
             ++hist[size_t(jc) * phi_res + ip];
         }
     });
@@ -377,8 +367,8 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
     for (const auto &hist : histograms)
         for (size_t k = 0; k < cells; ++k) res.observed[k] += hist[k];
 
+    // The chunks' findings in chunk order; examples sorted by sample index.
     Findings total;
-    std::vector<Findings::Example> examples, mismatches;
     for (const Findings &f : findings) {
         total.bad_direction += f.bad_direction;
         total.nonfinite_weight += f.nonfinite_weight;
@@ -395,9 +385,18 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
         }
         total.max_pdf_error = std::max(total.max_pdf_error, f.max_pdf_error);
         total.max_weight_error = std::max(total.max_weight_error, f.max_weight_error);
-        examples.insert(examples.end(), f.examples.begin(), f.examples.end());
-        mismatches.insert(mismatches.end(), f.mismatches.begin(), f.mismatches.end());
+        total.examples.insert(total.examples.end(), f.examples.begin(), f.examples.end());
+        total.mismatches.insert(total.mismatches.end(), f.mismatches.begin(), f.mismatches.end());
     }
+    auto by_index = [](const auto &a, const auto &b) { return a.index < b.index; };
+    std::sort(total.examples.begin(), total.examples.end(), by_index);
+    std::sort(total.mismatches.begin(), total.mismatches.end(), by_index);
+    return total;
+}
+
+/// Step 1, reported: counts, weight statistics, outright failures and inconsistent samples.
+void report_samples(const Findings &total, const Chi2Options &opts, Chi2Result &res) {
+    const uint64_t n = opts.samples;
     res.smooth = total.smooth;
     res.delta = total.delta;
     res.failed = total.failed;
@@ -415,10 +414,9 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
     count_failure(total.nonfinite_weight, "non-finite weight");
     count_failure(total.bad_direction, "sampled direction is not a unit vector");
     count_failure(total.bad_pdf, "non-finite or negative pdf() at the sampled direction");
-    auto by_index = [](const auto &a, const auto &b) { return a.index < b.index; };
-    std::sort(examples.begin(), examples.end(), by_index);
-    for (size_t k = 0; k < examples.size() && k < 4; ++k)
-        res.failures.push_back(fmt::format("  sample {}: {}", examples[k].index, examples[k].text));
+    for (size_t k = 0; k < total.examples.size() && k < 4; ++k)
+        res.failures.push_back(
+            fmt::format("  sample {}: {}", total.examples[k].index, total.examples[k].text));
 
     // Inconsistent weights or pdfs: a few samples may miss by rounding near singular
     // configurations (grazing refraction next to total internal reflection, the poles of an
@@ -438,18 +436,22 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
             mismatched, n, total.pdf_mismatch, total.weight_mismatch, total.adapter_problem,
             opts.weight_tolerance, worst, uint64_t(opts.mismatch_fraction * double(n)),
             opts.gross_tolerance));
-        std::sort(mismatches.begin(), mismatches.end(), by_index);
-        for (size_t k = 0; k < mismatches.size() && k < (mismatch_failure ? 4u : 2u); ++k)
-            mismatch_out.push_back(
-                fmt::format("  sample {}: {}", mismatches[k].index, mismatches[k].text));
+        for (size_t k = 0; k < total.mismatches.size() && k < (mismatch_failure ? 4u : 2u); ++k)
+            mismatch_out.push_back(fmt::format("  sample {}: {}", total.mismatches[k].index,
+                                               total.mismatches[k].text));
     }
+}
 
-    // 2. Expected counts: the pdf integrated over every cell.
+/// Step 2: expected counts, the pdf integrated over every cell (res.expected, res.pdf_integral).
+void integrate(const Chi2Adapter &adapter, const Chi2Options &opts, Chi2Result &res) {
+    const int phi_res = res.phi_res, cos_res = res.cos_res;
+    const size_t cells = size_t(cos_res) * phi_res;
+    const double n = double(opts.samples);
     res.expected.assign(cells, 0.0);
     std::vector<CellIntegral> integrals(cells);
     const double dphi = 2.0 * kPi / phi_res, dcos = 2.0 / cos_res;
     // Adaptive rule: no cell needs to be known better than a thousandth of a sample.
-    const double abs_tol = 1e-3 / double(n);
+    const double abs_tol = 1e-3 / n;
     tbb::parallel_for(size_t(0), cells, [&](size_t k) {
         int jc = int(k / phi_res), ip = int(k % phi_res);
         double phi0 = -kPi + ip * dphi, c0 = -1.0 + jc * dcos;
@@ -465,14 +467,39 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
             ++bad_cells;
         }
         res.pdf_integral += integrals[k].value;
-        res.expected[k] = integrals[k].value * double(n);
+        res.expected[k] = integrals[k].value * n;
     }
     if (bad_cells > 0)
         res.failures.push_back(
             fmt::format("{} cells have non-finite or negative pdf values", bad_cells));
+}
 
-    // 3. The pdf integrates to the fraction of samples that got a smooth direction, at most 1.
-    double fraction = double(res.smooth) / double(n);
+/// Step 3: Pearson's statistic over the cells, those expecting too little pooled (res.statistic,
+/// res.dof); a sample in a cell expecting none is an outright failure.
+void pool(const Chi2Options &opts, Chi2Result &res) {
+    PearsonResult pr = pearson_chi2(res.observed, res.expected, opts.min_expected);
+    res.statistic = pr.statistic;
+    res.dof = pr.dof;
+    if (pr.pooled_cells > 0)
+        res.notes.push_back(fmt::format("{} cells expecting fewer than {} samples were pooled",
+                                        pr.pooled_cells, opts.min_expected));
+    if (pr.zero_expected_hit) {
+        size_t k = pr.zero_expected_cell;
+        int jc = int(k / res.phi_res), ip = int(k % res.phi_res);
+        double phi = -kPi + (ip + 0.5) * 2.0 * kPi / res.phi_res,
+               c = -1.0 + (jc + 0.5) * 2.0 / res.cos_res;
+        res.failures.push_back(fmt::format("{} samples fell into cell (phi {}, cos theta {}) "
+                                           "around direction {} where the pdf integrates to zero",
+                                           res.observed[k], ip, jc,
+                                           vec_str(domain_to_direction(phi, c))));
+    }
+}
+
+/// Step 4: the pdf's integral against the smooth fraction, energy, the p-value, and the verdict.
+void verdict(const Chi2Adapter &adapter, const Chi2Options &opts, bool tested, Chi2Result &res) {
+    const double n = double(opts.samples);
+    // The pdf integrates to the fraction of samples that got a smooth direction, at most 1.
+    double fraction = double(res.smooth) / n;
     double integral_tol =
         5.0 * std::sqrt(std::max(fraction * (1.0 - fraction), 1.0 / n) / n) + 2e-3;
     if (res.pdf_integral > 1.0 + 2e-3)
@@ -483,10 +510,10 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
                         "the samples produced a smooth direction (tolerance {:.2g})",
                         res.pdf_integral, fraction, integral_tol));
 
-    // 4. Energy: the mean weight of a passive BSDF does not exceed 1 (5 standard errors of noise).
+    // Energy: the mean weight of a passive BSDF does not exceed 1 (5 standard errors of noise).
     if (adapter.bounded_weights()) {
         for (int c = 0; c < 3; ++c) {
-            double bound = 1.0 + 5.0 * res.weight_stddev[c] / std::sqrt(double(n)) + 1e-4;
+            double bound = 1.0 + 5.0 * res.weight_stddev[c] / std::sqrt(n) + 1e-4;
             if (res.mean_weight[c] > bound) {
                 res.failures.push_back(
                     fmt::format("mean weight {} exceeds 1 (energy gain; bound {:.6f})",
@@ -496,45 +523,56 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
         }
     }
 
-    // 5. Pearson's statistic.
     res.significance = sidak_correction(opts.significance, std::max(1u, opts.test_count));
-    if (res.smooth == 0 && res.pdf_integral == 0.0) {
-        res.notes.push_back(
-            "no smooth samples and a zero pdf: only delta lobes, no histogram to test");
+    if (!tested) {
         res.p_value = 1.0;
+    } else if (res.dof < 1) {
+        res.failures.push_back(fmt::format("too few cells with enough expected samples "
+                                           "(dof = {}); use more samples or fewer cells",
+                                           res.dof));
+        res.p_value = 0.0;
     } else {
-        PearsonResult pr = pearson_chi2(res.observed, res.expected, opts.min_expected);
-        res.statistic = pr.statistic;
-        res.dof = pr.dof;
-        if (pr.pooled_cells > 0)
-            res.notes.push_back(fmt::format("{} cells expecting fewer than {} samples were pooled",
-                                            pr.pooled_cells, opts.min_expected));
-        if (pr.zero_expected_hit) {
-            size_t k = pr.zero_expected_cell;
-            int jc = int(k / phi_res), ip = int(k % phi_res);
-            double phi = -kPi + (ip + 0.5) * dphi, c = -1.0 + (jc + 0.5) * dcos;
-            res.failures.push_back(fmt::format("{} samples fell into cell (phi {}, cos theta {}) "
-                                               "around direction {} where the pdf "
-                                               "integrates to zero",
-                                               res.observed[k], ip, jc,
-                                               vec_str(domain_to_direction(phi, c))));
-        }
-        if (res.dof < 1) {
-            res.failures.push_back(fmt::format("too few cells with enough expected samples "
-                                               "(dof = {}); use more samples or fewer cells",
-                                               res.dof));
-            res.p_value = 0.0;
-        } else {
-            res.p_value = chi2_survival(res.statistic, res.dof);
-            if (!std::isfinite(res.p_value))
-                res.failures.push_back("the p-value is not finite");
-            else if (res.p_value < res.significance)
-                res.failures.push_back(
-                    fmt::format("the histogram does not match the pdf: p-value {:.4g} < {:.4g}",
-                                res.p_value, res.significance));
-        }
+        res.p_value = chi2_survival(res.statistic, res.dof);
+        if (!std::isfinite(res.p_value))
+            res.failures.push_back("the p-value is not finite");
+        else if (res.p_value < res.significance)
+            res.failures.push_back(
+                fmt::format("the histogram does not match the pdf: p-value {:.4g} < {:.4g}",
+                            res.p_value, res.significance));
     }
     res.passed = res.failures.empty();
+}
+
+} // namespace
+
+Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
+    Chi2Options opts = opts_in;
+    Chi2Result res;
+    res.description = adapter.to_string();
+    if (opts.res < 2) FACET_THROW("chi2: res must be at least 2 (got {})", opts.res);
+    if (opts.samples == 0 || opts.samples > uint64_t(0xffffffffu))
+        FACET_THROW("chi2: the sample count must be in [1, 2^32) (got {})", opts.samples);
+    if (opts.res % 2 == 1) {
+        // An even count puts a cell edge on the horizon, where many pdfs jump.
+        res.notes.push_back(fmt::format("res {} rounded up to {} (even)", opts.res, opts.res + 1));
+        ++opts.res;
+    }
+    int dim = adapter.sample_dim();
+    if (dim < 1 || dim > 8) FACET_THROW("chi2: sample_dim must be in [1, 8] (got {})", dim);
+    res.cos_res = opts.res;
+    res.phi_res = 2 * opts.res;
+    res.samples = opts.samples;
+
+    report_samples(histogram(adapter, opts, res), opts, res);
+    integrate(adapter, opts, res);
+    // Only delta lobes: no histogram to test.
+    bool tested = !(res.smooth == 0 && res.pdf_integral == 0.0);
+    if (tested)
+        pool(opts, res);
+    else
+        res.notes.push_back(
+            "no smooth samples and a zero pdf: only delta lobes, no histogram to test");
+    verdict(adapter, opts, tested, res);
     return res;
 }
 
