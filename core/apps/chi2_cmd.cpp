@@ -135,6 +135,16 @@ int run(const Chi2Adapter &adapter, const CommonOptions &o, const std::string &f
     return result.passed ? 0 : 1;
 }
 
+/// XML text given on the command line, or the contents of the file it names.
+std::string read_xml_argument(const std::string &text) {
+    if (!text.empty() && text[0] == '<') return text;
+    std::ifstream in(text);
+    if (!in) FACET_THROW("cannot read \"{}\"", text);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
 std::string join_args(int argc, char **argv) {
     std::string s;
     for (int i = 0; i < argc; ++i) s += std::string(argv[i]) + "\n";
@@ -174,14 +184,19 @@ int chi2_main(int argc, char **argv) {
     CommonOptions eo;
     std::string emitter_name, emitter_xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
     std::vector<std::string> emitter_params;
+    bool emission = false;
     CLI::App *emitter = app.add_subcommand(
         "emitter",
         "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
-    emitter->add_option("name", emitter_name, "Emitter plugin name")->required();
+    emitter->add_option("name", emitter_name, "Emitter plugin name");
     emitter->add_option("params", emitter_params, "Parameters, as for bsdf");
     emitter->add_option("--xml", emitter_xml,
-                        "The emitter as XML text (an <emitter> or a whole <scene>), for "
-                        "parameters key=value cannot give (e.g. to_world)");
+                        "The emitter as XML text or an .xml file, an <emitter> or a whole <scene> "
+                        "(its first emitter is tested), instead of a name");
+    emitter->add_flag("--emission", emission,
+                      "Test the directions of emitted rays (sample_ray against "
+                      "pdf_ray_direction; emitters with one origin, e.g. spot) instead of "
+                      "direction sampling from --ref");
     emitter->add_option("--ref", ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
     emitter->add_option(
         "--shape", shape,
@@ -227,14 +242,7 @@ int chi2_main(int argc, char **argv) {
         std::string text;
         if (!xml.empty() || (!bsdf_name.empty() && bsdf_name[0] == '<')) {
             if (!bsdf_params.empty()) FACET_THROW("key=value parameters cannot be added to --xml");
-            text = xml.empty() ? bsdf_name : xml;
-            if (text[0] != '<') {
-                std::ifstream in(text);
-                if (!in) FACET_THROW("cannot read \"{}\"", text);
-                std::stringstream ss;
-                ss << in.rdbuf();
-                text = ss.str();
-            }
+            text = read_xml_argument(xml.empty() ? bsdf_name : xml);
             if (bsdf_name.empty() || bsdf_name[0] == '<') bsdf_name = "xml";
         } else {
             if (bsdf_name.empty()) FACET_THROW("name the BSDF plugin to test (or give --xml)");
@@ -246,17 +254,24 @@ int chi2_main(int argc, char **argv) {
     if (emitter->parsed()) {
         add_plugin_dirs(eo.plugin_dirs);
         auto r = parse_floats(ref_text, 3, "--ref");
-        std::string text;
+        std::string scene;
         if (!emitter_xml.empty()) {
-            if (!emitter_params.empty())
-                FACET_THROW("key=value parameters cannot be added to --xml");
-            text = emitter_xml.rfind("<scene", 0) == 0
-                       ? emitter_xml
-                       : "<scene version=\"3.0.0\">" + emitter_xml + "</scene>";
+            if (!emitter_name.empty() || !emitter_params.empty())
+                FACET_THROW("give the emitter either by name and key=value parameters or --xml");
+            scene = read_xml_argument(emitter_xml);
+            if (scene.find("<scene") == std::string::npos)
+                scene = "<scene version=\"3.0.0\">" + scene + "</scene>";
+            emitter_name = "xml";
         } else {
-            text = EmitterAdapter::scene_xml(emitter_name, emitter_params, shape);
+            if (emitter_name.empty())
+                FACET_THROW("name the emitter plugin to test (or give --xml)");
+            scene = EmitterAdapter::scene_xml(emitter_name, emitter_params, shape);
         }
-        EmitterAdapter adapter(text, Point3f(r[0], r[1], r[2]));
+        if (emission) {
+            EmissionAdapter adapter(scene);
+            return run(adapter, eo, slug("emission", emitter_name, everything));
+        }
+        EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]));
         return run(adapter, eo, slug("emitter", emitter_name, everything));
     }
     // microfacet

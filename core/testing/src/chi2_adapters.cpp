@@ -309,6 +309,39 @@ std::string EmitterAdapter::to_string() const {
     return fmt::format("{}, reference point {}", m_emitter->to_string(), vec_str(m_ref.p));
 }
 
+// -- Emission directions ----------------------------------------------------------------------
+
+EmissionAdapter::EmissionAdapter(const std::string &scene_xml, size_t index) {
+    m_scene = load_as<Scene>(scene_xml, ObjectType::Scene);
+    const auto &emitters = m_scene->emitters();
+    if (index >= emitters.size())
+        FACET_THROW("EmissionAdapter: the scene has {} emitters, no emitter {}", emitters.size(),
+                    index);
+    m_emitter = emitters[index];
+}
+
+EmissionAdapter::EmissionAdapter(std::shared_ptr<Emitter> emitter) : m_emitter(std::move(emitter)) {
+    if (!m_emitter) FACET_THROW("EmissionAdapter: no emitter");
+}
+
+Chi2Sample EmissionAdapter::sample(const float *u) const {
+    // One origin: the position sample does not matter.
+    auto [ray, weight] = m_emitter->sample_ray(Point2f(0.5f, 0.5f), Point2f(u[0], u[1]));
+    Chi2Sample s;
+    s.kind = weight.is_black() ? Chi2Sample::Kind::Failed : Chi2Sample::Kind::Smooth;
+    s.d = ray.d;
+    s.pdf = m_emitter->pdf_ray_direction(ray.d);
+    s.has_weight = true;
+    s.weight = weight;
+    return s;
+}
+
+double EmissionAdapter::pdf(const Vector3f &d) const { return m_emitter->pdf_ray_direction(d); }
+
+std::string EmissionAdapter::to_string() const {
+    return fmt::format("{}, emitted ray directions", m_emitter->to_string());
+}
+
 // -- Microfacet distributions -----------------------------------------------------------------
 
 struct MicrofacetAdapter::Impl {

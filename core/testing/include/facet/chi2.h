@@ -214,6 +214,24 @@ private:
     Interaction m_ref;
 };
 
+/// The directions of an emitter's emitted rays (sample_ray()) against pdf_ray_direction(), for
+/// emitters with one origin (point-like lights such as spot): what a light tracer draws.
+class EmissionAdapter : public Chi2Adapter {
+public:
+    /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it.
+    explicit EmissionAdapter(const std::string &scene_xml, size_t index = 0);
+    explicit EmissionAdapter(std::shared_ptr<Emitter> emitter);
+
+    int sample_dim() const override { return 2; }
+    Chi2Sample sample(const float *u) const override;
+    double pdf(const Vector3f &d) const override;
+    std::string to_string() const override;
+
+private:
+    std::shared_ptr<Scene> m_scene;
+    std::shared_ptr<Emitter> m_emitter;
+};
+
 /// A microfacet distribution's normal sampling (facet/microfacet.h) for incident direction wi.
 class MicrofacetAdapter : public Chi2Adapter {
 public:
