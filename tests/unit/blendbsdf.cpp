@@ -217,39 +217,4 @@ TEST(BlendBSDF, LoadsFromXml) {
     EXPECT_NEAR(value.r, (0.75f * 0.4f + 0.25f * 0.8f) * InvPi, 1e-6f);
 }
 
-namespace {
-void chi2_blend(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32_t seed,
-                const std::string &name, const BSDFContext &ctx = {}) {
-    BSDFAdapter adapter(bsdf, wi, ctx);
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.seed = seed;
-    opts.test_count = 4;
-    expect_chi2(adapter, "blendbsdf_" + name, opts);
-}
-} // namespace
-
-TEST(BSDFSampling, BlendDiffuseRoughConductor) {
-    chi2_blend(
-        make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.2)}, {{"weight", 0.3}}),
-        direction_from_angles(50.f, 0.f), 0, "diffuse_roughconductor");
-}
-TEST(BSDFSampling, BlendRoughConductorRoughDielectric) {
-    chi2_blend(make_nested("blendbsdf",
-                           {rough_conductor(0.5), make_bsdf("roughdielectric", {{"alpha", 0.5}})},
-                           {{"weight", 0.5}}),
-               direction_from_angles(30.f, 45.f), 1, "roughconductor_roughdielectric");
-}
-TEST(BSDFSampling, BlendWithDeltaLobes) {
-    chi2_blend(make_nested("blendbsdf",
-                           {make_bsdf("plastic"),
-                            make_bsdf("roughplastic",
-                                      {{"distribution", std::string("ggx")}, {"alpha", 0.3}})},
-                           {{"weight", 0.6}}),
-               direction_from_angles(20.f, 0.f), 2, "plastic_roughplastic");
-}
-TEST(BSDFSampling, BlendSecondComponent) {
-    chi2_blend(
-        make_nested("blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.3)}, {{"weight", 0.7}}),
-        direction_from_angles(65.f, 0.f), 3, "second_component", component_ctx(1));
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

@@ -1,10 +1,11 @@
 #pragma once
 
 // Checks shared by the BSDF unit tests (dielectric, conductor, rough*, ...): creation from
-// parameters, error messages, eval/pdf/sample consistency, energy (white furnace) and chi-square.
+// parameters, error messages, eval/pdf/sample consistency and energy (white furnace). Chi-square
+// tests are lines of tests/chi2/configs.txt, not GoogleTest cases.
 
 #include <facet/bsdf.h>
-#include <facet/chi2.h>
+#include <facet/chi2.h> // direction_from_angles
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/random.h>
@@ -171,18 +172,6 @@ inline Color3f furnace(const BSDF &bsdf, const BSDFContext &ctx, const Vector3f 
         for (int c = 0; c < 3; ++c) sum[c] += double(weight[c]) * scale;
     }
     return Color3f(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
-}
-
-/// Runs the project's chi-square test; on failure prints the summary and writes the observed and
-/// expected tables and a heat map next to the test binary.
-inline void expect_chi2(const Chi2Adapter &adapter, const std::string &name,
-                        Chi2Options opts = {}) {
-    Chi2Result result = run_chi2(adapter, opts);
-    EXPECT_TRUE(result.passed) << name << "\n" << result.summary();
-    if (!result.passed) {
-        write_chi2_tables(name + "_chi2.txt", result);
-        write_chi2_heatmap(name + "_chi2.png", result);
-    }
 }
 
 } // namespace bsdf_checks

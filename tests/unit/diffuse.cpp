@@ -1,8 +1,7 @@
-// The diffuse BSDF: creation, eval/pdf/sample consistency, energy, reciprocity, the back side and
-// a chi-square test of its sampling against its pdf.
+// The diffuse BSDF: creation, eval/pdf/sample consistency, energy, reciprocity and the back side
+// (its chi-square tests are lines of tests/chi2/configs.txt).
 
 #include <facet/bsdf.h>
-#include <facet/chi2.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/random.h>
@@ -225,47 +224,4 @@ TEST(BSDFEval, DiffuseRespectsContext) {
     EXPECT_FALSE(bsdf->eval(component0, si, wo).is_black());
 }
 
-// Sampled directions against the pdf, binned over (φ, cos θ) (facet/chi2.h); the same run checks
-// weight == eval/pdf and the integral of the pdf.
-TEST(BSDFChi2, Diffuse) {
-    const Vector3f incident[] = {Vector3f(0.f, 0.f, 1.f), normalize(Vector3f(0.7f, -0.3f, 0.2f)),
-                                 normalize(Vector3f(-0.1f, 0.4f, 0.02f))};
-    uint32_t seed = 0;
-    for (const Vector3f &wi : incident) {
-        Properties props("diffuse");
-        props.set_color("reflectance", Color3f(0.2f, 0.5f, 0.9f));
-        BSDFAdapter adapter(props, wi);
-        Chi2Options opts;
-        opts.seed = seed++;
-        opts.test_count = 3;
-        Chi2Result result = run_chi2(adapter, opts);
-        EXPECT_TRUE(result.passed) << result.summary();
-        EXPECT_NEAR(result.pdf_integral, 1.0, 1e-3);
-        EXPECT_EQ(result.failed, 0u);
-    }
-}
-
-TEST(BSDFChi2, DiffuseDetectsWrongSampling) {
-    // The test must be able to fail: a cosine-sampled BSDF checked against a uniform
-    // hemisphere density.
-    class UniformPdf : public Chi2Adapter {
-    public:
-        explicit UniformPdf(const BSDFAdapter &inner) : m_inner(inner) {}
-        int sample_dim() const override { return m_inner.sample_dim(); }
-        Chi2Sample sample(const float *u) const override {
-            Chi2Sample s = m_inner.sample(u);
-            s.has_value = false;
-            s.sampled_pdf = s.pdf = float(pdf(s.d));
-            return s;
-        }
-        double pdf(const Vector3f &d) const override { return d.z > 0.f ? InvTwoPi : 0.0; }
-        std::string to_string() const override { return "diffuse vs uniform pdf"; }
-
-    private:
-        const BSDFAdapter &m_inner;
-    };
-    BSDFAdapter adapter(Properties("diffuse"), Vector3f(0.f, 0.f, 1.f));
-    Chi2Options opts;
-    opts.samples = 200000;
-    EXPECT_FALSE(run_chi2(UniformPdf(adapter), opts).passed);
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

@@ -1,7 +1,6 @@
 // Emitters point, area and constant: sampling records and weights, pdf consistency, and the
 // irradiance their direction sampling estimates against closed forms.
 
-#include <facet/chi2.h>
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -388,33 +387,4 @@ TEST(EmitterConstant, SampledPointsLieOutsideTheScene) {
     }
 }
 
-// ---- chi-square of direction sampling (facet/chi2.h) -----------------------------------------
-
-TEST(EmitterChi2, AreaRectangle) {
-    EmitterAdapter adapter(EmitterAdapter::scene_xml("area", {"radiance=2"}),
-                           Point3f(0.3f, -0.2f, 0.8f));
-    Chi2Options opts;
-    opts.test_count = 3;
-    Chi2Result result = run_chi2(adapter, opts);
-    EXPECT_TRUE(result.passed) << result.summary();
-}
-
-TEST(EmitterChi2, AreaSphere) {
-    EmitterAdapter adapter(EmitterAdapter::scene_xml("area", {}, "sphere"),
-                           Point3f(0.f, 0.5f, 2.5f));
-    Chi2Options opts;
-    opts.test_count = 3;
-    opts.seed = 1;
-    Chi2Result result = run_chi2(adapter, opts);
-    EXPECT_TRUE(result.passed) << result.summary();
-}
-
-TEST(EmitterChi2, Constant) {
-    EmitterAdapter adapter(EmitterAdapter::scene_xml("constant", {}), Point3f(0.1f, 0.2f, 0.3f));
-    Chi2Options opts;
-    opts.test_count = 3;
-    opts.seed = 2;
-    Chi2Result result = run_chi2(adapter, opts);
-    EXPECT_TRUE(result.passed) << result.summary();
-    EXPECT_NEAR(result.pdf_integral, 1.0, 1e-3);
-}
+// ---- chi-square of direction sampling: the emitter lines of tests/chi2/configs.txt ----------

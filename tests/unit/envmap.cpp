@@ -1,11 +1,7 @@
-// The envmap emitter with Mitsuba 3's conventions: u = atan2(x, -z)/2π with texel-centred,
-// wrapping columns; v = acos(y)/π with corner-aligned rows (the first and last rows on the
-// poles); the sampling table on the same grid; the size limits; negative texels; MIS
-// compensation. Then chi-square tests of its importance sampling on the maps Mitsuba uses for
-// the same purpose (a single bright pixel, a constant map, a tiny 3×3 map) and on a rotated
-// HDR sky.
+// The envmap emitter: the direction mapping (+Y is the top row, u turns around +Y) and its pdf
+// integrating to one. Chi-square tests of its importance sampling on the maps Mitsuba uses for
+// the same purpose: tests/chi2/configs.txt.
 
-#include <facet/chi2.h>
 #include <facet/emitter.h>
 #include <facet/image.h>
 #include <facet/scene.h>
@@ -43,16 +39,6 @@ std::string scene_with(const std::string &map, const std::string &extra = "") {
            map + R"("/>)" + extra + R"(</emitter>
         <shape type="sphere"><float name="radius" value="0.1"/></shape>
     </scene>)";
-}
-
-void expect_chi2_passes(const std::string &xml, const Point3f &ref, int res = 32) {
-    EmitterAdapter adapter(xml, ref);
-    Chi2Options opts;
-    opts.res = res;
-    opts.samples = 400000;
-    Chi2Result r = run_chi2(adapter, opts);
-    EXPECT_TRUE(r.passed) << r.summary();
-    EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2) << r.summary();
 }
 
 std::shared_ptr<Scene> load(const std::string &xml) {
@@ -236,49 +222,5 @@ TEST(EnvironmentMap, ScaleAndEvalMatchSampleWeight) {
     EXPECT_NEAR(env.pdf_direction(ref, ds), ds.pdf, 1e-4f * ds.pdf);
 }
 
-TEST(EnvironmentMapChi2, SingleBrightPixel) {
-    std::string map = write_map("one-pixel.exr", 100, 10, [](int x, int y) {
-        return (x == 37 && y == 4) ? Color3f(1.f) : Color3f(0.f);
-    });
-    expect_chi2_passes(scene_with(map), Point3f(0.f, 0.f, 0.f));
-}
-
-TEST(EnvironmentMapChi2, ConstantMap) {
-    std::string map = write_map("constant.exr", 100, 100, [](int, int) { return Color3f(1.f); });
-    expect_chi2_passes(scene_with(map), Point3f(0.f, 0.f, 0.f));
-}
-
-TEST(EnvironmentMapChi2, TinyMap) {
-    std::string map =
-        write_map("tiny.exr", 3, 3, [](int x, int y) { return Color3f(float(1 + x + 3 * y)); });
-    expect_chi2_passes(scene_with(map), Point3f(0.f, 0.f, 0.f));
-}
-
-TEST(EnvironmentMapChi2, RotatedSkyWithSun) {
-    std::string map = write_map("sky.exr", 64, 32, [](int x, int y) {
-        if (x >= 40 && x < 43 && y >= 8 && y < 10) return Color3f(400.f, 300.f, 200.f);
-        float t = float(y) / 31.f;
-        return Color3f(0.3f + t, 0.5f + t, 1.f);
-    });
-    expect_chi2_passes(
-        scene_with(map,
-                   R"(<transform name="to_world"><rotate x="1" y="1" angle="30"/></transform>)"),
-        Point3f(0.05f, 0.0f, 0.02f));
-}
-
-TEST(EnvironmentMapChi2, UniformSamplingOption) {
-    std::string map =
-        write_map("grad.exr", 32, 16, [](int x, int) { return Color3f(0.1f + float(x)); });
-    expect_chi2_passes(scene_with(map, R"(<boolean name="importance_sampling" value="false"/>)"),
-                       Point3f(0.f, 0.f, 0.f));
-}
-
-TEST(EnvironmentMapChi2, MisCompensation) {
-    std::string map = write_map("mis-sky.exr", 48, 24, [](int x, int y) {
-        if (x >= 30 && x < 33 && y >= 6 && y < 8) return Color3f(60.f, 50.f, 40.f);
-        return Color3f(0.2f + 0.05f * float(y), 0.4f, 0.3f + 0.02f * float(x));
-    });
-    expect_chi2_passes(scene_with(map, R"(<boolean name="mis_compensation" value="true"/>
-            <transform name="to_world"><rotate y="1" angle="70"/></transform>)"),
-                       Point3f(0.f, 0.f, 0.f));
-}
+// Chi-square tests of its importance sampling (a single bright pixel, a constant map, a tiny 3x2
+// map, a rotated HDR sky, uniform sampling): the envmap lines of tests/chi2/configs.txt.

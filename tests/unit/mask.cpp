@@ -189,26 +189,4 @@ TEST(Mask, LoadsFromXml) {
     EXPECT_NEAR(bsdf->eval_null_transmission(make_si(Vector3f(0.f, 0.f, 1.f))).r, 0.8f, 1e-6f);
 }
 
-namespace {
-void chi2_mask(const std::shared_ptr<BSDF> &nested, double opacity, const Vector3f &wi,
-               uint32_t seed, const std::string &name, const BSDFContext &ctx = {}) {
-    BSDFAdapter adapter(make_nested("mask", {nested}, {{"opacity", opacity}}), wi, ctx);
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.seed = seed;
-    opts.test_count = 3;
-    expect_chi2(adapter, "mask_" + name, opts);
-}
-} // namespace
-
-TEST(BSDFSampling, MaskRoughConductor) {
-    chi2_mask(rough_conductor(), 0.4, direction_from_angles(40.f, 0.f), 0, "roughconductor");
-}
-TEST(BSDFSampling, MaskRoughDielectricFromInside) {
-    chi2_mask(make_bsdf("roughdielectric", {{"alpha", 0.4}}), 0.7,
-              normalize(Vector3f(0.2f, -0.3f, -0.6f)), 1, "roughdielectric");
-}
-TEST(BSDFSampling, MaskNestedComponentOnly) {
-    chi2_mask(make_bsdf("roughplastic", {{"alpha", 0.2}}), 0.5, direction_from_angles(60.f, 0.f), 2,
-              "roughplastic_nested", component_ctx(1));
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

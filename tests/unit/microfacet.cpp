@@ -1,7 +1,7 @@
 // Microfacet distributions: normalisation of D, the visible-normal density, Smith G1 against the
-// lecture's formulas, sampling (chi-square) for Beckmann and GGX, and the parameter reader.
+// lecture's formulas, sampling for Beckmann and GGX, and the parameter reader.
 
-#include <facet/chi2.h>
+#include <facet/chi2.h> // direction_from_angles
 #include <facet/microfacet.h>
 #include <facet/properties.h>
 #include <facet/random.h>
@@ -193,36 +193,8 @@ TEST(Microfacet, SampleReturnsItsPdf) {
     }
 }
 
-// Chi-square of normal sampling against pdf(): Mitsuba's test matrix (distribution × α ×
-// visible × incident angle), plus anisotropic roughness. One test per distribution and scheme.
-namespace {
-void chi2_matrix(const char *type, bool visible) {
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.res = 32;
-    opts.test_count = 8;
-    int run = 0;
-    for (auto [au, av] :
-         {std::pair{0.125f, 0.125f}, std::pair{0.5f, 0.5f}, std::pair{0.3f, 0.08f}}) {
-        for (float angle : {15.f, 30.f, 80.f}) {
-            if (au != av && angle == 30.f) continue;
-            MicrofacetAdapter adapter(type, au, av, visible, direction_from_angles(angle, 25.f));
-            opts.seed = uint32_t(run++);
-            Chi2Result result = run_chi2(adapter, opts);
-            EXPECT_TRUE(result.passed) << result.summary();
-            if (!result.passed)
-                write_chi2_heatmap(
-                    fmt::format("microfacet_{}_{}_{}_{}_{}.png", type, visible, au, av, angle),
-                    result);
-        }
-    }
-}
-} // namespace
-
-TEST(MicrofacetSampling, BeckmannAllNormals) { chi2_matrix("beckmann", false); }
-TEST(MicrofacetSampling, BeckmannVisibleNormals) { chi2_matrix("beckmann", true); }
-TEST(MicrofacetSampling, GGXAllNormals) { chi2_matrix("ggx", false); }
-TEST(MicrofacetSampling, GGXVisibleNormals) { chi2_matrix("ggx", true); }
+// Chi-square of normal sampling against pdf() (Mitsuba's test matrix): the microfacet lines of
+// tests/chi2/configs.txt.
 
 TEST(MicrofacetSampling, VisibleNormalsAreSeenFromWi) {
     // Every normal drawn by visible sampling faces wi, and at grazing incidence the normals

@@ -202,27 +202,4 @@ TEST(Plastic, WhiteFurnace) {
     }
 }
 
-namespace {
-void chi2_config(const Params &params, const Vector3f &wi, uint32_t seed, const std::string &name,
-                 const BSDFContext &ctx = {}) {
-    BSDFAdapter adapter(make_bsdf("plastic", params), wi, ctx);
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.seed = seed;
-    opts.test_count = 4;
-    expect_chi2(adapter, "plastic_" + name, opts);
-}
-} // namespace
-
-TEST(BSDFSampling, PlasticDefaults) {
-    chi2_config({}, Vector3f(0.f, 0.f, 1.f), 0, "normal");
-    chi2_config({}, direction_from_angles(75.f, 10.f), 1, "grazing");
-}
-TEST(BSDFSampling, PlasticNonlinearColoured) {
-    chi2_config({{"diffuse_reflectance", Color3f(0.3f, 0.6f, 0.2f)}, {"nonlinear", true}},
-                direction_from_angles(45.f, 120.f), 2, "nonlinear");
-}
-TEST(BSDFSampling, PlasticDiffuseComponent) {
-    chi2_config({{"int_ior", 2.0}}, direction_from_angles(30.f, 0.f), 3, "diffuse_only",
-                component_ctx(1));
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

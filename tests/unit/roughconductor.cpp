@@ -195,37 +195,4 @@ TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
                  BSDFFlags::Anisotropic));
 }
 
-// Chi-square tests: Mitsuba's roughconductor configurations (wi = normalize(1, 1, 1)) and GGX
-// anisotropic at a grazing angle.
-namespace {
-void chi2_config(const Params &params, const Vector3f &wi, uint32_t seed, const std::string &name,
-                 int res = 32) {
-    auto bsdf = make_bsdf("roughconductor", params);
-    BSDFAdapter adapter(bsdf, wi);
-    Chi2Options opts;
-    opts.samples = 300000;
-    opts.res = res;
-    opts.seed = seed;
-    opts.test_count = 6;
-    expect_chi2(adapter, "roughconductor_" + name, opts);
-}
-const Vector3f WI = normalize(Vector3f(1.f, 1.f, 1.f));
-} // namespace
-
-TEST(BSDFSampling, RoughConductorBeckmannSharp) {
-    chi2_config({{"alpha", 0.05}}, WI, 0, "beckmann_sharp", 48);
-}
-TEST(BSDFSampling, RoughConductorAnisoBeckmann) {
-    chi2_config({{"alpha_u", 0.2}, {"alpha_v", 0.05}, {"sample_visible", false}}, WI, 1,
-                "aniso_beckmann_all");
-    chi2_config({{"alpha_u", 0.2}, {"alpha_v", 0.05}}, WI, 2, "aniso_beckmann_visible");
-}
-TEST(BSDFSampling, RoughConductorGGX) {
-    Params all = {{"distribution", std::string("ggx")}, {"alpha", 0.2}, {"sample_visible", false}};
-    chi2_config(all, WI, 3, "ggx_all");
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.2}}, WI, 4, "ggx_visible");
-}
-TEST(BSDFSampling, RoughConductorAnisoGGXGrazing) {
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha_u", 0.4}, {"alpha_v", 0.1}},
-                direction_from_angles(80.f, 30.f), 5, "aniso_ggx_grazing");
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

@@ -226,44 +226,4 @@ TEST(RoughDielectric, WhiteFurnaceAtMostOne) {
     }
 }
 
-// Chi-square tests: Mitsuba's roughdielectric configurations.
-namespace {
-void chi2_config(const Params &params, const Vector3f &wi, uint32_t seed, const std::string &name,
-                 uint32_t component = uint32_t(-1)) {
-    auto bsdf = make_bsdf("roughdielectric", params);
-    BSDFContext ctx;
-    ctx.component = component;
-    BSDFAdapter adapter(bsdf, normalize(wi), ctx);
-    Chi2Options opts;
-    opts.samples = 250000;
-    opts.res = 32;
-    opts.seed = seed;
-    opts.test_count = 10;
-    expect_chi2(adapter, "roughdielectric_" + name, opts);
-}
-} // namespace
-
-TEST(BSDFSampling, RoughDielectricBeckmann) {
-    chi2_config({{"alpha", 0.5}}, Vector3f(0.8f, 0.3f, 0.05f), 4, "grazing");
-    chi2_config({{"alpha", 0.5}, {"sample_visible", false}}, Vector3f(0.5f, 0.f, 0.5f), 1,
-                "beckmann_all");
-    chi2_config({{"alpha", 0.5}}, Vector3f(0.5f, 0.f, 0.5f), 2, "beckmann_visible");
-}
-TEST(BSDFSampling, RoughDielectricGGX) {
-    Params ggx_all = {
-        {"distribution", std::string("ggx")}, {"alpha", 0.5}, {"sample_visible", false}};
-    chi2_config(ggx_all, Vector3f(0.5f, 0.f, 0.5f), 3, "ggx_all");
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.5}},
-                Vector3f(0.5f, 0.5f, 0.001f), 2, "ggx_visible_grazing");
-}
-TEST(BSDFSampling, RoughDielectricFromInside) {
-    chi2_config({{"alpha", 0.5}}, Vector3f(0.2f, -0.6f, -0.5f), 5, "inside");
-    chi2_config({{"alpha", 0.5}}, Vector3f(0.8f, 0.3f, -0.05f), 8, "inside_tir");
-    chi2_config({{"alpha", 0.5}, {"ext_ior", 1.5}, {"int_ior", 1.0}}, Vector3f(0.2f, -0.6f, 0.5f),
-                6, "denser_outside");
-}
-TEST(BSDFSampling, RoughDielectricSingleLobe) {
-    Params aniso = {{"alpha_u", 0.5}, {"alpha_v", 0.2}};
-    chi2_config(aniso, Vector3f(-0.5f, -0.5f, 0.1f), 2, "reflection_only", 0);
-    chi2_config(aniso, Vector3f(-0.5f, -0.5f, 0.1f), 7, "transmission_only", 1);
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

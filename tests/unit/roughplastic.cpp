@@ -226,33 +226,4 @@ TEST(RoughPlastic, WhiteFurnaceAtMostOne) {
     }
 }
 
-namespace {
-void chi2_config(const Params &params, const Vector3f &wi, uint32_t seed, const std::string &name,
-                 const BSDFContext &ctx = {}, int res = 32) {
-    BSDFAdapter adapter(make_bsdf("roughplastic", params), wi, ctx);
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.res = res;
-    opts.seed = seed;
-    opts.test_count = 6;
-    expect_chi2(adapter, "roughplastic_" + name, opts);
-}
-} // namespace
-
-TEST(BSDFSampling, RoughPlasticBeckmann) {
-    chi2_config({{"alpha", 0.05}, {"specular_reflectance", 0.7}, {"diffuse_reflectance", 0.1}},
-                Vector3f(0.f, 0.f, 1.f), 0, "beckmann_sharp", {}, 48);
-    chi2_config({{"alpha", 0.3}, {"sample_visible", false}}, direction_from_angles(60.f, 30.f), 1,
-                "beckmann_all");
-}
-TEST(BSDFSampling, RoughPlasticGGX) {
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.25}},
-                direction_from_angles(40.f, 0.f), 2, "ggx_visible");
-    chi2_config({{"distribution", std::string("ggx")}, {"alpha", 0.6}},
-                direction_from_angles(85.f, 200.f), 3, "ggx_grazing");
-}
-TEST(BSDFSampling, RoughPlasticComponents) {
-    Params p = {{"alpha", 0.2}};
-    chi2_config(p, direction_from_angles(45.f, 0.f), 4, "glossy_only", component_ctx(0));
-    chi2_config(p, direction_from_angles(45.f, 0.f), 5, "diffuse_only", component_ctx(1));
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).

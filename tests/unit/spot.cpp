@@ -1,7 +1,6 @@
 // The spot light: falloff between beam_width and cutoff_angle, the inverse-square law towards a
-// reference point, and a chi-square test of its emission sampling (directions inside the cone).
+// reference point.
 
-#include <facet/chi2.h>
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 
@@ -30,28 +29,6 @@ Color3f intensity_towards(const Emitter &spot, const Point3f &light_pos, const V
     return spot.sample_direction(ref, Point2f(0.5f, 0.5f)).second;
 }
 
-/// Emission directions of a spot, seen by the chi-square test.
-class SpotEmissionAdapter final : public Chi2Adapter {
-public:
-    explicit SpotEmissionAdapter(std::shared_ptr<Emitter> e) : m_emitter(std::move(e)) {}
-    int sample_dim() const override { return 2; }
-    Chi2Sample sample(const float *u) const override {
-        auto [ray, weight] = m_emitter->sample_ray(Point2f(0.5f, 0.5f), Point2f(u[0], u[1]));
-        Chi2Sample s;
-        s.kind = weight.is_black() ? Chi2Sample::Kind::Failed : Chi2Sample::Kind::Smooth;
-        s.d = ray.d;
-        s.pdf = m_emitter->pdf_ray_direction(ray.d);
-        s.has_weight = true;
-        s.weight = weight;
-        return s;
-    }
-    double pdf(const Vector3f &d) const override { return m_emitter->pdf_ray_direction(d); }
-    std::string to_string() const override { return m_emitter->to_string(); }
-
-private:
-    std::shared_ptr<Emitter> m_emitter;
-};
-
 } // namespace
 
 TEST(Spot, FalloffAndInverseSquare) {
@@ -78,15 +55,5 @@ TEST(Spot, InvalidAnglesAreRefused) {
     EXPECT_THROW(make_spot(20.f, 25.f), std::exception);
 }
 
-TEST(SpotChi2, EmissionDirections) {
-    for (float cutoff : {10.f, 45.f, 80.f}) {
-        auto spot = make_spot(cutoff, 0.5f * cutoff, Transform::rotate(Vector3f(1, 1, 0), 50.f));
-        SpotEmissionAdapter adapter(spot);
-        Chi2Options opts;
-        opts.samples = 300000;
-        opts.test_count = 3;
-        Chi2Result r = run_chi2(adapter, opts);
-        EXPECT_TRUE(r.passed) << r.summary();
-        EXPECT_NEAR(r.pdf_integral, 1.0, 1e-2) << r.summary();
-    }
-}
+// Chi-square tests of its emission sampling (directions inside the cone): the spot lines of
+// tests/chi2/configs.txt (facet chi2 emitter --emission).

@@ -213,33 +213,4 @@ TEST(TwoSided, LoadsFromXml) {
     EXPECT_NEAR(value.g, 0.2f * InvPi, 1e-6f);
 }
 
-namespace {
-void chi2_twosided(const std::shared_ptr<BSDF> &bsdf, const Vector3f &wi, uint32_t seed,
-                   const std::string &name, const BSDFContext &ctx = {}) {
-    BSDFAdapter adapter(bsdf, wi, ctx);
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.seed = seed;
-    opts.test_count = 4;
-    expect_chi2(adapter, "twosided_" + name, opts);
-}
-} // namespace
-
-TEST(BSDFSampling, TwoSidedFromTheBack) {
-    chi2_twosided(make_nested("twosided", {rough_conductor(0.3)}),
-                  normalize(Vector3f(0.3f, 0.2f, -0.7f)), 0, "roughconductor_back");
-    chi2_twosided(make_nested("twosided",
-                              {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
-                  direction_from_angles(120.f, 40.f), 1, "roughplastic_back");
-}
-TEST(BSDFSampling, TwoSidedBackComponent) {
-    chi2_twosided(make_nested("twosided",
-                              {make_bsdf("diffuse"), make_bsdf("roughplastic", {{"alpha", 0.2}})}),
-                  direction_from_angles(140.f, 40.f), 2, "back_diffuse_component",
-                  component_ctx(2));
-}
-TEST(BSDFSampling, TwoSidedTransmission) {
-    chi2_twosided(make_nested("twosided", {make_bsdf("roughdielectric", {{"alpha", 0.4}})},
-                              {{"allow_transmission", true}}),
-                  direction_from_angles(150.f, 0.f), 3, "roughdielectric_back");
-}
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
