@@ -108,6 +108,12 @@ inline Vector3f random_direction(PCG32 &rng, bool upper_only) {
     }
 }
 
+/// Each channel of a within `rel` (relative to b, at least 1e-6 absolute) of b.
+inline void expect_color_near(const Color3f &a, const Color3f &b, float rel) {
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(a[c], b[c], rel * std::max(1e-6f, std::abs(b[c]))) << "channel " << c;
+}
+
 inline bool near_rel(float a, float b, float rel) {
     return std::abs(a - b) <= rel * std::max(std::abs(a), std::abs(b)) + 1e-12f;
 }

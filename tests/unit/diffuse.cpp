@@ -1,6 +1,8 @@
 // The diffuse BSDF: creation, eval/pdf/sample consistency, energy, reciprocity and the back side
 // (its chi-square tests are lines of tests/chi2/configs.txt).
 
+#include "bsdf_checks.h"
+
 #include <facet/bsdf.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -13,45 +15,18 @@
 #include <cmath>
 #include <vector>
 
-using namespace facet;
+using namespace bsdf_checks;
 
 namespace {
 
-std::shared_ptr<BSDF> make_diffuse(const Properties &props) {
-    return PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, props);
-}
-
 std::shared_ptr<BSDF> make_diffuse(const Color3f &reflectance) {
-    Properties props("diffuse");
-    props.set_color("reflectance", reflectance);
-    return make_diffuse(props);
-}
-
-SurfaceInteraction interaction(const Vector3f &wi) {
-    SurfaceInteraction si;
-    si.p = Point3f(0.f);
-    si.n = Normal3f(0.f, 0.f, 1.f);
-    si.t = 1.f;
-    si.uv = Point2f(0.5f, 0.5f);
-    si.wi = wi;
-    return si;
-}
-
-Vector3f random_upper_direction(PCG32 &rng) {
-    Vector3f v = warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
-    v.z = std::max(v.z, 1e-3f);
-    return normalize(v);
-}
-
-void expect_color_near(const Color3f &a, const Color3f &b, float rel) {
-    for (int c = 0; c < 3; ++c)
-        EXPECT_NEAR(a[c], b[c], rel * std::max(1e-6f, std::abs(b[c]))) << "channel " << c;
+    return make_bsdf("diffuse", {{"reflectance", reflectance}});
 }
 
 } // namespace
 
 TEST(BSDFCreation, Diffuse) {
-    auto bsdf = make_diffuse(Properties("diffuse"));
+    auto bsdf = make_bsdf("diffuse");
     ASSERT_TRUE(bsdf);
     EXPECT_EQ(bsdf->component_count(), 1u);
     EXPECT_EQ(bsdf->flags(), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
@@ -60,7 +35,7 @@ TEST(BSDFCreation, Diffuse) {
     EXPECT_FALSE(bsdf->to_string().empty());
 
     // The default reflectance is 0.5.
-    SurfaceInteraction si = interaction(Vector3f(0.f, 0.f, 1.f));
+    SurfaceInteraction si = make_si(Vector3f(0.f, 0.f, 1.f));
     expect_color_near(bsdf->eval_diffuse_reflectance(si), Color3f(0.5f), 1e-6f);
     expect_color_near(bsdf->eval(BSDFContext(), si, Vector3f(0.f, 0.f, 1.f)), Color3f(0.5f * InvPi),
                       1e-6f);
@@ -69,17 +44,17 @@ TEST(BSDFCreation, Diffuse) {
 TEST(BSDFCreation, DiffuseRejectsBadParameters) {
     Properties props("diffuse");
     props.set_string("reflectance", "blue");
-    EXPECT_THROW(make_diffuse(props), Error);
+    EXPECT_THROW(PluginRegistry::instance().create(ObjectType::BSDF, props), Error);
 
     Properties typo("diffuse");
     typo.set_float("reflectence", 0.3);
-    EXPECT_THROW(make_diffuse(typo), Error);
+    EXPECT_THROW(PluginRegistry::instance().create(ObjectType::BSDF, typo), Error);
 }
 
 TEST(BSDFEval, DiffuseValue) {
     Color3f rho(0.2f, 0.5f, 0.9f);
     auto bsdf = make_diffuse(rho);
-    SurfaceInteraction si = interaction(normalize(Vector3f(0.3f, -0.2f, 0.8f)));
+    SurfaceInteraction si = make_si(normalize(Vector3f(0.3f, -0.2f, 0.8f)));
     Vector3f wo = normalize(Vector3f(-0.5f, 0.1f, 0.4f));
     expect_color_near(bsdf->eval(BSDFContext(), si, wo), rho * (InvPi * wo.z), 1e-6f);
     EXPECT_NEAR(bsdf->pdf(BSDFContext(), si, wo), wo.z * InvPi, 1e-6f);
@@ -101,7 +76,7 @@ TEST(BSDFEval, DiffuseTexturedReflectance) {
     EXPECT_TRUE(has_flag(bsdf->flags(), BSDFFlags::DiffuseReflection));
     BSDFContext ctx;
     Vector3f wo = normalize(Vector3f(0.3f, 0.1f, 0.8f));
-    SurfaceInteraction si = interaction(Vector3f(0.f, 0.f, 1.f));
+    SurfaceInteraction si = make_si(Vector3f(0.f, 0.f, 1.f));
     const std::pair<Point2f, Color3f> cases[] = {
         {Point2f(0.25f, 0.25f), Color3f(0.1f, 0.2f, 0.3f)},
         {Point2f(0.75f, 0.25f), Color3f(0.7f, 0.8f, 0.9f)},
@@ -120,7 +95,7 @@ TEST(BSDFSampling, DiffuseConsistency) {
     BSDFContext ctx;
     int checked = 0;
     for (int i = 0; i < 10000; ++i) {
-        SurfaceInteraction si = interaction(random_upper_direction(rng));
+        SurfaceInteraction si = make_si(random_direction(rng, true));
         auto [bs, weight] =
             bsdf->sample(ctx, si, rng.next_float(), Point2f(rng.next_float(), rng.next_float()));
         if (weight.is_black()) continue;
@@ -145,7 +120,7 @@ TEST(BSDFEnergy, DiffuseAlbedoEqualsReflectance) {
     auto bsdf = make_diffuse(rho);
     PCG32 rng(11);
     BSDFContext ctx;
-    SurfaceInteraction si = interaction(normalize(Vector3f(0.4f, 0.1f, 0.7f)));
+    SurfaceInteraction si = make_si(normalize(Vector3f(0.4f, 0.1f, 0.7f)));
     const int n = 200000;
     double sum_w[3] = {0, 0, 0}, sum_u[3] = {0, 0, 0}, sum_u2 = 0;
     for (int i = 0; i < n; ++i) {
@@ -174,10 +149,10 @@ TEST(BSDFReciprocity, Diffuse) {
     PCG32 rng(3);
     BSDFContext ctx;
     for (int i = 0; i < 1000; ++i) {
-        Vector3f a = random_upper_direction(rng), b = random_upper_direction(rng);
+        Vector3f a = random_direction(rng, true), b = random_direction(rng, true);
         // eval includes cos θo: divide it out on both sides.
-        Color3f f_ab = bsdf->eval(ctx, interaction(a), b) / b.z;
-        Color3f f_ba = bsdf->eval(ctx, interaction(b), a) / a.z;
+        Color3f f_ab = bsdf->eval(ctx, make_si(a), b) / b.z;
+        Color3f f_ba = bsdf->eval(ctx, make_si(b), a) / a.z;
         expect_color_near(f_ab, f_ba, 1e-5f);
     }
 }
@@ -188,14 +163,14 @@ TEST(BSDFEval, DiffuseBackSideIsBlack) {
     Vector3f up = normalize(Vector3f(0.1f, 0.2f, 0.9f)),
              down = normalize(Vector3f(0.3f, 0.f, -0.6f));
     // Incident from below.
-    SurfaceInteraction below = interaction(down);
+    SurfaceInteraction below = make_si(down);
     EXPECT_TRUE(bsdf->eval(ctx, below, up).is_black());
     EXPECT_TRUE(bsdf->eval(ctx, below, down).is_black());
     EXPECT_EQ(bsdf->pdf(ctx, below, up), 0.f);
     auto [bs, weight] = bsdf->sample(ctx, below, 0.5f, Point2f(0.3f, 0.6f));
     EXPECT_TRUE(weight.is_black());
     // Outgoing below.
-    SurfaceInteraction above = interaction(up);
+    SurfaceInteraction above = make_si(up);
     EXPECT_TRUE(bsdf->eval(ctx, above, down).is_black());
     EXPECT_EQ(bsdf->pdf(ctx, above, down), 0.f);
     auto [value, pdf] = bsdf->eval_pdf(ctx, above, down);
@@ -205,7 +180,7 @@ TEST(BSDFEval, DiffuseBackSideIsBlack) {
 
 TEST(BSDFEval, DiffuseRespectsContext) {
     auto bsdf = make_diffuse(Color3f(0.8f));
-    SurfaceInteraction si = interaction(Vector3f(0.f, 0.f, 1.f));
+    SurfaceInteraction si = make_si(Vector3f(0.f, 0.f, 1.f));
     Vector3f wo = normalize(Vector3f(0.2f, 0.2f, 0.9f));
 
     BSDFContext glossy_only;
