@@ -1,5 +1,6 @@
-// The chi-square test itself: its statistics, its pooling, and that it rejects wrong samplers
-// and accepts right ones. The BSDFs here are test-only and live in this file.
+// Tests of the chi-square harness itself (facet::testing): its statistics, its pooling, and that
+// it rejects wrong samplers and accepts right ones. The BSDFs here are test-only and live in this
+// file; the chi-square configurations of facet's plugins are lines of tests/chi2/configs.txt.
 
 #include <facet/bsdf.h>
 #include <facet/chi2.h>
@@ -175,7 +176,7 @@ TEST(Chi2Pearson, ZeroExpectationWithSamplesIsFlagged) {
     EXPECT_EQ(s.dof, 1);
 }
 
-TEST(Chi2BSDF, CorrectSamplerAcceptedOverTwentySeeds) {
+TEST(SlowChi2BSDF, CorrectSamplerAcceptedOverTwentySeeds) {
     // Family of 20 tests at 1 % with Sidak: each must pass at the corrected level, and all of
     // them pass with probability 0.99 for a correct sampler; the seeds are fixed.
     for (uint32_t seed = 0; seed < 20; ++seed) {
@@ -235,7 +236,7 @@ TEST(Chi2BSDF, SampleInZeroExpectationCellIsAnOutrightFailure) {
     EXPECT_GT(r.p_value, 1e-3) << r.summary();
 }
 
-TEST(Chi2BSDF, WeightNotEvalOverPdfRejected) {
+TEST(SlowChi2BSDF, WeightNotEvalOverPdfRejected) {
     Chi2Result r = run_lambert(TestLambert::Bug::WrongWeight);
     EXPECT_FALSE(r.passed);
     EXPECT_EQ(r.weight_mismatches, r.smooth);

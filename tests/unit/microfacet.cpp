@@ -155,7 +155,7 @@ TEST(Microfacet, AnisotropicMaskingUsesTheProjectedRoughness) {
     }
 }
 
-TEST(Microfacet, VisibleNormalDensityIntegratesToOne) {
+TEST(SlowMicrofacet, VisibleNormalDensityIntegratesToOne) {
     // ∫ G1(wi) max(0, wi·m) D(m) / cos θi dm = 1 with the exact Smith G1 of each distribution.
     for (const Config &c : CONFIGS) {
         MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, true);

@@ -142,7 +142,7 @@ TEST(RoughConductor, BackSideIsBlack) {
         bsdf->sample(delta_only, make_si(above), 0.5f, Point2f(0.3f, 0.4f)).second.is_black());
 }
 
-TEST(RoughConductor, WhiteFurnaceAtMostOne) {
+TEST(SlowRoughConductor, WhiteFurnaceAtMostOne) {
     // A perfect mirror (material none) loses only what G masks: close to one at low roughness.
     PCG32 rng(13);
     for (const Config &c : configs()) {
