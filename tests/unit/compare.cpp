@@ -60,8 +60,8 @@ TEST(PeerComparison, ABiasedRenderFailsAndTheVarianceHasAFloor) {
     // One bad pixel in 64 is 1.6 % of the channels: more than the 0.25 % allowed.
     Image ours = ref;
     ours.at(5, 5, 0) = 10.f;
-    PeerComparison one = compare_with_reference(ours, ref, constant(8, 8, 0.01f, 0.01f, 0.01f, "XYZ"),
-                                                100);
+    PeerComparison one =
+        compare_with_reference(ours, ref, constant(8, 8, 0.01f, 0.01f, 0.01f, "XYZ"), 100);
     EXPECT_FALSE(one.passed_rule);
     EXPECT_LT(one.fraction, 1.0);
 }

@@ -66,8 +66,8 @@ PeerComparison compare_with_reference(const Image &ours, const Image &mean, cons
             sum_ours += a[1];
             sum_ref += b[1];
             for (int k = 0; k < 3; ++k) {
-                double v = std::max(double(var.at(x, y, var_c[size_t(k)])),
-                                    PeerComparison::MinVariance);
+                double v =
+                    std::max(double(var.at(x, y, var_c[size_t(k)])), PeerComparison::MinVariance);
                 double z = std::abs(a[size_t(k)] - b[size_t(k)]) * std::sqrt(double(spp) / v);
                 r.z.at(x, y, k) = float(z);
                 if (!std::isfinite(z)) {

@@ -22,13 +22,13 @@ struct PeerComparison {
 
     int width = 0, height = 0, spp = 0;
     size_t pixels = 0;
-    double alpha = 0.0;                  ///< per-channel level after the Šidák correction
-    std::array<size_t, 3> passed{0, 0, 0}; ///< channels with p > alpha, per X, Y, Z
-    size_t non_finite = 0;               ///< channels whose z is not finite (they fail)
-    double fraction = 0.0;               ///< of the 3 · pixels channels that passed
+    double alpha = 0.0;                     ///< per-channel level after the Šidák correction
+    std::array<size_t, 3> passed{0, 0, 0};  ///< channels with p > alpha, per X, Y, Z
+    size_t non_finite = 0;                  ///< channels whose z is not finite (they fail)
+    double fraction = 0.0;                  ///< of the 3 · pixels channels that passed
     double mean_ours = 0.0, mean_ref = 0.0; ///< mean Y of the two images
-    bool passed_rule = false;            ///< fraction >= PassFraction
-    Image z;                             ///< z per pixel and channel (X, Y, Z)
+    bool passed_rule = false;               ///< fraction >= PassFraction
+    Image z;                                ///< z per pixel and channel (X, Y, Z)
 
     /// Relative difference of the mean brightness (Y), 0 when the reference is black.
     double brightness_difference() const {
@@ -39,10 +39,9 @@ struct PeerComparison {
 /// Applies the rule. `ours` and `ref_mean` are RGB (channels R, G, B, else the first three),
 /// `ref_var_xyz` holds the per-sample variance in X, Y, Z (else the first three channels). The
 /// labels name the images in errors (different sizes, fewer than three channels).
-PeerComparison compare_with_reference(const Image &ours, const Image &ref_mean,
-                                      const Image &ref_var_xyz, int spp,
-                                      const std::array<std::string, 3> &labels = {
-                                          "the render", "the reference mean",
-                                          "the reference variance"});
+PeerComparison
+compare_with_reference(const Image &ours, const Image &ref_mean, const Image &ref_var_xyz, int spp,
+                       const std::array<std::string, 3> &labels = {
+                           "the render", "the reference mean", "the reference variance"});
 
 } // namespace facet
