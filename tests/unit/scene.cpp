@@ -81,7 +81,6 @@ TEST(SceneBuild, EmittingShapesGetABlackDefaultBSDF) {
     // As in Mitsuba: a shape without a BSDF reflects as a diffuse of albedo 0.5, unless it
     // emits; an emitter's default diffuse is black, so a light seen directly shows only its
     // emission.
-    REQUIRE_PLUGINS();
     Scene scene(rect_and_sphere(area_light(Color3f(4.f))));
     ASSERT_EQ(scene.shapes().size(), 2u);
     SurfaceInteraction si;
