@@ -4,17 +4,20 @@ static const char *DOC = R"DOC(
 Mixes two nested BSDFs with a weight that may vary over the surface:
 f = (1 − weight)·f_first + weight·f_second. A weight of 0 gives the first BSDF, 1 the second.
 Sampling picks one of the two with probability 1 − weight and weight and reuses the lobe choice
-number for the picked BSDF; the density is the blend of the two densities, and a smooth sample's
-weight is the blend's value over that density (so MIS sees exactly what was sampled).
+number for the picked BSDF. As in Mitsuba 3, every sample, a delta one included, is weighted by
+the blend on its direction: the picked BSDF brings its sampled value and density (for a delta
+lobe its discrete weight and probability, counted as if they were a value and a density), the
+other BSDF its eval and pdf there, and the weight is the blended value over the blended density.
+A mirror blended with a diffuse at weight w therefore returns (w + (1 − w)·ρ·cos/π) / (w +
+(1 − w)·cos/π) rather than 1: Mitsuba's mirror share looks darker and tinted by the diffuse where
+w is small. Renders depend on it; the sample stays flagged delta.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | weight | float or texture | (required) | Blend weight in [0, 1]: 0 = the first BSDF, 1 = the second (textures are clamped to [0, 1]) |
 | (nested bsdf) | bsdf | — | Exactly two nested BSDFs, in order: first, second |
 
-Components: the first BSDF's components, then the second's; the flags are their union. A delta
-direction that both BSDFs produce (two mirrors, say) is sampled through either one and weighted
-as if only that one had it; the estimate stays unbiased.
+Components: the first BSDF's components, then the second's; the flags are their union.
 
 ```xml
 <bsdf type="blendbsdf">
@@ -109,14 +112,15 @@ public:
             bs.sampled_component += m_first_count;
         if (value.is_black() || !(p_which > 0.f)) return {bs, Color3f(0.f)};
 
-        if (has_flag(bs.sampled_type, BSDFFlags::Delta | BSDFFlags::Delta1D)) {
-            // Value scaled by p_which and discrete probability scaled by p_which: same weight.
-            bs.pdf *= p_which;
-            return {bs, value};
-        }
-        // A smooth direction may also be reached through the other BSDF: the weight is the
-        // blend's value over the blend's density.
-        auto [blend_value, blend_pdf] = eval_pdf(ctx, si, bs.wo);
+        // As in Mitsuba 3, the sample is weighted by the blend on the sampled direction: the
+        // picked BSDF contributes its own value and density (for a delta lobe, its discrete
+        // weight and probability, treated like a value and a density), the other BSDF its eval
+        // and pdf there. A delta sample thus picks up the other BSDF's smooth value too.
+        float pdf_picked = bs.pdf;
+        Color3f f_picked = value * pdf_picked;
+        auto [f_other, pdf_other] = m_nested[1 - which]->eval_pdf(ctx, si, bs.wo);
+        float blend_pdf = p_which * pdf_picked + (1.f - p_which) * pdf_other;
+        Color3f blend_value = f_picked * p_which + f_other * (1.f - p_which);
         if (!(blend_pdf > 0.f) || blend_value.is_black()) return {bs, Color3f(0.f)};
         bs.pdf = blend_pdf;
         return {bs, blend_value / blend_pdf};

@@ -97,19 +97,42 @@ TEST(BlendBSDF, EvalAndPdfAreBlended) {
                 1e-6f);
 }
 
-TEST(BlendBSDF, DeltaSamplesKeepTheirWeight) {
-    // A delta lobe of one BSDF: probability scaled by its selection probability, weight unchanged.
-    auto plastic = make_bsdf("plastic");
-    auto bsdf = make_nested("blendbsdf", {make_bsdf("diffuse"), plastic}, {{"weight", 0.5}});
-    SurfaceInteraction si = make_si(direction_from_angles(70.f, 0.f));
-    // sample1 = 0.01 picks the second BSDF (u = 0.02), which then takes its mirror lobe.
-    auto [bs, weight] = bsdf->sample(BSDFContext(), si, 0.01f, Point2f(0.3f, 0.3f));
-    auto [bs_p, weight_p] = plastic->sample(BSDFContext(), si, 0.02f, Point2f(0.3f, 0.3f));
-    ASSERT_EQ(bs_p.sampled_type, BSDFFlags::DeltaReflection);
+TEST(BlendBSDF, DeltaSamplesAreWeightedByTheBlend) {
+    // Mitsuba 3 weights a sample by the blend on its direction, a delta lobe included: its
+    // discrete weight and probability count like a value and a density, and the other BSDF adds
+    // its eval and pdf there. A mirror blended with a diffuse at weight w thus returns
+    // (w + (1 - w) rho cos/pi) / (w + (1 - w) cos/pi), not 1, and keeps its delta flag.
+    const float rho = 0.1f, w = 0.1f;
+    auto bsdf = make_nested(
+        "blendbsdf", {make_bsdf("diffuse", {{"reflectance", double(rho)}}), make_bsdf("conductor")},
+        {{"weight", double(w)}});
+    SurfaceInteraction si = make_si(direction_from_angles(40.f, 30.f));
+    // sample1 = 0.05 <= w picks the conductor.
+    auto [bs, weight] = bsdf->sample(BSDFContext(), si, 0.05f, Point2f(0.3f, 0.3f));
     EXPECT_EQ(bs.sampled_type, BSDFFlags::DeltaReflection);
-    EXPECT_EQ(bs.sampled_component, 1u); // the plastic's component 0, after diffuse's one
-    EXPECT_NEAR(bs.pdf, 0.5f * bs_p.pdf, 1e-6f);
-    EXPECT_NEAR(weight.r, weight_p.r, 1e-5f * weight_p.r);
+    EXPECT_EQ(bs.sampled_component, 1u); // the conductor's component 0, after diffuse's one
+    float cos_o = bs.wo.z;
+    EXPECT_NEAR(cos_o, std::cos(40.f * Pi / 180.f), 1e-5f);
+    float pdf = w + (1.f - w) * cos_o * InvPi;
+    EXPECT_NEAR(bs.pdf, pdf, 1e-5f * pdf);
+    float expected = (w + (1.f - w) * rho * cos_o * InvPi) / pdf;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(weight[c], expected, 1e-5f) << c;
+    EXPECT_LT(weight.r, 0.45f); // far from the mirror's own weight of 1
+
+    // The same blend at weight 0.9: the mirror dominates, the weight comes close to 1.
+    auto mostly_mirror = make_nested(
+        "blendbsdf", {make_bsdf("diffuse", {{"reflectance", double(rho)}}), make_bsdf("conductor")},
+        {{"weight", 0.9}});
+    auto [bs9, weight9] = mostly_mirror->sample(BSDFContext(), si, 0.5f, Point2f(0.3f, 0.3f));
+    EXPECT_EQ(bs9.sampled_type, BSDFFlags::DeltaReflection);
+    float pdf9 = 0.9f + 0.1f * cos_o * InvPi;
+    EXPECT_NEAR(weight9.g, (0.9f + 0.1f * rho * cos_o * InvPi) / pdf9, 1e-5f);
+
+    // A diffuse sample of the same blend: the mirror adds nothing off its direction.
+    auto [bs_d, weight_d] = bsdf->sample(BSDFContext(), si, 0.5f, Point2f(0.3f, 0.3f));
+    EXPECT_EQ(bs_d.sampled_type, BSDFFlags::DiffuseReflection);
+    EXPECT_NEAR(weight_d.r, rho, 1e-5f);
+    EXPECT_NEAR(bs_d.pdf, (1.f - w) * bs_d.wo.z * InvPi, 1e-5f);
 }
 
 TEST(BlendBSDF, ComponentsAreRouted) {
