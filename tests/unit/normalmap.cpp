@@ -203,28 +203,6 @@ TEST(NormalMap, SampleMatchesEvalAndPdf) {
     }
 }
 
-TEST(BSDFSampling, NormalMapRoughConductor) {
-    BSDFAdapter adapter(normalmap(normalize(Vector3f(0.3f, 0.1f, 1.f)),
-                                  make_bsdf("roughconductor", {{"alpha", 0.2}})),
-                        direction_from_angles(35.f, 10.f));
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.test_count = 3;
-    expect_chi2(adapter, "normalmap_roughconductor", opts);
-}
-
-TEST(BSDFSampling, NormalMapRoughPlasticFlipped) {
-    // wi behind the perturbed normal: the flipped frame is sampled.
-    BSDFAdapter adapter(
-        normalmap(normalize(Vector3f(0.6f, 0.f, 1.f)), make_bsdf("roughplastic", {{"alpha", 0.3}})),
-        normalize(Vector3f(-0.9f, 0.f, 0.3f)));
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.seed = 4;
-    opts.test_count = 3;
-    expect_chi2(adapter, "normalmap_roughplastic_flipped", opts);
-}
-
 TEST(BumpMap, NormalFromTheHeightGradient) {
     const float a = 0.8f, b = -0.5f, scale = 0.3f;
     auto bump = bumpmap(std::make_shared<SlopeTexture>(a, b), make_bsdf("diffuse"),
@@ -295,17 +273,6 @@ TEST(BumpMap, SampleMatchesEvalAndPdfAndDocs) {
     std::string doc = PluginRegistry::instance().descriptor("bumpmap", ObjectType::BSDF).doc;
     for (const std::string &name : props.requested_names())
         EXPECT_NE(doc.find("| " + name + " |"), std::string::npos) << name;
-}
-
-TEST(BSDFSampling, BumpMapDiffuse) {
-    BSDFAdapter adapter(
-        bumpmap(std::make_shared<SlopeTexture>(2.f, -1.f), make_bsdf("diffuse"), {{"scale", 0.4}}),
-        direction_from_angles(50.f, 0.f));
-    Chi2Options opts;
-    opts.samples = 200000;
-    opts.seed = 2;
-    opts.test_count = 3;
-    expect_chi2(adapter, "bumpmap_diffuse", opts);
 }
 
 TEST(NullBSDF, PassesEverythingThrough) {
