@@ -63,8 +63,29 @@ Properties valid_properties(const std::string &name) {
     } else if (name == "twosided" || name == "mask") {
         p.set_object("nested", make(ObjectType::BSDF, Properties("diffuse")));
     } else if (name == "blendbsdf") {
+        p.set_float("weight", 0.5);
         p.set_object("_arg_0", make(ObjectType::BSDF, Properties("diffuse")));
         p.set_object("_arg_1", make(ObjectType::BSDF, Properties("diffuse")));
+    } else if (name == "radiancemeter" || name == "distant") {
+        Properties film("hdrfilm");
+        film.set_int("width", 1);
+        film.set_int("height", 1);
+        p.set_object("film", make(ObjectType::Film, film));
+    } else if (name == "moment") {
+        p.set_object("_arg_0", make(ObjectType::Integrator, Properties("path")));
+    } else if (name == "blackbody") {
+        p.set_float("temperature", 5000.0);
+    } else if (name == "uniform" || name == "rawconstant") {
+        p.set_float("value", 0.5);
+    } else if (name == "srgb") {
+        p.set_color("color", Color3f(0.2f, 0.4f, 0.6f));
+    } else if (name == "regular") {
+        p.set_float("wavelength_min", 400.0);
+        p.set_float("wavelength_max", 700.0);
+        p.set_string("values", "0.2, 0.5, 0.8");
+    } else if (name == "irregular") {
+        p.set_string("wavelengths", "400, 550, 700");
+        p.set_string("values", "0.2, 0.5, 0.8");
     } else if (name == "normalmap" || name == "bumpmap") {
         Properties map("bitmap");
         map.set_string("filename", asset(name == "normalmap" ? "chi2/normal_tilt.exr"
