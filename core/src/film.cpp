@@ -25,28 +25,39 @@ void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, i
     m_data.assign(size_t(s.x) * size_t(s.y) * size_t(channel_count()), 0.f);
 }
 
-void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
-                     const ReconstructionFilter &filter) {
-    if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return;
+bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp) {
+    if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return false;
     const float radius = filter.radius();
     const Point2i s = storage_size();
     // Continuous position in the block's storage, with pixel centres at integers.
     const float px = pos.x - 0.5f - float(m_offset.x - m_border);
     const float py = pos.y - 0.5f - float(m_offset.y - m_border);
-    const int x0 = std::max(0, int(std::ceil(px - radius)));
+    fp.x0 = std::max(0, int(std::ceil(px - radius)));
+    fp.y0 = std::max(0, int(std::ceil(py - radius)));
     const int x1 = std::min(s.x - 1, int(std::floor(px + radius)));
-    const int y0 = std::max(0, int(std::ceil(py - radius)));
     const int y1 = std::min(s.y - 1, int(std::floor(py + radius)));
-    if (x0 > x1 || y0 > y1) return;
-
-    const size_t nx = size_t(x1 - x0 + 1), ny = size_t(y1 - y0 + 1);
+    if (fp.x0 > x1 || fp.y0 > y1) return false;
+    fp.nx = size_t(x1 - fp.x0 + 1);
+    fp.ny = size_t(y1 - fp.y0 + 1);
     // Grows only the first time a block sees a filter of this size.
-    if (m_wx.size() < nx) m_wx.resize(nx);
-    if (m_wy.size() < ny) m_wy.resize(ny);
+    if (m_wx.size() < fp.nx) m_wx.resize(fp.nx);
+    if (m_wy.size() < fp.ny) m_wy.resize(fp.ny);
     // The filter argument is the sample's offset from the pixel centre.
-    for (size_t i = 0; i < nx; ++i) m_wx[i] = filter.eval(px - float(x0 + int(i)));
-    for (size_t j = 0; j < ny; ++j) m_wy[j] = filter.eval(py - float(y0 + int(j)));
+    fp.sum_x = fp.sum_y = 0.f;
+    for (size_t i = 0; i < fp.nx; ++i)
+        fp.sum_x += (m_wx[i] = filter.eval(px - float(fp.x0 + int(i))));
+    for (size_t j = 0; j < fp.ny; ++j)
+        fp.sum_y += (m_wy[j] = filter.eval(py - float(fp.y0 + int(j))));
+    return true;
+}
 
+void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
+                     const ReconstructionFilter &filter) {
+    Footprint fp;
+    if (!footprint(pos, filter, fp)) return;
+    const Point2i s = storage_size();
+    const size_t nx = fp.nx, ny = fp.ny;
+    const int x0 = fp.x0, y0 = fp.y0;
     const int nc = channel_count();
     for (size_t j = 0; j < ny; ++j) {
         const float wy = m_wy[j];
@@ -67,22 +78,12 @@ void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
 }
 
 void ImageBlock::splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter) {
-    if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return;
-    const float radius = filter.radius();
+    Footprint fp;
+    if (!footprint(pos, filter, fp)) return;
     const Point2i s = storage_size();
-    const float px = pos.x - 0.5f - float(m_offset.x - m_border);
-    const float py = pos.y - 0.5f - float(m_offset.y - m_border);
-    const int x0 = std::max(0, int(std::ceil(px - radius)));
-    const int x1 = std::min(s.x - 1, int(std::floor(px + radius)));
-    const int y0 = std::max(0, int(std::ceil(py - radius)));
-    const int y1 = std::min(s.y - 1, int(std::floor(py + radius)));
-    if (x0 > x1 || y0 > y1) return;
-    const size_t nx = size_t(x1 - x0 + 1), ny = size_t(y1 - y0 + 1);
-    if (m_wx.size() < nx) m_wx.resize(nx);
-    if (m_wy.size() < ny) m_wy.resize(ny);
-    float sx = 0.f, sy = 0.f;
-    for (size_t i = 0; i < nx; ++i) sx += (m_wx[i] = filter.eval(px - float(x0 + int(i))));
-    for (size_t j = 0; j < ny; ++j) sy += (m_wy[j] = filter.eval(py - float(y0 + int(j))));
+    const size_t nx = fp.nx, ny = fp.ny;
+    const int x0 = fp.x0, y0 = fp.y0;
+    const float sx = fp.sum_x, sy = fp.sum_y;
     // A footprint cut by the block edge keeps its unnormalised share: only the whole-footprint
     // sum is known to be the filter's integral over the pixels it covers.
     const float norm = sx * sy;

@@ -53,6 +53,16 @@ private:
     Point2i m_offset, m_size;
     int m_border = 0, m_aov_count = 0;
     std::vector<float> m_data;
+    /// The storage pixels [x0, x0 + nx) × [y0, y0 + ny) a sample reaches, its separable filter
+    /// weights left in m_wx / m_wy, and their sums.
+    struct Footprint {
+        int x0 = 0, y0 = 0;
+        size_t nx = 0, ny = 0;
+        float sum_x = 0.f, sum_y = 0.f;
+    };
+    /// False when the sample (non-finite, or outside the block) reaches no pixel.
+    bool footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp);
+
     std::vector<float> m_wx, m_wy; ///< scratch filter weights, reused
 };
 
