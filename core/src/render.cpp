@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <pmmintrin.h>
@@ -206,6 +207,24 @@ WorkUnitsRun run_work_units(size_t count, const RenderOptions &opts, double time
 // The sampling integrators' render loop
 
 double read_timeout(const Properties &props) { return props.get_float("timeout", -1.0); }
+
+uint32_t read_max_depth(const Properties &props, const char *plugin) {
+    int64_t max_depth = props.get_int("max_depth", -1);
+    if (max_depth < -1)
+        FACET_THROW_AT(props.location("max_depth"),
+                       "{}: max_depth must be -1 (unbounded) or a value >= 0, got {}", plugin,
+                       max_depth);
+    return max_depth == -1 ? std::numeric_limits<uint32_t>::max()
+                           : uint32_t(std::min<int64_t>(max_depth, 0xfffffffe));
+}
+
+uint32_t read_rr_depth(const Properties &props, const char *plugin) {
+    int64_t rr_depth = props.get_int("rr_depth", 5);
+    if (rr_depth <= 0)
+        FACET_THROW_AT(props.location("rr_depth"),
+                       "{}: rr_depth must be a value greater than zero, got {}", plugin, rr_depth);
+    return uint32_t(std::min<int64_t>(rr_depth, 0xffffffff));
+}
 
 uint32_t read_samples_per_pass(const Properties &props) {
     if (!props.has("samples_per_pass")) {

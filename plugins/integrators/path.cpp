@@ -40,18 +40,8 @@ namespace facet {
 class PathIntegrator final : public SamplingIntegrator {
 public:
     explicit PathIntegrator(const Properties &props) : SamplingIntegrator(props) {
-        int64_t max_depth = props.get_int("max_depth", -1);
-        if (max_depth < -1)
-            FACET_THROW_AT(props.location("max_depth"),
-                           "path: max_depth must be -1 (unbounded) or a value >= 0, got {}",
-                           max_depth);
-        m_max_depth = max_depth == -1 ? std::numeric_limits<uint32_t>::max()
-                                      : uint32_t(std::min<int64_t>(max_depth, 0xfffffffe));
-        int64_t rr_depth = props.get_int("rr_depth", 5);
-        if (rr_depth <= 0)
-            FACET_THROW_AT(props.location("rr_depth"),
-                           "path: rr_depth must be a value greater than zero, got {}", rr_depth);
-        m_rr_depth = uint32_t(std::min<int64_t>(rr_depth, 0xffffffff));
+        m_max_depth = read_max_depth(props, "path");
+        m_rr_depth = read_rr_depth(props, "path");
         m_hide_emitters = props.get_bool("hide_emitters", false);
     }
 

@@ -53,18 +53,8 @@ namespace facet {
 class ParticleTracer final : public Integrator {
 public:
     explicit ParticleTracer(const Properties &props) {
-        int64_t max_depth = props.get_int("max_depth", -1);
-        if (max_depth < -1)
-            FACET_THROW_AT(props.location("max_depth"),
-                           "ptracer: max_depth must be -1 (unbounded) or a value >= 0, got {}",
-                           max_depth);
-        m_max_depth = max_depth == -1 ? std::numeric_limits<uint32_t>::max()
-                                      : uint32_t(std::min<int64_t>(max_depth, 0xfffffffe));
-        int64_t rr_depth = props.get_int("rr_depth", 5);
-        if (rr_depth <= 0)
-            FACET_THROW_AT(props.location("rr_depth"),
-                           "ptracer: rr_depth must be a value greater than zero, got {}", rr_depth);
-        m_rr_depth = uint32_t(std::min<int64_t>(rr_depth, 0xffffffff));
+        m_max_depth = read_max_depth(props, "ptracer");
+        m_rr_depth = read_rr_depth(props, "ptracer");
         m_hide_emitters = props.get_bool("hide_emitters", false);
         m_samples_per_pass = read_samples_per_pass(props);
         m_timeout = read_timeout(props);

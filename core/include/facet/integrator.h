@@ -66,5 +66,10 @@ protected:
 /// used by SamplingIntegrator and by integrators that render otherwise (light tracers).
 double read_timeout(const Properties &props);
 uint32_t read_samples_per_pass(const Properties &props);
+/// Reads Mitsuba's path depth parameters as `path` and `ptracer` take them: `max_depth` (-1 for
+/// unbounded, returned as UINT32_MAX) and `rr_depth` (> 0, default 5); `plugin` names the
+/// integrator in the error message.
+uint32_t read_max_depth(const Properties &props, const char *plugin);
+uint32_t read_rr_depth(const Properties &props, const char *plugin);
 
 } // namespace facet
