@@ -1,9 +1,10 @@
 static const char *DOC = R"DOC(
 # independent
 
-Independent uniform random numbers from a PCG32 generator. Each pixel gets its own stream,
-seeded from a hash of the sampler's `seed` and the pixel, so images do not depend on the order
-in which pixels are rendered.
+Independent uniform random numbers from a PCG32 generator. Each sample of each pixel gets its
+own stream, seeded from a hash of the sampler's `seed`, the pixel and the sample index, so images
+do not depend on the order in which pixels are rendered, and samples [a, b) of a pixel are the
+same whether they are taken in one render or in several passes or parts.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
@@ -32,13 +33,19 @@ public:
     }
 
     void seed(uint64_t seed_value) override {
-        m_sample_index = 0;
-        m_dimension = 0;
-        // Two TEA hashes decorrelate neighbouring seed values; the second one picks the stream.
-        uint32_t lo = uint32_t(seed_value), hi = uint32_t(seed_value >> 32);
+        m_pixel_seed = seed_value;
+        set_sample_index(0);
+    }
+
+    void set_sample_index(uint32_t index) override {
+        Sampler::set_sample_index(index);
+        // The sample index moves the pixel seed along a Weyl sequence (sample 0 keeps it); two
+        // TEA hashes decorrelate neighbouring values, the second one picks the stream.
+        const uint64_t v = m_pixel_seed ^ (uint64_t(index) * 0x9e3779b97f4a7c15ull);
+        uint32_t lo = uint32_t(v), hi = uint32_t(v >> 32);
         uint32_t base_lo = uint32_t(m_base_seed), base_hi = uint32_t(m_base_seed >> 32);
         uint64_t state = tea_hash(lo ^ base_hi, base_lo, 8);
-        uint64_t stream = tea_hash(hi, base_lo ^ 0x6a09e667u, 8) ^ seed_value;
+        uint64_t stream = tea_hash(hi, base_lo ^ 0x6a09e667u, 8) ^ v;
         m_rng.seed(state, stream);
     }
 
@@ -61,6 +68,7 @@ public:
 private:
     Independent(const Independent &) = default;
     PCG32 m_rng;
+    uint64_t m_pixel_seed = 0;
 };
 
 } // namespace facet

@@ -64,7 +64,10 @@ public:
     }
 
     void seed(uint64_t seed_value) override {
-        update_resolution(); // the render loop may have changed the sample count
+        // The render loop may have changed the sample count: round it as the constructor does
+        // (without the warning), so sample_count() is the number of samples of the pattern.
+        update_resolution();
+        m_sample_count = m_resolution * m_resolution;
         m_pixel_seed = qmc::hash_combine(qmc::hash64(seed_value), uint32_t(m_base_seed));
         m_sample_index = 0;
         m_dimension = 0;

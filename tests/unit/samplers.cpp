@@ -135,6 +135,18 @@ TEST(Samplers, SampleCountRounding) {
     EXPECT_EQ(make_sampler("stratified", 10)->sample_count(), 16u);
     EXPECT_EQ(make_sampler("ldsampler", 10)->sample_count(), 16u);
     EXPECT_EQ(make_sampler("multijitter", 10)->sample_count(), 10u);
+    // A count set by the render loop (--spp) is rounded the same way once the sampler is seeded,
+    // so the render loop can read back (and report) the samples actually taken.
+    for (auto [type, rounded] : {std::pair<const char *, uint32_t>{"stratified", 16u},
+                                 {"ldsampler", 16u},
+                                 {"multijitter", 10u},
+                                 {"orthogonal", 25u},
+                                 {"independent", 10u}}) {
+        auto s = make_sampler(type, 4)->clone();
+        s->set_sample_count(10);
+        s->seed(0);
+        EXPECT_EQ(s->sample_count(), rounded) << type;
+    }
 }
 
 TEST(Samplers, MultijitterStratifiesGridAndProjections) {
@@ -151,5 +163,47 @@ TEST(Samplers, MultijitterStratifiesGridAndProjections) {
     for (int i = 0; i < n; ++i) {
         EXPECT_EQ(xs[size_t(i)], 1) << "x stratum " << i;
         EXPECT_EQ(ys[size_t(i)], 1) << "y stratum " << i;
+    }
+}
+
+TEST(Samplers, SampleIndexAloneDecidesTheValues) {
+    // Sample i of a pixel is the same whether the samples before it were taken (with any number
+    // of dimensions each) or skipped: parts of a render may take any range of samples.
+    for (const char *type :
+         {"independent", "stratified", "multijitter", "ldsampler", "orthogonal"}) {
+        auto a = make_sampler(type, 25)->clone(), b = make_sampler(type, 25)->clone();
+        a->seed(99);
+        std::vector<float> sequential;
+        for (uint32_t i = 0; i < 25; ++i) {
+            if (i > 0) a->advance();
+            EXPECT_EQ(a->sample_index(), i);
+            for (int d = 0; d < 3; ++d) {
+                Point2f p = a->next_2d();
+                sequential.push_back(p.x);
+                sequential.push_back(p.y);
+                sequential.push_back(a->next_1d());
+            }
+            for (uint32_t d = 0; d < i % 4; ++d) a->next_1d(); // uneven path lengths
+        }
+        b->seed(99);
+        for (uint32_t i = 25; i-- > 0;) { // backwards, one sample at a time
+            b->set_sample_index(i);
+            for (int d = 0; d < 3; ++d) {
+                Point2f p = b->next_2d();
+                EXPECT_EQ(p.x, sequential[i * 9 + d * 3]) << type << " sample " << i;
+                EXPECT_EQ(p.y, sequential[i * 9 + d * 3 + 1]) << type << " sample " << i;
+                EXPECT_EQ(b->next_1d(), sequential[i * 9 + d * 3 + 2]) << type << " sample " << i;
+            }
+        }
+    }
+}
+
+TEST(Samplers, IndependentSamplesDifferAcrossIndices) {
+    auto s = make_sampler("independent", 4)->clone();
+    s->seed(5);
+    Point2f first = s->next_2d();
+    for (uint32_t i = 1; i < 64; ++i) {
+        s->set_sample_index(i);
+        EXPECT_NE(s->next_2d(), first) << i;
     }
 }

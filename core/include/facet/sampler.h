@@ -8,9 +8,12 @@
 
 namespace facet {
 
-/// Source of sample values. The render loop clones one sampler per block, calls seed() once per
-/// pixel with a value derived from (scene seed, pixel index) and advance() between the samples
-/// of that pixel, so images do not depend on the thread count.
+/// Source of sample values. The render loop clones one sampler per thread, calls seed() once per
+/// pixel with a value derived from (scene seed, pixel index), then set_sample_index() with the
+/// index of each sample it takes (or advance() between consecutive ones). The values of sample
+/// `i` of a pixel depend only on (pixel seed, i, sample_count), never on which samples were
+/// taken before: a render may take any sub-range of a pixel's samples (passes, parts of a
+/// distributed render) and the union is the same estimator, whatever the thread count.
 class Sampler : public Object {
 public:
     /// Reads `sample_count` (default 4) and `seed` (default 0).
@@ -20,11 +23,15 @@ public:
     virtual std::unique_ptr<Sampler> clone() const = 0;
     /// Starts a new pixel (sample index 0).
     virtual void seed(uint64_t seed_value) = 0;
-    /// Moves to the next sample of the current pixel.
-    virtual void advance() {
-        ++m_sample_index;
+    /// Moves to sample `index` of the current pixel (dimension 0). Samplers with per-sample
+    /// state (the independent sampler's random stream) override it and call this one.
+    virtual void set_sample_index(uint32_t index) {
+        m_sample_index = index;
         m_dimension = 0;
     }
+    /// Moves to the next sample of the current pixel.
+    void advance() { set_sample_index(m_sample_index + 1); }
+    uint32_t sample_index() const { return m_sample_index; }
     virtual float next_1d() = 0;
     virtual Point2f next_2d() = 0;
 
