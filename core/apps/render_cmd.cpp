@@ -19,6 +19,8 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 
 namespace fs = std::filesystem;
@@ -124,6 +126,8 @@ int render_main(int argc, char **argv) {
     std::string output, ocio_config, view = "Standard";
     uint64_t seed = 0;
     int spp = 0;
+    std::vector<int> crop;
+    int pass_index = -1, pass_count = 0;
 
     CLI::App app("Render a Mitsuba 3 scene", "facet render");
     cli::add_scene_options(app, opts);
@@ -133,6 +137,17 @@ int render_main(int argc, char **argv) {
     app.add_option("--seed", seed, "Added to the sampler's seed (default 0)");
     app.add_option("--spp", spp, "Samples per pixel (default: the sampler's sample_count)")
         ->check(CLI::PositiveNumber);
+    app.add_option("--crop", crop,
+                   "Render only film pixels [X0, X1) x [Y0, Y1) (the EXR's data window inside "
+                   "the full display window); pixels equal those of a full render")
+        ->expected(4)
+        ->type_name("X0 Y0 X1 Y1");
+    app.add_option("--pass", pass_index,
+                   "Render part I (0-based) of the --passes N independent parts of one render "
+                   "of N x spp samples per pixel (for merging later)")
+        ->type_name("I");
+    app.add_option("--passes", pass_count, "Number of parts for --pass (default 1)")
+        ->type_name("N");
     app.add_option("--ocio-config", ocio_config,
                    "OpenColorIO config for 8-bit outputs (default: $OCIO, else facet's own)");
     app.add_option("--view", view, "OpenColorIO view for 8-bit outputs: Standard or Raw");
@@ -144,27 +159,65 @@ int render_main(int argc, char **argv) {
         FACET_THROW("-s {}: the scene has {} sensor{} (valid indices 0..{})", opts.sensor,
                     sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
     const Sensor &sensor = *sensors[size_t(opts.sensor)];
-    const Film &film = sensor.film();
-
-    std::string out = output_path(opts.scene, output, film);
-    check_output(out);
+    Film &film = sensor.film();
 
     RenderOptions ropts;
     ropts.threads = opts.threads;
     ropts.seed = seed;
     ropts.spp = spp;
     ropts.progress = !opts.quiet;
+    if (!crop.empty()) {
+        const Point2i size = film.size();
+        if (crop[0] < 0 || crop[1] < 0 || crop[2] > size.x || crop[3] > size.y ||
+            crop[2] <= crop[0] || crop[3] <= crop[1])
+            FACET_THROW("--crop {} {} {} {}: expected X0 Y0 X1 Y1 with 0 <= X0 < X1 <= {} and "
+                        "0 <= Y0 < Y1 <= {} (the film is {}x{}; X1 and Y1 are exclusive)",
+                        crop[0], crop[1], crop[2], crop[3], size.x, size.y, size.x, size.y);
+        ropts.crop = {{crop[0], crop[1], crop[2], crop[3]}};
+    }
+    if (pass_count != 0 || pass_index >= 0) {
+        if (pass_count < 1 || pass_index < 0 || pass_index >= pass_count)
+            FACET_THROW("--pass I --passes N: expected both, with N >= 1 and 0 <= I < N, got "
+                        "--pass {} --passes {}",
+                        pass_index < 0 ? std::string("(none)") : std::to_string(pass_index),
+                        pass_count == 0 ? std::string("(none)") : std::to_string(pass_count));
+        ropts.pass_index = pass_index;
+        ropts.pass_count = pass_count;
+    }
     std::atomic<bool> cancel{false};
     ropts.cancel = &cancel;
-    int used_spp = spp > 0 ? spp : int(sensor.sampler().sample_count());
+    const SampleRange range = render_sample_range(sensor, ropts);
     int threads = cli::effective_threads(opts.threads);
+
+    std::string out = output_path(opts.scene, output, film);
+    check_output(out);
+    // What ties the parts of one render together (checked by a merge).
+    std::map<std::string, std::string> params;
+    for (const std::string &define : opts.defines) {
+        size_t eq = define.find('=');
+        params[define.substr(0, eq)] = define.substr(eq + 1);
+    }
+    std::ifstream scene_file(opts.scene, std::ios::binary);
+    std::string scene_text((std::istreambuf_iterator<char>(scene_file)),
+                           std::istreambuf_iterator<char>());
+    const std::string scene_hash = scene_identity(scene_text, params, film.size().x, film.size().y);
 
     // From here on Ctrl-C stops the render and the partial image is written.
     install_interrupt_handler(&cancel);
     if (!opts.quiet) {
-        fmt::print("Rendering {}: {}x{} pixels, {} spp, {} thread{}\n", opts.scene,
-                   film.crop_size().x, film.crop_size().y, used_spp, threads,
-                   threads == 1 ? "" : "s");
+        const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
+        const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
+        fmt::print("Rendering {}: {}x{} pixels{}, {} spp{}, {} thread{}\n", opts.scene, w, h,
+                   crop.empty() ? ""
+                                : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1],
+                                              crop[2], crop[3], film.size().x, film.size().y),
+                   range.count,
+                   ropts.pass_count > 1
+                       ? fmt::format(" (part {} of {}: samples {}..{} of {})", ropts.pass_index,
+                                     ropts.pass_count, range.first, range.first + range.count - 1,
+                                     range.total)
+                       : "",
+                   threads, threads == 1 ? "" : "s");
         std::fflush(stdout);
     }
     RenderResult result;
@@ -179,7 +232,8 @@ int render_main(int argc, char **argv) {
     ImageWriteOptions wopts;
     wopts.ocio_config = ocio_config;
     wopts.view = view;
-    wopts.metadata["facet:spp"] = std::to_string(used_spp);
+    wopts.metadata = render_metadata(result);
+    wopts.metadata["facet:scene_hash"] = scene_hash;
     wopts.metadata["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
     wopts.metadata["facet:scene"] = fs::absolute(opts.scene).lexically_normal().string();
     wopts.metadata["facet:seed"] = std::to_string(seed);

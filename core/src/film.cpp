@@ -138,6 +138,8 @@ Film::Film(const Properties &props) {
             "{}x{} film",
             ox, oy, cw, ch, m_size.x, m_size.y);
     m_crop_size = {int(cw), int(ch)};
+    m_file_crop_offset = m_crop_offset;
+    m_file_crop_size = m_crop_size;
 
     for (const auto &[name, obj] : props.objects()) {
         if (!obj || obj->type() != ObjectType::ReconstructionFilter) continue;
@@ -149,6 +151,27 @@ Film::Film(const Properties &props) {
     if (!m_filter)
         m_filter = PluginRegistry::instance().create_as<ReconstructionFilter>(
             ObjectType::ReconstructionFilter, Properties("gaussian"));
+}
+
+void Film::set_crop_window(const Point2i &offset, const Point2i &size) {
+    if (offset.x < 0 || offset.y < 0 || size.x <= 0 || size.y <= 0 ||
+        int64_t(offset.x) + size.x > m_size.x || int64_t(offset.y) + size.y > m_size.y)
+        FACET_THROW("the crop window [{}, {}) x [{}, {}) must be non-empty and lie inside the "
+                    "{}x{} film (pixels 0..{} x 0..{})",
+                    offset.x, int64_t(offset.x) + size.x, offset.y, int64_t(offset.y) + size.y,
+                    m_size.x, m_size.y, m_size.x - 1, m_size.y - 1);
+    m_crop_offset = offset;
+    m_crop_size = size;
+    m_storage.clear();
+    m_splats.clear();
+}
+
+void Film::reset_crop_window() {
+    if (m_crop_offset == m_file_crop_offset && m_crop_size == m_file_crop_size) return;
+    m_crop_offset = m_file_crop_offset;
+    m_crop_size = m_file_crop_size;
+    m_storage.clear();
+    m_splats.clear();
 }
 
 void Film::prepare(const std::vector<std::string> &aov_names) {
@@ -208,6 +231,10 @@ Image Film::develop() const {
     const int nc = 4 + naov;
     const int out_c = 3 + (m_alpha ? 1 : 0) + naov;
     Image img(m_crop_size.x, m_crop_size.y, out_c);
+    img.x = m_crop_offset.x;
+    img.y = m_crop_offset.y;
+    img.full_width = m_size.x;
+    img.full_height = m_size.y;
     img.channel_names = {"R", "G", "B"};
     if (m_alpha) img.channel_names.push_back("A");
     for (const auto &n : m_aov_names) img.channel_names.push_back(n);

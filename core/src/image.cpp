@@ -205,6 +205,12 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         for (int c = 0; c < image.channels; ++c)
             if (spec.channelnames[c] == "A") spec.alpha_channel = c;
         spec.attribute("compression", "zip");
+        // A crop window: data window at (x, y) inside the full display window.
+        spec.x = image.x;
+        spec.y = image.y;
+        spec.full_x = spec.full_y = 0;
+        spec.full_width = image.full_width > 0 ? image.full_width : image.x + image.width;
+        spec.full_height = image.full_height > 0 ? image.full_height : image.y + image.height;
         pixels = image.data.data();
         pixel_type = OIIO::TypeDesc::FLOAT;
     } else {
@@ -267,6 +273,11 @@ Image read_image(const std::string &path) {
     const OIIO::ImageSpec &spec = in->spec();
     Image img(spec.width, spec.height, spec.nchannels);
     img.channel_names.assign(spec.channelnames.begin(), spec.channelnames.end());
+    // The data window (the pixels read) inside the display window (origin 0 in facet's files).
+    img.x = spec.x - spec.full_x;
+    img.y = spec.y - spec.full_y;
+    img.full_width = spec.full_width;
+    img.full_height = spec.full_height;
     bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, img.data.data());
     std::string err = ok ? "" : in->geterror();
     in->close();

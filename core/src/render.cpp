@@ -249,24 +249,55 @@ SamplingIntegrator::SamplingIntegrator(const Properties &props) {
     m_block_size = int(bs);
 }
 
+SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts) {
+    if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
+    if (opts.pass_count < 1)
+        FACET_THROW("the pass count must be at least 1, got {}", opts.pass_count);
+    if (opts.pass_index < 0 || opts.pass_index >= opts.pass_count)
+        FACET_THROW("the pass index must lie in 0..{} (pass_count {}), got {}", opts.pass_count - 1,
+                    opts.pass_count, opts.pass_index);
+    // Samplers may round the count (stratified ones to a square); seeding once lets them do so
+    // before the count is read back.
+    std::unique_ptr<Sampler> sampler = sensor.sampler().clone();
+    const uint64_t per_part = opts.spp > 0 ? uint64_t(opts.spp) : sensor.sampler().sample_count();
+    const uint64_t whole = per_part * uint64_t(opts.pass_count);
+    if (whole > UINT32_MAX / 2)
+        FACET_THROW("{} passes of {} samples per pixel are too many (at most {} in all)",
+                    opts.pass_count, per_part, UINT32_MAX / 2);
+    sampler->set_sample_count(uint32_t(whole));
+    sampler->seed(0);
+    SampleRange range;
+    range.total = std::max(sampler->sample_count(), 1u);
+    const uint64_t n = uint64_t(opts.pass_count), i = uint64_t(opts.pass_index);
+    range.first = uint32_t(uint64_t(range.total) * i / n);
+    range.count = uint32_t(uint64_t(range.total) * (i + 1) / n) - range.first;
+    return range;
+}
+
 RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor,
                                         const RenderOptions &opts) const {
     const auto start = Clock::now();
-    if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
     if (opts.block_size < 0)
         FACET_THROW("the block size must be positive, got {}", opts.block_size);
     const int bs = opts.block_size > 0 ? opts.block_size : m_block_size > 0 ? m_block_size : 32;
 
     Film &film = sensor.film();
     const Sampler &proto_sampler = sensor.sampler();
-    // The per-thread samplers are clones of this one. Samplers may round the count (stratified
-    // ones to a square); seeding once lets them do so before the count is read back.
+    const SampleRange range = render_sample_range(sensor, opts);
+    const uint64_t asked =
+        uint64_t(opts.spp > 0 ? uint32_t(opts.spp) : proto_sampler.sample_count()) *
+        uint64_t(opts.pass_count);
+    if (range.total != asked)
+        FACET_LOG(Info, "The sampler takes {} samples per pixel instead of {}", range.total, asked);
+    if (range.count == 0)
+        FACET_THROW("pass {} of {} has no samples: the {} samples per pixel of the whole render "
+                    "cannot be split into {} parts",
+                    opts.pass_index, opts.pass_count, range.total, opts.pass_count);
+    // The per-thread samplers are clones of this one, set to the whole render's sample count.
     std::unique_ptr<Sampler> base_sampler = proto_sampler.clone();
-    if (opts.spp > 0) base_sampler->set_sample_count(uint32_t(opts.spp));
+    base_sampler->set_sample_count(range.total);
     base_sampler->seed(0);
-    const uint32_t spp = base_sampler->sample_count();
-    if (opts.spp > 0 && spp != uint32_t(opts.spp))
-        FACET_LOG(Info, "The sampler takes {} samples per pixel instead of {}", spp, opts.spp);
+    const uint32_t spp = range.count;
     const uint32_t spp_per_pass =
         m_samples_per_pass > 0 ? std::min(m_samples_per_pass, spp) : std::max(spp, 1u);
     if (spp % spp_per_pass != 0)
@@ -280,17 +311,25 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
 
     const Point2i film_size = film.size(), crop_offset = film.crop_offset(),
                   crop_size = film.crop_size();
-    const int blocks_x = (crop_size.x + bs - 1) / bs, blocks_y = (crop_size.y + bs - 1) / bs;
+    const int border = ImageBlock::border_for(film.rfilter());
+    // The pixels whose samples reach the crop window through the filter are sampled, in blocks
+    // of the grid of the whole film: a crop's pixels receive the same samples, in the same
+    // order, as in a render of the whole film.
+    const int rx0 = std::max(0, crop_offset.x - border), ry0 = std::max(0, crop_offset.y - border);
+    const int rx1 = std::min(film_size.x, crop_offset.x + crop_size.x + border);
+    const int ry1 = std::min(film_size.y, crop_offset.y + crop_size.y + border);
+    const int gx0 = rx0 / bs, gy0 = ry0 / bs;
+    const int blocks_x = (rx1 + bs - 1) / bs - gx0, blocks_y = (ry1 + bs - 1) / bs - gy0;
     const size_t blocks = size_t(blocks_x) * size_t(blocks_y);
     const size_t total = blocks * passes;
-    const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
-    const int border = ImageBlock::border_for(film.rfilter());
     const ReconstructionFilter &filter = film.rfilter();
     const bool needs_aperture = sensor.needs_aperture_sample();
     const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
 
-    FACET_LOG(Info, "Starting render job ({}x{}, {} samples{}, {} threads)", crop_size.x,
+    FACET_LOG(Info, "Starting render job ({}x{}, {} samples{}{}, {} threads)", crop_size.x,
               crop_size.y, spp, passes > 1 ? fmt::format(" in {} passes", passes) : "",
+              opts.pass_count > 1 ? fmt::format(", part {} of {}", opts.pass_index, opts.pass_count)
+                                  : "",
               render_thread_count(opts));
     if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
 
@@ -303,23 +342,26 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
         auto sampler = std::shared_ptr<Sampler>(base_sampler->clone());
         auto aovs = std::make_shared<std::vector<float>>(size_t(aov_count) + 1, 0.f);
         return [&, sampler, aovs](size_t index) -> size_t {
-            const uint64_t pass = index / blocks;
+            const uint32_t pass = uint32_t(index / blocks);
             const size_t block_index = index % blocks;
-            const int bx = int(block_index % size_t(blocks_x)),
-                      by = int(block_index / size_t(blocks_x));
-            const Point2i offset(crop_offset.x + bx * bs, crop_offset.y + by * bs);
-            const Point2i size(std::min(bs, crop_offset.x + crop_size.x - offset.x),
-                               std::min(bs, crop_offset.y + crop_size.y - offset.y));
+            const int bx = gx0 + int(block_index % size_t(blocks_x)),
+                      by = gy0 + int(block_index / size_t(blocks_x));
+            const Point2i offset(bx * bs, by * bs);
+            const Point2i size(std::min(bs, film_size.x - offset.x),
+                               std::min(bs, film_size.y - offset.y));
             std::unique_ptr<ImageBlock> block = merger.acquire();
             block->reset(offset, size, border, aov_count);
+            const int x0 = std::max(offset.x, rx0), x1 = std::min(offset.x + size.x, rx1);
+            const int y0 = std::max(offset.y, ry0), y1 = std::min(offset.y + size.y, ry1);
+            const uint32_t first = range.first + pass * spp_per_pass, last = first + spp_per_pass;
 
             uint64_t invalid = 0;
-            for (int y = offset.y; y < offset.y + size.y; ++y) {
-                for (int x = offset.x; x < offset.x + size.x; ++x) {
+            for (int y = y0; y < y1; ++y) {
+                for (int x = x0; x < x1; ++x) {
                     const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
-                    sampler->seed(sample_stream_seed(seed, pixel_index + pass * film_pixels));
-                    for (uint32_t s = 0; s < spp_per_pass; ++s) {
-                        if (s > 0) sampler->advance();
+                    sampler->seed(sample_stream_seed(seed, pixel_index));
+                    for (uint32_t s = first; s < last; ++s) {
+                        sampler->set_sample_index(s);
                         const Point2f u = sampler->next_2d();
                         const Point2f pos(float(x) + u.x, float(y) + u.y);
                         const Point2f aperture =
@@ -345,7 +387,8 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                     }
                 }
             }
-            samples_taken += uint64_t(size.x) * uint64_t(size.y) * spp_per_pass;
+            samples_taken +=
+                uint64_t(std::max(0, x1 - x0)) * uint64_t(std::max(0, y1 - y0)) * spp_per_pass;
             invalid_samples += invalid;
             return merger.submit(index, std::move(block));
         };
@@ -359,6 +402,12 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
     result.cancelled = (run.cancelled || run.timed_out) && result.blocks_done < total;
     result.timed_out = run.timed_out && result.blocks_done < total;
     result.samples = samples_taken.load();
+    result.spp_target = spp;
+    result.spp = result.cancelled
+                     ? uint32_t(result.blocks_done / std::max<size_t>(blocks, 1)) * spp_per_pass
+                     : spp;
+    result.sample_offset = range.first;
+    result.spp_total = range.total;
     result.seconds = seconds_since(start);
     if (result.timed_out)
         FACET_LOG(Warn, "Timeout of {:.2f}s reached after {} of {} blocks", m_timeout,
@@ -382,7 +431,70 @@ RenderResult Integrator::render(const Scene &, const Sensor &, const RenderOptio
 
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts) {
     if (!scene.integrator()) FACET_THROW("the scene has no integrator");
-    return scene.integrator()->render(scene, sensor, opts);
+    const Integrator &integrator = *scene.integrator();
+    Film &film = sensor.film();
+    const auto &c = opts.crop;
+    if (c[0] == 0 && c[1] == 0 && c[2] == 0 && c[3] == 0) {
+        film.reset_crop_window();
+    } else {
+        if (c[2] <= c[0] || c[3] <= c[1])
+            FACET_THROW("the crop window x0 y0 x1 y1 = {} {} {} {} is empty (x1 and y1 are "
+                        "exclusive: they must be greater than x0 and y0)",
+                        c[0], c[1], c[2], c[3]);
+        film.set_crop_window(Point2i(c[0], c[1]), Point2i(c[2] - c[0], c[3] - c[1]));
+    }
+    const bool sampling = dynamic_cast<const SamplingIntegrator *>(&integrator) != nullptr;
+    if (opts.pass_count != 1 && !sampling)
+        FACET_THROW("the integrator {} renders in one part only (a pass count of {} needs a "
+                    "sampling integrator such as path)",
+                    integrator.to_string(), opts.pass_count);
+    const SampleRange range = render_sample_range(sensor, opts); // validates the options
+    RenderResult result = integrator.render(scene, sensor, opts);
+    if (result.spp_total == 0) {
+        // An integrator that does not fill these in (a light tracer) renders one whole part.
+        result.spp_target = range.count;
+        result.spp = range.count;
+        result.sample_offset = range.first;
+        result.spp_total = range.total;
+    }
+    result.pass_index = opts.pass_index;
+    result.pass_count = opts.pass_count;
+    const Point2i o = film.crop_offset(), sz = film.crop_size();
+    result.crop = {{o.x, o.y, o.x + sz.x, o.y + sz.y}};
+    result.film_width = film.size().x;
+    result.film_height = film.size().y;
+    return result;
+}
+
+std::map<std::string, std::string> render_metadata(const RenderResult &r) {
+    std::map<std::string, std::string> m;
+    m["facet:spp"] = std::to_string(r.spp);
+    if (r.spp != r.spp_target) m["facet:spp_target"] = std::to_string(r.spp_target);
+    m["facet:spp_total"] = std::to_string(r.spp_total);
+    m["facet:sample_offset"] = std::to_string(r.sample_offset);
+    m["facet:pass_index"] = std::to_string(r.pass_index);
+    m["facet:pass_count"] = std::to_string(r.pass_count);
+    m["facet:crop"] = fmt::format("{} {} {} {}", r.crop[0], r.crop[1], r.crop[2], r.crop[3]);
+    m["facet:film_size"] = fmt::format("{} {}", r.film_width, r.film_height);
+    return m;
+}
+
+std::string scene_identity(const std::string &scene_text,
+                           const std::map<std::string, std::string> &params, int film_width,
+                           int film_height) {
+    uint64_t h = 0xcbf29ce484222325ull; // FNV-1a, 64 bits
+    auto add = [&h](const std::string &bytes) {
+        for (unsigned char ch : bytes) {
+            h ^= ch;
+            h *= 0x100000001b3ull;
+        }
+        h ^= 0xff; // separator: ("ab", "c") and ("a", "bc") differ
+        h *= 0x100000001b3ull;
+    };
+    add(scene_text);
+    for (const auto &[key, value] : params) add(key + "=" + value);
+    add(fmt::format("{}x{}", film_width, film_height));
+    return fmt::format("{:016x}", h);
 }
 // ---------------------------------------------------------------------------------------------
 // Interrupt handling

@@ -10,14 +10,14 @@ everything (float16 or float32, AOV channels, metadata); `.hdr`/`.rgbe`/`.pfm` k
 |---|---|---|---|
 | width | integer | 768 | Image width in pixels |
 | height | integer | 576 | Image height in pixels |
-| crop_offset_x | integer | 0 | Left column of the crop window (the part that is rendered) |
+| crop_offset_x | integer | 0 | Left column of the crop window (the part that is rendered; an EXR keeps it as its data window inside the full display window) |
 | crop_offset_y | integer | 0 | Top row of the crop window |
 | crop_width | integer | width - crop_offset_x | Width of the crop window |
 | crop_height | integer | height - crop_offset_y | Height of the crop window |
 | file_format | string | openexr | openexr (.exr), rgbe (.rgbe) or pfm (.pfm): the default extension |
 | pixel_format | string | rgb | rgb, rgba, luminance, luminance_alpha, xyz or xyza |
 | component_format | string | float16 | float16 or float32 (EXR sample type) |
-| sample_border | boolean | false | Accepted for compatibility; facet never samples outside the crop window |
+| sample_border | boolean | false | Accepted for compatibility; facet always samples the pixels whose filter footprint reaches the crop window, so a crop's pixels equal those of the full image |
 | compensate | boolean | false | Accepted for compatibility; the film always accumulates in double precision |
 | high_quality_edges | boolean | false | Mitsuba 0.6 name of sample_border; accepted, no effect |
 | banner | boolean | false | Mitsuba 0.6 parameter; accepted, no effect |
@@ -112,6 +112,10 @@ public:
         const int ncol = lum ? 1 : 3;
         const int rest = rgb.channels - 3;
         Image out(rgb.width, rgb.height, ncol + rest);
+        out.x = rgb.x;
+        out.y = rgb.y;
+        out.full_width = rgb.full_width;
+        out.full_height = rgb.full_height;
         out.channel_names =
             lum ? std::vector<std::string>{"Y"} : std::vector<std::string>{"X", "Y", "Z"};
         out.channel_names.insert(out.channel_names.end(), rgb.channel_names.begin() + 3,

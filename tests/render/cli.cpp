@@ -301,6 +301,65 @@ TEST_F(CliTest, SameImageForAnyThreadCount) {
     EXPECT_FALSE(a.data == c.data);
 }
 
+TEST_F(CliTest, CropAndPassWriteTheDataWindowAndWhatAMergeNeeds) {
+    Result r = run("render scene.xml -D spp=4 --crop 4 2 20 10 --pass 1 --passes 3 -o part.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("16x8 pixels (crop 4 2 20 10 of 32x32)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("part 1 of 3"), std::string::npos) << r.out;
+    const std::string part = (m_dir / "part.exr").string();
+    {
+        auto in = OIIO::ImageInput::open(part);
+        ASSERT_TRUE(in);
+        const OIIO::ImageSpec &spec = in->spec();
+        EXPECT_EQ(spec.x, 4);
+        EXPECT_EQ(spec.y, 2);
+        EXPECT_EQ(spec.width, 16);
+        EXPECT_EQ(spec.height, 8);
+        EXPECT_EQ(spec.full_x, 0);
+        EXPECT_EQ(spec.full_y, 0);
+        EXPECT_EQ(spec.full_width, 32);
+        EXPECT_EQ(spec.full_height, 32);
+    }
+    EXPECT_EQ(attribute(part, "facet:spp"), "4");
+    EXPECT_EQ(attribute(part, "facet:spp_total"), "12");
+    EXPECT_EQ(attribute(part, "facet:sample_offset"), "4");
+    EXPECT_EQ(attribute(part, "facet:pass_index"), "1");
+    EXPECT_EQ(attribute(part, "facet:pass_count"), "3");
+    EXPECT_EQ(attribute(part, "facet:crop"), "4 2 20 10");
+    EXPECT_EQ(attribute(part, "facet:film_size"), "32 32");
+    const std::string hash = attribute(part, "facet:scene_hash");
+    EXPECT_EQ(hash.size(), 16u) << hash;
+
+    // The other parts of the same render carry the same scene identity; another -D does not.
+    ASSERT_EQ(run("render scene.xml -q -D spp=4 --pass 0 --passes 3 -o p0.exr").code, 0);
+    EXPECT_EQ(attribute((m_dir / "p0.exr").string(), "facet:scene_hash"), hash);
+    EXPECT_EQ(attribute((m_dir / "p0.exr").string(), "facet:crop"), "0 0 32 32");
+    ASSERT_EQ(run("render scene.xml -q -D spp=5 --pass 0 --passes 3 -o p5.exr").code, 0);
+    EXPECT_NE(attribute((m_dir / "p5.exr").string(), "facet:scene_hash"), hash);
+
+    // The crop's pixels are those of the full image.
+    ASSERT_EQ(run("render scene.xml -q -D spp=4 --pass 1 --passes 3 -o full.exr").code, 0);
+    facet::Image crop = facet::read_image(part),
+                 full = facet::read_image((m_dir / "full.exr").string());
+    ASSERT_EQ(crop.width, 16);
+    for (int y = 0; y < crop.height; ++y)
+        for (int x = 0; x < crop.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                ASSERT_EQ(crop.at(x, y, c), full.at(x + 4, y + 2, c)) << x << "," << y;
+}
+
+TEST_F(CliTest, BadCropOrPassIsOneLineError) {
+    std::string line = expect_one_line_error("render scene.xml --crop 0 0 40 10");
+    EXPECT_NE(line.find("32x32"), std::string::npos) << line;
+    line = expect_one_line_error("render scene.xml --crop 8 0 8 10");
+    EXPECT_NE(line.find("exclusive"), std::string::npos) << line;
+    expect_one_line_error("render scene.xml --crop 1 2 3");
+    line = expect_one_line_error("render scene.xml --pass 2 --passes 2");
+    EXPECT_NE(line.find("0 <= I < N"), std::string::npos) << line;
+    line = expect_one_line_error("render scene.xml --pass 1");
+    EXPECT_NE(line.find("--passes"), std::string::npos) << line;
+}
+
 TEST_F(CliTest, InterruptWritesThePartialImage) {
     // Far too many samples to finish: about 2·10⁹ camera samples in small blocks.
     fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";

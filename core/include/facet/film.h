@@ -78,6 +78,11 @@ public:
     Point2i size() const { return m_size; }
     Point2i crop_offset() const { return m_crop_offset; }
     Point2i crop_size() const { return m_crop_size; }
+    /// Renders the window `offset` + [0, size) of the film instead of the crop window of the
+    /// scene file (validated against the film size; a FACET_THROW names what is wrong).
+    void set_crop_window(const Point2i &offset, const Point2i &size);
+    /// Back to the crop window of the scene file (crop_offset_x/y, crop_width/height).
+    void reset_crop_window();
     const ReconstructionFilter &rfilter() const { return *m_filter; }
 
     /// Clears the storage for a new render without extra channels.
@@ -103,7 +108,9 @@ public:
     /// Factor applied to the splat buffer by develop() (1 / light paths per pixel).
     void set_splat_scale(double scale) { m_splat_scale = scale; }
     /// Normalised linear RGB (plus alpha when the pixel format asks) of the crop window, followed
-    /// by the AOV channels. Pixels without any sample weight are 0 (and alpha 0).
+    /// by the AOV channels. Pixels without any sample weight are 0 (and alpha 0). The image's
+    /// window (Image::x, y, full_width, full_height) is the crop window inside the film, so an
+    /// EXR of a crop has the crop as data window and the whole film as display window.
     virtual Image develop() const;
     /// Extension the film writes by default (".exr").
     virtual std::string default_extension() const { return ".exr"; }
@@ -117,6 +124,7 @@ public:
 
 protected:
     Point2i m_size, m_crop_offset, m_crop_size;
+    Point2i m_file_crop_offset, m_file_crop_size; ///< the crop window of the scene file
     std::shared_ptr<ReconstructionFilter> m_filter;
     std::vector<double> m_storage; ///< Σ w·L (3), Σ w·aov (per AOV) and Σ w per crop pixel
     std::vector<std::string> m_aov_names;

@@ -11,6 +11,10 @@ namespace facet {
 /// Interleaved float image.
 struct Image {
     int width = 0, height = 0, channels = 0;
+    /// Where the pixels lie in a larger image (OpenEXR's data and display windows): this image
+    /// is the window at (x, y) of a full_width x full_height one (0: the image itself). A film's
+    /// crop window is developed so; EXR files keep both windows.
+    int x = 0, y = 0, full_width = 0, full_height = 0;
     std::vector<std::string> channel_names;
     std::vector<float> data;
 

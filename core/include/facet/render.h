@@ -3,6 +3,7 @@
 #include <facet/fwd.h>
 #include <facet/image.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -26,11 +27,43 @@ struct RenderOptions {
     bool progress = true; ///< progress line on a terminal (never when stderr is not a tty)
     /// Set to true (e.g. by a signal handler) to stop after the work units in flight.
     std::atomic<bool> *cancel = nullptr;
+    /// Film pixels [x0, x1) x [y0, y1) to render, as {x0, y0, x1, y1}, instead of the film's crop
+    /// window (validated against the film). The developed image is that window of the film (an
+    /// EXR's data window inside the full display window) and its pixels are bit-identical to the
+    /// same pixels of a render of the whole film. All zero: the crop window of the scene file.
+    std::array<int, 4> crop{{0, 0, 0, 0}};
+    /// Part `pass_index` (0-based) of `pass_count` independent parts of one render of
+    /// pass_count x spp samples per pixel: the part takes the samples
+    /// [pass_index·T/pass_count, (pass_index+1)·T/pass_count) of every pixel, T being that total
+    /// after the sampler's rounding (T = pass_count·spp for the independent sampler). The parts,
+    /// averaged with their spp as weights, are the same estimator as the whole render.
+    int pass_index = 0;
+    int pass_count = 1;
 };
+
+/// The samples per pixel a render takes: sample indices [first, first + count) of each pixel of
+/// a render whose sampler pattern spans `total` samples (see RenderOptions::pass_index).
+struct SampleRange {
+    uint32_t first = 0, count = 0, total = 0;
+};
+
+/// The sample range `opts` asks of `sensor`'s sampler, after the sampler's own rounding of
+/// pass_count x spp (stratified samplers take a square number, ldsampler a power of two, ...).
+/// Throws on a bad spp or pass index/count.
+SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts);
 
 struct RenderResult {
     Image image; ///< developed film (crop window), plus AOV channels
     double seconds = 0.0;
+    /// Samples per pixel in the image (of a stopped render: what was reached), and what the
+    /// render was to take (after the sampler's rounding).
+    uint32_t spp = 0, spp_target = 0;
+    /// This part's place in the whole estimator: sample indices [sample_offset, sample_offset +
+    /// spp_target) of spp_total, part pass_index of pass_count (see RenderOptions).
+    uint32_t sample_offset = 0, spp_total = 0;
+    int pass_index = 0, pass_count = 1;
+    std::array<int, 4> crop{{0, 0, 0, 0}}; ///< the film pixels rendered: {x0, y0, x1, y1}
+    int film_width = 0, film_height = 0;
     bool cancelled = false; ///< stopped early by the cancel flag (Ctrl-C) or the timeout
     bool timed_out = false; ///< stopped early by the integrator's `timeout`
     /// Work units finished and in total: image blocks (times passes) of a sampling integrator,
@@ -42,6 +75,19 @@ struct RenderResult {
 /// Renders `sensor` of `scene` with the scene's integrator (Integrator::render). Deterministic:
 /// the same scene, seed and spp give the same image for any thread count.
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts);
+
+/// What a merge of parts of one render needs, as EXR attributes: facet:spp (of this image),
+/// facet:spp_total, facet:sample_offset, facet:pass_index, facet:pass_count, facet:crop
+/// ("x0 y0 x1 y1"), facet:film_size ("width height"), and facet:spp_target when the render was
+/// stopped before it.
+std::map<std::string, std::string> render_metadata(const RenderResult &result);
+
+/// Identity of a render's input, for checking that parts belong together: 16 hex digits of a
+/// 64-bit FNV-1a hash of `scene_text` (the scene file's bytes), the parameters (key=value, in
+/// key order) and the film size. Stored as facet:scene_hash.
+std::string scene_identity(const std::string &scene_text,
+                           const std::map<std::string, std::string> &params, int film_width,
+                           int film_height);
 
 /// Installs SIGINT/SIGHUP handlers that set `flag` (restored by uninstall_interrupt_handler).
 void install_interrupt_handler(std::atomic<bool> *flag);
