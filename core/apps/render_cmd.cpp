@@ -17,6 +17,7 @@
 #include <tbb/info.h>
 
 #include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -242,21 +243,22 @@ int render_main(int argc, char **argv) {
             fmt::format("{}/{}", result.blocks_done, result.blocks_total);
     film.write(result.image, out, wopts);
 
+    const std::string reached =
+        fmt::format("{} of {} spp{}", result.spp, result.spp_target,
+                    result.spp == 0 ? ", no pass finished: the image is black" : "");
     if (result.timed_out) {
         // The integrator's `timeout` is a request, not an interruption: success.
         if (!opts.quiet)
-            fmt::print("Timeout reached after {} ({} of {} work units), wrote {}\n",
-                       format_seconds(result.seconds), result.blocks_done, result.blocks_total,
-                       out);
+            fmt::print("Timeout reached after {} ({}), wrote {}\n", format_seconds(result.seconds),
+                       reached, out);
         return 0;
     }
     if (result.cancelled) {
-        std::fprintf(stderr,
-                     "facet: interrupted after %s: wrote the partial image (%zu of %zu blocks) "
-                     "to %s\n",
-                     format_seconds(result.seconds).c_str(), result.blocks_done,
-                     result.blocks_total, out.c_str());
-        return 130;
+        const int sig = interrupt_signal();
+        std::fprintf(stderr, "facet: %s after %s: wrote the partial image (%s) to %s\n",
+                     sig == SIGTERM ? "terminated" : "interrupted",
+                     format_seconds(result.seconds).c_str(), reached.c_str(), out.c_str());
+        return 128 + (sig > 0 ? sig : SIGINT);
     }
     if (!opts.quiet) fmt::print("Rendered in {}, wrote {}\n", format_seconds(result.seconds), out);
     return 0;

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -21,6 +22,7 @@
 #include <mutex>
 #include <pmmintrin.h>
 #include <signal.h>
+#include <thread>
 #include <unistd.h>
 #include <xmmintrin.h>
 
@@ -78,6 +80,7 @@ public:
     void finish() {
         if (m_enabled && m_drawn) std::fputs("\n", stderr);
     }
+    bool drawn() const { return m_drawn; }
 
 private:
     bool m_enabled;
@@ -96,7 +99,8 @@ uint64_t sample_stream_seed(uint64_t seed, uint64_t index) {
 // ---------------------------------------------------------------------------------------------
 // BlockMerger
 
-BlockMerger::BlockMerger(Film &film, bool splat) : m_film(film), m_splat(splat) {}
+BlockMerger::BlockMerger(Film &film, bool splat, size_t group)
+    : m_film(film), m_splat(splat), m_group(std::max<size_t>(group, 1)) {}
 BlockMerger::~BlockMerger() = default;
 
 std::unique_ptr<ImageBlock> BlockMerger::acquire() {
@@ -118,20 +122,39 @@ size_t BlockMerger::submit(size_t index, std::unique_ptr<ImageBlock> block) {
     std::lock_guard<std::mutex> lock(m_mutex);
     m_pending.emplace(index, std::move(block));
     ++m_finished;
-    for (auto it = m_pending.begin(); it != m_pending.end() && it->first == m_next;
-         it = m_pending.begin()) {
-        merge(*it->second);
-        m_free.push_back(std::move(it->second));
-        m_pending.erase(it);
-        ++m_next;
+    // Merge every whole group that is next in order: the keys are distinct and sorted, so the
+    // group is complete when its first and last blocks are the first m_group pending ones.
+    while (m_pending.size() >= m_group && m_pending.begin()->first == m_next &&
+           std::next(m_pending.begin(), std::ptrdiff_t(m_group - 1))->first ==
+               m_next + m_group - 1) {
+        for (size_t k = 0; k < m_group; ++k) {
+            auto it = m_pending.begin();
+            merge(*it->second);
+            m_free.push_back(std::move(it->second));
+            m_pending.erase(it);
+        }
+        m_next += m_group;
     }
     return m_finished;
 }
 
+void BlockMerger::release(std::unique_ptr<ImageBlock> block) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_free.push_back(std::move(block));
+}
+
 void BlockMerger::flush() {
     std::lock_guard<std::mutex> lock(m_mutex);
-    for (auto &[index, block] : m_pending) merge(*block);
+    if (m_group == 1) {
+        for (auto &[index, block] : m_pending) merge(*block);
+        m_next += m_pending.size();
+    }
     m_pending.clear();
+}
+
+size_t BlockMerger::merged() {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    return m_next;
 }
 
 size_t BlockMerger::finished() {
@@ -148,6 +171,107 @@ int render_thread_count(const RenderOptions &opts) {
     tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
     return arena.max_concurrency();
 }
+
+namespace {
+
+/// When a render stops early: the cancel flag is set, or `timeout` seconds (if > 0) have passed
+/// since `start`. Cheap enough to ask every few samples.
+struct StopCondition {
+    const std::atomic<bool> *cancel = nullptr;
+    double timeout = -1.0;
+    Clock::time_point start;
+    bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+    bool timed_out() const { return timeout > 0.0 && seconds_since(start) >= timeout; }
+    bool operator()() const { return cancelled() || timed_out(); }
+};
+
+/// Runs units 0..count-1 like run_work_units(); a unit may return early (without its result)
+/// when `stop` says so. The progress line shows work_done / work_total, redrawn by a monitor
+/// thread (so it moves while long units run), which also says "stopping" at the first
+/// cancellation.
+WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondition &stop,
+                       const std::atomic<uint64_t> &work_done, uint64_t work_total,
+                       const std::function<std::function<void(size_t)>()> &make_worker) {
+    if (opts.threads < 0)
+        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
+    const auto start = Clock::now();
+    std::unique_ptr<tbb::global_control> allow;
+    if (opts.threads > 0)
+        allow = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      size_t(opts.threads));
+    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
+    const int workers = arena.max_concurrency();
+
+    ProgressLine progress(opts.progress);
+    std::atomic<size_t> next_unit{0};
+    std::atomic<bool> cancelled{false}, timed_out{false};
+
+    std::mutex monitor_mutex;
+    std::condition_variable monitor_cv;
+    bool finished = false, announced = false;
+    auto announce_stop = [&] {
+        // Under monitor_mutex. The line ends the progress line; the render stops within
+        // moments, keeping the passes finished so far.
+        if (announced) return;
+        announced = true;
+        std::fputs(progress.drawn() ? "\nfacet: stopping...\n" : "facet: stopping...\n", stderr);
+        std::fflush(stderr);
+    };
+    std::thread monitor([&] {
+        std::unique_lock<std::mutex> lock(monitor_mutex);
+        while (
+            !monitor_cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return finished; })) {
+            if (stop.cancelled()) announce_stop();
+            if (!announced) progress.update(work_done.load(), work_total, seconds_since(start));
+        }
+    });
+
+    auto worker = [&](int) {
+        ScopedFlushToZero ftz;
+        std::function<void(size_t)> run = make_worker();
+        for (;;) {
+            if (stop.cancelled()) {
+                cancelled = true;
+                return;
+            }
+            if (stop.timed_out()) {
+                timed_out = true;
+                return;
+            }
+            const size_t index = next_unit.fetch_add(1);
+            if (index >= count) return;
+            run(index);
+        }
+    };
+    try {
+        arena.execute([&] { tbb::parallel_for(0, workers, worker, tbb::simple_partitioner()); });
+    } catch (...) {
+        {
+            std::lock_guard<std::mutex> lock(monitor_mutex);
+            finished = true;
+        }
+        monitor_cv.notify_all();
+        monitor.join();
+        throw;
+    }
+
+    WorkUnitsRun run;
+    run.seconds = seconds_since(start);
+    run.cancelled = cancelled || stop.cancelled();
+    run.timed_out = !run.cancelled && (timed_out || stop.timed_out());
+    {
+        std::lock_guard<std::mutex> lock(monitor_mutex);
+        finished = true;
+        if (run.cancelled) announce_stop();
+        if (!announced) progress.update(work_done.load(), work_total, run.seconds, true);
+    }
+    monitor_cv.notify_all();
+    monitor.join();
+    if (!announced) progress.finish();
+    return run;
+}
+
+} // namespace
 
 WorkUnitsRun run_work_units(size_t count, const RenderOptions &opts, double timeout,
                             const std::function<std::function<size_t(size_t)>()> &make_worker) {
@@ -298,12 +422,9 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
     base_sampler->set_sample_count(range.total);
     base_sampler->seed(0);
     const uint32_t spp = range.count;
-    const uint32_t spp_per_pass =
-        m_samples_per_pass > 0 ? std::min(m_samples_per_pass, spp) : std::max(spp, 1u);
-    if (spp % spp_per_pass != 0)
+    if (m_samples_per_pass > 0 && spp % std::min(m_samples_per_pass, spp) != 0)
         FACET_THROW("the sample count ({}) must be a multiple of samples_per_pass ({})", spp,
-                    spp_per_pass);
-    const uint32_t passes = spp / spp_per_pass;
+                    m_samples_per_pass);
     const uint64_t seed = opts.seed + proto_sampler.base_seed();
     const std::vector<std::string> aov_names = this->aov_names();
     const int aov_count = int(aov_names.size());
@@ -311,6 +432,30 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
 
     const Point2i film_size = film.size(), crop_offset = film.crop_offset(),
                   crop_size = film.crop_size();
+    const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
+
+    // Progressive rendering: the samples are taken in passes over the whole image, and the film
+    // only ever holds whole passes, so a render stopped at any moment has every pixel at the
+    // same spp. Without samples_per_pass the passes take 1, 1, 2, 4, ... samples, at most
+    // about 2^18 samples over the film each (a power of two): early stops keep a useful image
+    // and a stop throws away at most one pass. The schedule depends only on the film size and
+    // the part's samples, never on the crop or the thread count.
+    std::vector<uint32_t> pass_start; // pass p takes samples [pass_start[p], pass_start[p + 1])
+    {
+        uint32_t cap = 1;
+        while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
+        uint32_t next = 0, size = 1;
+        while (next < spp) {
+            pass_start.push_back(next);
+            const uint32_t take =
+                m_samples_per_pass > 0 ? std::min(m_samples_per_pass, spp) : std::min(size, cap);
+            next += std::min(take, spp - next);
+            if (next > 1) size = std::min(cap, size * 2);
+        }
+        pass_start.push_back(spp);
+    }
+    const size_t passes = pass_start.size() - 1;
+
     const int border = ImageBlock::border_for(film.rfilter());
     // The pixels whose samples reach the crop window through the filter are sampled, in blocks
     // of the grid of the whole film: a crop's pixels receive the same samples, in the same
@@ -322,27 +467,29 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
     const int blocks_x = (rx1 + bs - 1) / bs - gx0, blocks_y = (ry1 + bs - 1) / bs - gy0;
     const size_t blocks = size_t(blocks_x) * size_t(blocks_y);
     const size_t total = blocks * passes;
+    const uint64_t sampled_pixels = uint64_t(rx1 - rx0) * uint64_t(ry1 - ry0);
     const ReconstructionFilter &filter = film.rfilter();
     const bool needs_aperture = sensor.needs_aperture_sample();
     const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
 
-    FACET_LOG(Info, "Starting render job ({}x{}, {} samples{}{}, {} threads)", crop_size.x,
-              crop_size.y, spp, passes > 1 ? fmt::format(" in {} passes", passes) : "",
+    FACET_LOG(Info, "Starting render job ({}x{}, {} samples in {} pass{}{}, {} threads)",
+              crop_size.x, crop_size.y, spp, passes, passes == 1 ? "" : "es",
               opts.pass_count > 1 ? fmt::format(", part {} of {}", opts.pass_index, opts.pass_count)
                                   : "",
               render_thread_count(opts));
     if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
 
-    BlockMerger merger(film);
-    std::atomic<uint64_t> samples_taken{0}, invalid_samples{0};
+    StopCondition stop{opts.cancel, m_timeout, start};
+    BlockMerger merger(film, /*splat=*/false, blocks);
+    std::atomic<uint64_t> samples_done{0}, invalid_samples{0};
     std::atomic<uint64_t> first_invalid_pixel{UINT64_MAX};
 
     // Unit `index` is block index % blocks of pass index / blocks; blocks are in scanline order.
-    auto make_worker = [&]() -> std::function<size_t(size_t)> {
+    auto make_worker = [&]() -> std::function<void(size_t)> {
         auto sampler = std::shared_ptr<Sampler>(base_sampler->clone());
         auto aovs = std::make_shared<std::vector<float>>(size_t(aov_count) + 1, 0.f);
-        return [&, sampler, aovs](size_t index) -> size_t {
-            const uint32_t pass = uint32_t(index / blocks);
+        return [&, sampler, aovs](size_t index) {
+            const size_t pass = index / blocks;
             const size_t block_index = index % blocks;
             const int bx = gx0 + int(block_index % size_t(blocks_x)),
                       by = gy0 + int(block_index / size_t(blocks_x));
@@ -353,14 +500,24 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
             block->reset(offset, size, border, aov_count);
             const int x0 = std::max(offset.x, rx0), x1 = std::min(offset.x + size.x, rx1);
             const int y0 = std::max(offset.y, ry0), y1 = std::min(offset.y + size.y, ry1);
-            const uint32_t first = range.first + pass * spp_per_pass, last = first + spp_per_pass;
+            const uint32_t first = range.first + pass_start[pass],
+                           last = range.first + pass_start[pass + 1];
 
             uint64_t invalid = 0;
+            uint32_t until_check = 1;
             for (int y = y0; y < y1; ++y) {
                 for (int x = x0; x < x1; ++x) {
                     const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
                     sampler->seed(sample_stream_seed(seed, pixel_index));
                     for (uint32_t s = first; s < last; ++s) {
+                        // A stop abandons the unit (its pass is incomplete and is dropped).
+                        if (--until_check == 0) {
+                            until_check = 16;
+                            if (stop()) {
+                                merger.release(std::move(block));
+                                return;
+                            }
+                        }
                         sampler->set_sample_index(s);
                         const Point2f u = sampler->next_2d();
                         const Point2f pos(float(x) + u.x, float(y) + u.y);
@@ -386,34 +543,37 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                         block->put(pos, L, aovs->data(), filter);
                     }
                 }
+                samples_done.fetch_add(uint64_t(x1 - x0) * (last - first),
+                                       std::memory_order_relaxed);
             }
-            samples_taken +=
-                uint64_t(std::max(0, x1 - x0)) * uint64_t(std::max(0, y1 - y0)) * spp_per_pass;
             invalid_samples += invalid;
-            return merger.submit(index, std::move(block));
+            merger.submit(index, std::move(block));
         };
     };
-    WorkUnitsRun run = run_work_units(total, opts, m_timeout, make_worker);
+    WorkUnitsRun run =
+        run_units(total, opts, stop, samples_done, sampled_pixels * spp, make_worker);
     merger.flush();
 
     RenderResult result;
+    const size_t passes_done = merger.merged() / std::max<size_t>(blocks, 1);
     result.blocks_total = total;
-    result.blocks_done = merger.finished();
-    result.cancelled = (run.cancelled || run.timed_out) && result.blocks_done < total;
-    result.timed_out = run.timed_out && result.blocks_done < total;
-    result.samples = samples_taken.load();
+    result.blocks_done = merger.merged();
+    result.cancelled = passes_done < passes;
+    result.timed_out = result.cancelled && run.timed_out;
     result.spp_target = spp;
-    result.spp = result.cancelled
-                     ? uint32_t(result.blocks_done / std::max<size_t>(blocks, 1)) * spp_per_pass
-                     : spp;
+    result.spp = pass_start[passes_done];
+    result.samples = sampled_pixels * result.spp;
     result.sample_offset = range.first;
     result.spp_total = range.total;
-    result.seconds = seconds_since(start);
-    if (result.timed_out)
-        FACET_LOG(Warn, "Timeout of {:.2f}s reached after {} of {} blocks", m_timeout,
-                  result.blocks_done, total);
-    else if (result.cancelled)
-        FACET_LOG(Warn, "Rendering cancelled after {} of {} blocks", result.blocks_done, total);
+    if (result.cancelled) {
+        const std::string what = fmt::format(
+            "after {} of {} passes: the image has {} of {} samples per pixel{}", passes_done,
+            passes, result.spp, spp, result.spp == 0 ? " (no pass was finished: it is black)" : "");
+        if (result.timed_out)
+            FACET_LOG(Warn, "Timeout of {:.2f}s reached {}", m_timeout, what);
+        else
+            FACET_LOG(Warn, "Rendering stopped {}", what);
+    }
     if (invalid_samples > 0) {
         uint64_t p = first_invalid_pixel.load();
         FACET_LOG(Warn,
@@ -422,6 +582,7 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                   invalid_samples.load(), p % uint64_t(film_size.x), p / uint64_t(film_size.x));
     }
     result.image = film.develop();
+    result.seconds = seconds_since(start);
     return result;
 }
 
@@ -502,10 +663,12 @@ std::string scene_identity(const std::string &scene_text,
 namespace {
 
 std::atomic<bool> *g_interrupt_flag = nullptr;
-struct sigaction g_old_sigint, g_old_sighup;
+volatile sig_atomic_t g_interrupt_signal = 0;
+struct sigaction g_old_sigint, g_old_sighup, g_old_sigterm;
 bool g_handler_installed = false;
 
 extern "C" void facet_interrupt_handler(int sig) {
+    g_interrupt_signal = sig;
     if (g_interrupt_flag) g_interrupt_flag->store(true);
     // A second signal of the same kind takes the default action, so the user can force quit.
     struct sigaction dfl;
@@ -527,13 +690,18 @@ void install_interrupt_handler(std::atomic<bool> *flag) {
     sa.sa_flags = SA_RESTART;
     sigaction(SIGINT, &sa, &g_old_sigint);
     sigaction(SIGHUP, &sa, &g_old_sighup);
+    sigaction(SIGTERM, &sa, &g_old_sigterm);
+    g_interrupt_signal = 0;
     g_handler_installed = true;
 }
+
+int interrupt_signal() { return int(g_interrupt_signal); }
 
 void uninstall_interrupt_handler() {
     if (!g_handler_installed) return;
     sigaction(SIGINT, &g_old_sigint, nullptr);
     sigaction(SIGHUP, &g_old_sighup, nullptr);
+    sigaction(SIGTERM, &g_old_sigterm, nullptr);
     g_interrupt_flag = nullptr;
     g_handler_installed = false;
 }

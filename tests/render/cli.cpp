@@ -360,12 +360,21 @@ TEST_F(CliTest, BadCropOrPassIsOneLineError) {
     EXPECT_NE(line.find("--passes"), std::string::npos) << line;
 }
 
-TEST_F(CliTest, InterruptWritesThePartialImage) {
-    // Far too many samples to finish: about 2·10⁹ camera samples in small blocks.
-    fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
-    std::string scene = (m_dir / "scene.xml").string(), image = (m_dir / "long.exr").string();
-    std::vector<std::string> args = {FACET,     "render", scene, "-D", "res=2048", "-D",
-                                     "spp=512", "-t",     "2",   "-o", image};
+/// Starts `facet render scene.xml -D res=<res> -D spp=<spp> -t 2 -o <image>`, waits until it
+/// renders, lets it run for `run_for`, sends `sig` and waits for it to exit. Returns the exit
+/// status, the seconds from the signal to the exit and stderr.
+struct Stopped {
+    int status = 0;
+    double stop_seconds = 0.0;
+    std::string err;
+};
+
+Stopped render_and_stop(const fs::path &dir, const std::string &image, int sig,
+                        std::chrono::milliseconds run_for) {
+    fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+    std::string scene = (dir / "scene.xml").string();
+    std::vector<std::string> args = {FACET,         "render", scene, "-D", "res=192", "-D",
+                                     "spp=1000000", "-t",     "2",   "-o", image};
     std::vector<char *> argv;
     for (auto &a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -374,7 +383,11 @@ TEST_F(CliTest, InterruptWritesThePartialImage) {
     posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, FACET.c_str(), &actions, nullptr, argv.data(), environ), 0);
+    Stopped result;
+    if (posix_spawn(&pid, FACET.c_str(), &actions, nullptr, argv.data(), environ) != 0) {
+        ADD_FAILURE() << "cannot start facet";
+        return result;
+    }
     posix_spawn_file_actions_destroy(&actions);
 
     using clock = std::chrono::steady_clock;
@@ -383,35 +396,66 @@ TEST_F(CliTest, InterruptWritesThePartialImage) {
     while (read_file(out).find("Rendering") == std::string::npos &&
            clock::now() - start < std::chrono::seconds(120))
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    std::this_thread::sleep_for(std::chrono::seconds(1));
-    ASSERT_EQ(kill(pid, SIGINT), 0);
+    std::this_thread::sleep_for(run_for);
+    EXPECT_EQ(kill(pid, sig), 0);
 
-    int status = 0;
     auto sent = clock::now();
-    while (waitpid(pid, &status, WNOHANG) == 0) {
+    while (waitpid(pid, &result.status, WNOHANG) == 0) {
         if (clock::now() - sent > std::chrono::seconds(60)) {
             kill(pid, SIGKILL);
-            waitpid(pid, &status, 0);
-            FAIL() << "facet did not stop within 60 s of SIGINT";
+            waitpid(pid, &result.status, 0);
+            ADD_FAILURE() << "facet did not stop within 60 s of the signal";
+            break;
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    ASSERT_TRUE(WIFEXITED(status)) << "facet died from a signal";
-    EXPECT_EQ(WEXITSTATUS(status), 130);
-    std::string errors = read_file(err);
-    EXPECT_NE(errors.find("partial"), std::string::npos) << errors;
+    result.stop_seconds = std::chrono::duration<double>(clock::now() - sent).count();
+    result.err = read_file(err);
+    fs::remove(out);
+    fs::remove(err);
+    return result;
+}
+
+/// Every pixel of a render of the tiny scene is lit (the sphere or the sky behind it).
+size_t black_pixels(const facet::Image &img) {
+    size_t black = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) black += img.at(x, y, 2) > 0.f ? 0 : 1;
+    return black;
+}
+
+TEST_F(CliTest, InterruptWritesTheWholeImageAtTheSppReached) {
+    // A million samples per pixel: far too many to finish. Ctrl-C keeps the passes done.
+    const std::string image = (m_dir / "long.exr").string();
+    Stopped r = render_and_stop(m_dir, image, SIGINT, std::chrono::milliseconds(2500));
+    ASSERT_TRUE(WIFEXITED(r.status)) << "facet died from a signal";
+    EXPECT_EQ(WEXITSTATUS(r.status), 130);
+    EXPECT_LT(r.stop_seconds, 1.0) << "the stop took too long";
+    EXPECT_NE(r.err.find("stopping"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("partial"), std::string::npos) << r.err;
 
     ASSERT_TRUE(fs::exists(image));
     facet::Image img = facet::read_image(image);
-    EXPECT_EQ(img.width, 2048);
-    size_t lit = 0, black = 0;
-    for (int y = 0; y < img.height; y += 16)
-        for (int x = 0; x < img.width; x += 16) (img.at(x, y, 0) > 0.f ? lit : black)++;
-    EXPECT_GT(lit, 0u) << "nothing was rendered";
-    EXPECT_GT(black, 0u) << "the render was not interrupted";
-    fs::remove(out);
-    fs::remove(err);
+    EXPECT_EQ(img.width, 192);
+    EXPECT_EQ(black_pixels(img), 0u) << "a stopped render covers the whole image";
+    const int spp = std::stoi(attribute(image, "facet:spp"));
+    EXPECT_GE(spp, 1);
+    EXPECT_LT(spp, 1000000);
+    EXPECT_EQ(attribute(image, "facet:spp_target"), "1000000");
     EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", "long.exr"}));
+}
+
+TEST_F(CliTest, TerminateWritesTheWholeImageToo) {
+    // `timeout 10 facet render ...` sends SIGTERM.
+    const std::string image = (m_dir / "term.exr").string();
+    Stopped r = render_and_stop(m_dir, image, SIGTERM, std::chrono::milliseconds(2500));
+    ASSERT_TRUE(WIFEXITED(r.status)) << "facet died from a signal";
+    EXPECT_EQ(WEXITSTATUS(r.status), 128 + SIGTERM);
+    EXPECT_LT(r.stop_seconds, 1.0) << "the stop took too long";
+    EXPECT_NE(r.err.find("terminated"), std::string::npos) << r.err;
+    ASSERT_TRUE(fs::exists(image));
+    EXPECT_EQ(black_pixels(facet::read_image(image)), 0u);
+    EXPECT_GE(std::stoi(attribute(image, "facet:spp")), 1);
 }
 
 } // namespace

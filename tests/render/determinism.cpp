@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstring>
@@ -125,13 +126,16 @@ const PluginDescriptor *invalid_samples_descriptor() {
     return &desc;
 }
 
-/// Test integrator that raises a cancel flag the first time it runs, and returns radiance 1.
+/// Test integrator that raises a cancel flag at the first sample whose index is at least
+/// g_cancel_at_sample, and returns radiance 1.
 std::atomic<bool> *g_cancel_flag = nullptr;
+uint32_t g_cancel_at_sample = 0;
 class CancellingIntegrator final : public SamplingIntegrator {
 public:
     explicit CancellingIntegrator(const Properties &) {}
-    Color3f sample(const Scene &, Sampler &, const Ray &, float *) const override {
-        if (g_cancel_flag) g_cancel_flag->store(true);
+    Color3f sample(const Scene &, Sampler &sampler, const Ray &, float *) const override {
+        if (g_cancel_flag && sampler.sample_index() >= g_cancel_at_sample)
+            g_cancel_flag->store(true);
         return Color3f(1.f);
     }
 };
@@ -175,15 +179,18 @@ TEST(RenderLoop, BitIdenticalForAnyThreadCount) {
     auto scene = load_temp_scene("threads", scene_xml(PATH, 32, 16, ""));
     RenderResult one = render_with(*scene, 1);
     RenderResult two = render_with(*scene, 2);
+    RenderResult three = render_with(*scene, 3);
     RenderResult four = render_with(*scene, 4);
     ASSERT_EQ(one.image.width, 32);
     ASSERT_EQ(one.image.height, 32);
     ASSERT_EQ(one.image.channels, 3);
-    EXPECT_EQ(one.blocks_total, 16u);
-    EXPECT_EQ(one.blocks_done, 16u);
+    EXPECT_EQ(one.blocks_total, 16u * 5u); // 16 blocks x passes of 1, 1, 2, 4 and 8 samples
+    EXPECT_EQ(one.blocks_done, 16u * 5u);
+    EXPECT_EQ(one.spp, 16u);
     EXPECT_FALSE(one.cancelled);
     EXPECT_EQ(one.samples, 32u * 32u * 16u);
     EXPECT_TRUE(identical(one.image, two.image));
+    EXPECT_TRUE(identical(one.image, three.image));
     EXPECT_TRUE(identical(one.image, four.image));
 
     // Not a trivially constant image: lit and unlit parts, all finite and non-negative.
@@ -263,10 +270,10 @@ TEST(RenderLoop, InvalidSamplesAreDroppedAndAovsDeveloped) {
     EXPECT_GT(r.image.at(4, 4, 4), r.image.at(0, 0, 4));
 }
 
-TEST(RenderLoop, CancelFinishesTheBlockInFlight) {
+TEST(RenderLoop, CancelAbandonsThePassInFlight) {
     PluginRegistry::instance().register_static(cancelling_descriptor());
     auto scene = load_temp_scene("cancel_mid", scene_xml("<integrator type=\"test_cancelling\"/>",
-                                                         8, 2, "<rfilter type=\"box\"/>"));
+                                                         8, 4, "<rfilter type=\"box\"/>"));
     std::atomic<bool> cancel{false};
     g_cancel_flag = &cancel;
     RenderOptions opts;
@@ -274,16 +281,28 @@ TEST(RenderLoop, CancelFinishesTheBlockInFlight) {
     opts.block_size = 4;
     opts.progress = false;
     opts.cancel = &cancel;
+    // Cancelled at the first sample: the first pass is abandoned, nothing reaches the film.
+    g_cancel_at_sample = 0;
     RenderResult r = render(*scene, *scene->sensors().at(0), opts);
-    g_cancel_flag = nullptr;
-    // The first block (pixels 0-3 of rows 0-3) is finished and merged, the other three are not.
     EXPECT_TRUE(r.cancelled);
-    EXPECT_EQ(r.blocks_total, 4u);
-    EXPECT_EQ(r.blocks_done, 1u);
-    EXPECT_EQ(r.samples, 4u * 4u * 2u);
+    EXPECT_EQ(r.blocks_total, 4u * 3u); // passes of 1, 1 and 2 samples
+    EXPECT_EQ(r.blocks_done, 0u);
+    EXPECT_EQ(r.spp, 0u);
+    EXPECT_EQ(r.spp_target, 4u);
+    EXPECT_EQ(r.samples, 0u);
+    for (float v : r.image.data) EXPECT_EQ(v, 0.f);
+    // Cancelled in the first block of the second pass: the image is the whole first pass,
+    // every pixel at 1 spp (the blocks of the second pass done by then are not kept).
+    cancel = false;
+    g_cancel_at_sample = 1;
+    r = render(*scene, *scene->sensors().at(0), opts);
+    g_cancel_flag = nullptr;
+    EXPECT_TRUE(r.cancelled);
+    EXPECT_EQ(r.blocks_done, 4u);
+    EXPECT_EQ(r.spp, 1u);
+    EXPECT_EQ(r.samples, 8u * 8u);
     for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x)
-            EXPECT_EQ(r.image.at(x, y, 0), (x < 4 && y < 4) ? 1.f : 0.f) << x << "," << y;
+        for (int x = 0; x < 8; ++x) EXPECT_EQ(r.image.at(x, y, 0), 1.f) << x << "," << y;
 }
 
 TEST(RenderLoop, InterruptHandlerSetsTheFlagOnce) {
@@ -306,27 +325,70 @@ TEST(RenderLoop, InterruptHandlerSetsTheFlagOnce) {
     EXPECT_EQ(now.sa_handler, before.sa_handler);
 }
 
-TEST(RenderLoop, TimeoutDevelopsWhatIsDone) {
+TEST(RenderLoop, TimeoutDevelopsTheWholePassesDone) {
     PluginRegistry::instance().register_static(slow_descriptor());
-    // 8x8 pixels in four 4x4 blocks of 16 pixels x 2 samples x 2 ms: 64 ms per block.
+    // 4x4 pixels x 2 ms per sample: a pass takes 32 ms per sample per pixel, so after 0.3 s
+    // some passes are done (1 + 1 + 2 + 4 spp take ~0.26 s) and far from all 1024 spp. The
+    // only block is 64 x 64 pixels: the stop must come from inside it.
     auto scene = load_temp_scene(
-        "timeout", scene_xml(R"(<integrator type="test_slow"><float name="timeout" value="0.03"/>
-                                <integer name="block_size" value="4"/></integrator>)",
-                             8, 2, "<rfilter type=\"box\"/>"));
+        "timeout", scene_xml(R"(<integrator type="test_slow"><float name="timeout" value="0.3"/>
+                                <integer name="block_size" value="64"/></integrator>)",
+                             4, 1024, "<rfilter type=\"box\"/>"));
     RenderOptions opts;
     opts.threads = 1;
     opts.progress = false;
     RenderResult r = render(*scene, *scene->sensors().at(0), opts);
-    // The first block starts before the timeout and is finished; no other one starts.
     EXPECT_TRUE(r.timed_out);
     EXPECT_TRUE(r.cancelled);
-    EXPECT_EQ(r.blocks_total, 4u);
-    EXPECT_EQ(r.blocks_done, 1u);
-    EXPECT_LT(r.seconds, 1.0); // four blocks would take 0.26 s
-    ASSERT_EQ(r.image.width, 8);
-    for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x)
-            EXPECT_EQ(r.image.at(x, y, 0), (x < 4 && y < 4) ? 1.f : 0.f) << x << "," << y;
+    EXPECT_LT(r.seconds, 0.3 + 1.0);
+    EXPECT_GE(r.spp, 1u);
+    EXPECT_LT(r.spp, 1024u);
+    EXPECT_EQ(r.spp_target, 1024u);
+    EXPECT_EQ(r.samples, 16u * r.spp);
+    // A whole number of passes: 1, 2, 4, 8, ... samples per pixel, on every pixel.
+    EXPECT_EQ(r.spp & (r.spp - 1), 0u) << r.spp;
+    ASSERT_EQ(r.image.width, 4);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) EXPECT_EQ(r.image.at(x, y, 0), 1.f) << x << "," << y;
+}
+
+TEST(RenderLoop, LargeRenderStopsWithinASecondOfTheTimeout) {
+    auto scene = load_temp_scene(
+        "stop", scene_xml(R"(<integrator type="path"><float name="timeout" value="1"/>
+                             <integer name="block_size" value="256"/></integrator>)",
+                          96, 1000000, ""));
+    RenderOptions opts;
+    opts.threads = 2;
+    opts.progress = false;
+    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
+    EXPECT_TRUE(r.timed_out);
+    EXPECT_LT(r.seconds, 1.0 + 1.0);
+    EXPECT_GE(r.seconds, 1.0);
+    ASSERT_GE(r.spp, 1u) << "not one pass in a second";
+    // Full coverage: every pixel sees the lit scene or the sky.
+    for (int y = 0; y < 96; ++y)
+        for (int x = 0; x < 96; ++x) ASSERT_GT(r.image.at(x, y, 2), 0.f) << x << "," << y;
+}
+
+TEST(RenderLoop, ProgressiveRenderIsDeterministicAndConverges) {
+    // The same image for any thread count, and the passes build up the same picture as a
+    // render in one pass of all samples (samples_per_pass = spp).
+    auto progressive = load_temp_scene("prog", scene_xml(PATH, 24, 37, "<rfilter type=\"box\"/>"));
+    RenderResult a = render_with(*progressive, 1, 0, 5), b = render_with(*progressive, 2, 0, 5);
+    EXPECT_TRUE(identical(a.image, b.image));
+    EXPECT_EQ(a.spp, 37u);
+    auto one_pass = load_temp_scene(
+        "onepass", scene_xml(R"(<integrator type="path"><integer name="max_depth" value="6"/>
+                     <integer name="samples_per_pass" value="37"/></integrator>)",
+                             24, 37, "<rfilter type=\"box\"/>"));
+    RenderResult c = render_with(*one_pass, 2, 0, 5);
+    EXPECT_EQ(c.blocks_total, 25u);
+    // The same samples in other groups: equal to float rounding.
+    double max_rel = 0.0;
+    for (size_t i = 0; i < a.image.data.size(); ++i)
+        max_rel = std::max(max_rel, std::abs(double(a.image.data[i]) - c.image.data[i]) /
+                                        std::max(1e-3, double(c.image.data[i])));
+    EXPECT_LT(max_rel, 2e-6);
 }
 
 TEST(RenderLoop, BlockSizeParameterIsHonouredAndDoesNotChangeTheImage) {
@@ -341,11 +403,11 @@ TEST(RenderLoop, BlockSizeParameterIsHonouredAndDoesNotChangeTheImage) {
     };
     auto s5 = with_block(5), s0 = with_block(0);
     RenderResult a = render_with(*s5, 2, 0, /*block_size=*/0); // the integrator's block_size
-    EXPECT_EQ(a.blocks_total, 25u);                            // ceil(24 / 5)^2
-    RenderResult b = render_with(*s0, 2, 0, 0);                // 0: 32, one block
-    EXPECT_EQ(b.blocks_total, 1u);
+    EXPECT_EQ(a.blocks_total, 25u * 3u);        // ceil(24 / 5)^2 blocks x passes of 1, 1, 2 spp
+    RenderResult b = render_with(*s0, 2, 0, 0); // 0: 32, one block
+    EXPECT_EQ(b.blocks_total, 1u * 3u);
     RenderResult c = render_with(*s5, 2, 0, 7); // RenderOptions override the parameter
-    EXPECT_EQ(c.blocks_total, 16u);
+    EXPECT_EQ(c.blocks_total, 16u * 3u);
     EXPECT_TRUE(identical(a.image, b.image));
     EXPECT_TRUE(identical(a.image, c.image));
     EXPECT_THROW(with_block(-1), Error);

@@ -25,13 +25,16 @@ public:
                                 const RenderOptions &opts) const;
 };
 
-/// Integrators that estimate the radiance along camera rays independently. render() splits the
-/// crop window into square blocks (and the samples into passes) and renders them on all threads.
+/// Integrators that estimate the radiance along camera rays independently. render() is
+/// progressive: it takes the samples in passes over the whole crop window (1, 1, 2, 4, ...
+/// samples per pixel, or samples_per_pass each), each pass in square blocks on all threads, and
+/// the film only receives whole passes. A stop (cancel flag, timeout) abandons the pass in
+/// flight within moments and develops the passes done: every pixel has the same spp.
 ///
-/// Determinism rule: every pixel's sample stream is seeded from (seed, pixel index, pass), and
-/// blocks are merged into the film in (pass, block) order, so the image does not depend on the
-/// thread count; nor, with a filter whose footprint stays inside one pixel (box), on the block
-/// size.
+/// Determinism rule: sample i of a pixel is seeded from (seed, pixel index, i) alone, the pass
+/// schedule depends only on the film size and the sample count, and blocks are merged into the
+/// film in (pass, block) order, so the image does not depend on the thread count; nor, with a
+/// filter whose footprint stays inside one pixel (box), on the block size.
 ///
 /// Parameters read here (every sampling integrator lists them in its table):
 /// | timeout | float | -1 | Stop after this many seconds (develop what is done); <= 0: none |

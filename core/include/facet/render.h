@@ -25,7 +25,8 @@ struct RenderOptions {
     /// `block_size` parameter (32 when that is 0 too).
     int block_size = 0;
     bool progress = true; ///< progress line on a terminal (never when stderr is not a tty)
-    /// Set to true (e.g. by a signal handler) to stop after the work units in flight.
+    /// Set to true (e.g. by a signal handler) to stop within moments: a sampling integrator
+    /// keeps the passes over the image finished so far (see RenderResult::spp).
     std::atomic<bool> *cancel = nullptr;
     /// Film pixels [x0, x1) x [y0, y1) to render, as {x0, y0, x1, y1}, instead of the film's crop
     /// window (validated against the film). The developed image is that window of the film (an
@@ -66,8 +67,8 @@ struct RenderResult {
     int film_width = 0, film_height = 0;
     bool cancelled = false; ///< stopped early by the cancel flag (Ctrl-C) or the timeout
     bool timed_out = false; ///< stopped early by the integrator's `timeout`
-    /// Work units finished and in total: image blocks (times passes) of a sampling integrator,
-    /// light-path batches of a light tracer.
+    /// Work units in the image and in total: image blocks times passes of a sampling integrator
+    /// (whole passes only), light-path batches of a light tracer.
     size_t blocks_done = 0, blocks_total = 0;
     uint64_t samples = 0; ///< camera samples (or light paths) taken
 };
@@ -89,9 +90,12 @@ std::string scene_identity(const std::string &scene_text,
                            const std::map<std::string, std::string> &params, int film_width,
                            int film_height);
 
-/// Installs SIGINT/SIGHUP handlers that set `flag` (restored by uninstall_interrupt_handler).
+/// Installs SIGINT/SIGHUP/SIGTERM handlers that set `flag` (restored by
+/// uninstall_interrupt_handler). A second signal of the same kind takes its default action.
 void install_interrupt_handler(std::atomic<bool> *flag);
 void uninstall_interrupt_handler();
+/// The signal that set the flag since install_interrupt_handler() (0: none).
+int interrupt_signal();
 
 // ---------------------------------------------------------------------------------------------
 // Building blocks of integrators' render loops
@@ -104,16 +108,23 @@ uint64_t sample_stream_seed(uint64_t seed, uint64_t index);
 /// through Film::put_splats(), the others through Film::put_block().
 class BlockMerger {
 public:
-    BlockMerger(Film &film, bool splat = false);
+    /// With `group` > 1 the blocks are merged only in whole groups [g·group, (g+1)·group) (the
+    /// blocks of one pass over the image), so the film only ever holds whole passes.
+    BlockMerger(Film &film, bool splat = false, size_t group = 1);
     ~BlockMerger();
     std::unique_ptr<ImageBlock> acquire();
     /// Hands in block `index` (each index in [0, n) exactly once, or not at all after a
     /// cancellation); merges every block that is now next in order. Returns the number of blocks
     /// handed in so far.
     size_t submit(size_t index, std::unique_ptr<ImageBlock> block);
-    /// After a cancelled render: merges what is left, still in index order (gaps are skipped).
+    /// Takes back a block that is not handed in (a unit abandoned by a stop).
+    void release(std::unique_ptr<ImageBlock> block);
+    /// After a cancelled render: merges what is left, still in index order (gaps are skipped);
+    /// with groups, the blocks of incomplete groups are dropped instead.
     void flush();
     size_t finished();
+    /// Number of blocks merged into the film (whole groups only, with groups).
+    size_t merged();
 
 private:
     void merge(const ImageBlock &block);
@@ -122,6 +133,7 @@ private:
     std::mutex m_mutex;
     std::map<size_t, std::unique_ptr<ImageBlock>> m_pending;
     std::vector<std::unique_ptr<ImageBlock>> m_free;
+    size_t m_group = 1;
     size_t m_next = 0, m_finished = 0;
 };
 
