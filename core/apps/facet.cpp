@@ -5,7 +5,10 @@
 #include <facet/logger.h>
 
 #include <CLI/CLI.hpp>
+#include <OpenImageIO/oiioversion.h>
+#include <embree3/rtcore_config.h>
 #include <fmt/format.h>
+#include <tbb/version.h>
 
 #include <cstdio>
 #include <cstring>
@@ -27,7 +30,8 @@ Usage:
                                        chi-square test of a plugin's sampling against its pdf
   facet new-plugin ...                 start a plugin of your own from the template
 
-Run `facet <command> --help` for the options of a command.
+Run `facet <command> --help` for the options of a command; `facet --version` prints the
+version.
 )";
 
 struct Command {
@@ -68,6 +72,11 @@ int run(int argc, char **argv) {
     std::string first = argv[1];
     if (first == "-h" || first == "--help" || first == "help") {
         std::fputs(USAGE, stdout);
+        return 0;
+    }
+    if (first == "--version" || first == "-V") {
+        std::printf("facet %s (Embree %s, OpenImageIO %s, oneTBB %d.%d)\n", FACET_VERSION,
+                    RTC_VERSION_STRING, OIIO_VERSION_STRING, TBB_VERSION_MAJOR, TBB_VERSION_MINOR);
         return 0;
     }
 

@@ -16,7 +16,9 @@
 #include <fmt/format.h>
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -136,8 +138,9 @@ int render_main(int argc, char **argv) {
                    "Output image (default: the scene's name with .exr); .png/.jpg are tone mapped "
                    "through OpenColorIO");
     app.add_option("--seed", seed, "Added to the sampler's seed (default 0)");
-    app.add_option("--spp", spp, "Samples per pixel (default: the sampler's sample_count)")
-        ->check(CLI::PositiveNumber);
+    app.add_option("--spp", spp,
+                   "Samples per pixel (default: the sampler's sample_count; samplers may round "
+                   "it, e.g. stratified to a square: the summary and the EXR say what was taken)");
     app.add_option("--crop", crop,
                    "Render only film pixels [X0, X1) x [Y0, Y1) (the EXR's data window inside "
                    "the full display window); pixels equal those of a full render")
@@ -153,8 +156,13 @@ int render_main(int argc, char **argv) {
                    "OpenColorIO config for 8-bit outputs (default: $OCIO, else facet's own)");
     app.add_option("--view", view, "OpenColorIO view for 8-bit outputs: Standard or Raw");
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (app.count("--spp") > 0 && spp < 1)
+        FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", spp);
 
+    const auto load_start = std::chrono::steady_clock::now();
     std::shared_ptr<Scene> scene = cli::load_scene(opts);
+    const double load_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     const auto &sensors = scene->sensors();
     if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
         FACET_THROW("-s {}: the scene has {} sensor{} (valid indices 0..{})", opts.sensor,
@@ -188,6 +196,12 @@ int render_main(int argc, char **argv) {
     std::atomic<bool> cancel{false};
     ropts.cancel = &cancel;
     const SampleRange range = render_sample_range(sensor, ropts);
+    const uint64_t asked = uint64_t(spp > 0 ? uint32_t(spp) : sensor.sampler().sample_count()) *
+                           uint64_t(ropts.pass_count);
+    // The sampler's rounding, said where the spp is printed.
+    const std::string rounding =
+        range.total != asked ? fmt::format(" (the sampler rounds {} up to {})", asked, range.total)
+                             : "";
     int threads = cli::effective_threads(opts.threads);
 
     std::string out = output_path(opts.scene, output, film);
@@ -208,11 +222,11 @@ int render_main(int argc, char **argv) {
     if (!opts.quiet) {
         const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
         const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
-        fmt::print("Rendering {}: {}x{} pixels{}, {} spp{}, {} thread{}\n", opts.scene, w, h,
+        fmt::print("Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", opts.scene, w, h,
                    crop.empty() ? ""
                                 : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1],
                                               crop[2], crop[3], film.size().x, film.size().y),
-                   range.count,
+                   range.count, rounding,
                    ropts.pass_count > 1
                        ? fmt::format(" (part {} of {}: samples {}..{} of {})", ropts.pass_index,
                                      ropts.pass_count, range.first, range.first + range.count - 1,
@@ -224,6 +238,7 @@ int render_main(int argc, char **argv) {
     RenderResult result;
     try {
         result = render(*scene, sensor, ropts);
+        result.load_seconds = load_seconds;
     } catch (...) {
         uninstall_interrupt_handler();
         throw;
@@ -241,7 +256,30 @@ int render_main(int argc, char **argv) {
     if (result.cancelled)
         wopts.metadata["facet:blocks"] =
             fmt::format("{}/{}", result.blocks_done, result.blocks_total);
+    const auto write_start = std::chrono::steady_clock::now();
     film.write(result.image, out, wopts);
+    const double write_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+    if (!opts.quiet) {
+        // The summary of where the time went (-v: every phase).
+        fmt::print("Times: load {} (acceleration structure {}), render {}\n",
+                   format_seconds(result.load_seconds), format_seconds(result.accel_seconds),
+                   format_seconds(result.seconds));
+        if (opts.verbose > 0) {
+            fmt::print("  scene file and plugins  {}\n",
+                       format_seconds(std::max(0.0, result.load_seconds - result.accel_seconds)));
+            fmt::print("  acceleration structure  {}\n", format_seconds(result.accel_seconds));
+            const double rate = result.sampling_seconds > 0.0
+                                    ? double(result.samples) / result.sampling_seconds
+                                    : 0.0;
+            fmt::print("  sampling                {} ({} of {} work units, {:.3g} samples/s)\n",
+                       format_seconds(result.sampling_seconds), result.blocks_done,
+                       result.blocks_total, rate);
+            fmt::print("  developing the film     {}\n", format_seconds(result.develop_seconds));
+            fmt::print("  writing the image       {}\n", format_seconds(write_seconds));
+        }
+        std::fflush(stdout);
+    }
 
     const std::string reached =
         fmt::format("{} of {} spp{}", result.spp, result.spp_target,

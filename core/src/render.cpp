@@ -581,7 +581,10 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                   "({}, {}))",
                   invalid_samples.load(), p % uint64_t(film_size.x), p / uint64_t(film_size.x));
     }
+    result.sampling_seconds = run.seconds;
+    const auto develop_start = Clock::now();
     result.image = film.develop();
+    result.develop_seconds = seconds_since(develop_start);
     result.seconds = seconds_since(start);
     return result;
 }
@@ -624,6 +627,8 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     result.crop = {{o.x, o.y, o.x + sz.x, o.y + sz.y}};
     result.film_width = film.size().x;
     result.film_height = film.size().y;
+    result.accel_seconds = scene.accel_build_seconds();
+    if (result.sampling_seconds == 0.0) result.sampling_seconds = result.seconds;
     return result;
 }
 

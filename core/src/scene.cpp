@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <pmmintrin.h>
 #include <vector>
@@ -174,6 +175,7 @@ Scene::Scene(const Properties &props) {
 
     m_device = facet::embree_device(); // the free function, not the accessor of the same name
     rtcRetainDevice(m_device);
+    const auto accel_start = std::chrono::steady_clock::now();
     m_rtc_scene = rtcNewScene(m_device);
     rtcSetSceneFlags(m_rtc_scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
@@ -188,6 +190,8 @@ Scene::Scene(const Properties &props) {
             m_bbox.expand(shape->bbox());
         }
         rtcCommitScene(m_rtc_scene);
+        m_accel_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - accel_start).count();
         RTCError err = rtcGetDeviceError(m_device);
         if (err != RTC_ERROR_NONE)
             FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));

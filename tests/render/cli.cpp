@@ -34,6 +34,7 @@ const std::string FACET = FACET_BINARY_DIR "/bin/facet";
 const char *TINY_SCENE = R"(<scene version="3.0.0">
     <default name="spp" value="4"/>
     <default name="res" value="32"/>
+    <default name="sampler" value="independent"/>
     <integrator type="path">
         <integer name="max_depth" value="4"/>
     </integrator>
@@ -42,7 +43,7 @@ const char *TINY_SCENE = R"(<scene version="3.0.0">
         <transform name="to_world">
             <lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/>
         </transform>
-        <sampler type="independent">
+        <sampler type="$sampler">
             <integer name="sample_count" value="$spp"/>
         </sampler>
         <film type="hdrfilm">
@@ -346,6 +347,43 @@ TEST_F(CliTest, CropAndPassWriteTheDataWindowAndWhatAMergeNeeds) {
         for (int x = 0; x < crop.width; ++x)
             for (int c = 0; c < 3; ++c)
                 ASSERT_EQ(crop.at(x, y, c), full.at(x + 4, y + 2, c)) << x << "," << y;
+}
+
+TEST_F(CliTest, SppIsTheNumberOfSamplesTaken) {
+    // stratified takes a square number of samples: 10 become 16, in the banner and the EXR.
+    Result r = run("render scene.xml -D sampler=stratified -D res=8 --spp 10 -o strat.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("16 spp (the sampler rounds 10 up to 16)"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("10 spp"), std::string::npos) << r.out;
+    EXPECT_EQ(attribute((m_dir / "strat.exr").string(), "facet:spp"), "16");
+    // The same through the scene's sample_count.
+    ASSERT_EQ(run("render scene.xml -q -D sampler=ldsampler -D res=8 -D spp=5 -o ld.exr").code, 0);
+    EXPECT_EQ(attribute((m_dir / "ld.exr").string(), "facet:spp"), "8");
+    // --spp 0 and negative counts: facet's own message, not the option parser's range text.
+    for (const char *bad : {"0", "-3"}) {
+        std::string line = expect_one_line_error(std::string("render scene.xml --spp ") + bad);
+        EXPECT_NE(line.find("at least 1"), std::string::npos) << line;
+        EXPECT_EQ(line.find("[0 - "), std::string::npos) << line;
+    }
+}
+
+TEST_F(CliTest, SummaryTimesAndVersion) {
+    Result r = run("render scene.xml -D res=8 -o t.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(std::regex_search(
+        r.out, std::regex(R"(Times: load [0-9.]+ s \(acceleration structure [0-9.]+ s\), render )"
+                          R"([0-9.]+ s)")))
+        << r.out;
+    EXPECT_EQ(r.out.find("writing the image"), std::string::npos) << r.out; // -v only
+    r = run("render scene.xml -v -D res=8 -o t.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char *phase : {"scene file and plugins", "acceleration structure", "sampling",
+                              "developing the film", "writing the image", "samples/s"})
+        EXPECT_NE(r.out.find(phase), std::string::npos) << phase << "\n" << r.out;
+    r = run("--version");
+    EXPECT_EQ(r.code, 0);
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(^facet [0-9]+\.[0-9]+\.[0-9]+ \(Embree )")))
+        << r.out;
 }
 
 TEST_F(CliTest, BadCropOrPassIsOneLineError) {

@@ -54,8 +54,12 @@ struct SampleRange {
 SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts);
 
 struct RenderResult {
-    Image image; ///< developed film (crop window), plus AOV channels
-    double seconds = 0.0;
+    Image image;          ///< developed film (crop window), plus AOV channels
+    double seconds = 0.0; ///< the render (sampling and developing the film)
+    /// Times of the phases, in seconds: loading the scene (filled in by whoever loaded it:
+    /// render() cannot know), building the acceleration structure (Scene::accel_build_seconds,
+    /// part of the load), sampling, and developing the film (parts of `seconds`).
+    double load_seconds = 0.0, accel_seconds = 0.0, sampling_seconds = 0.0, develop_seconds = 0.0;
     /// Samples per pixel in the image (of a stopped render: what was reached), and what the
     /// render was to take (after the sampler's rounding).
     uint32_t spp = 0, spp_target = 0;

@@ -61,6 +61,8 @@ public:
     const std::vector<std::shared_ptr<Sensor>> &sensors() const { return m_sensors; }
     std::shared_ptr<Integrator> integrator() const { return m_integrator; }
     const BoundingBox3f &bbox() const { return m_bbox; }
+    /// Seconds the acceleration structure (the Embree scene) took to build.
+    double accel_build_seconds() const { return m_accel_seconds; }
     RTCScene embree_scene() const { return m_rtc_scene; }
     RTCDevice embree_device() const { return m_device; }
     std::string to_string() const override;
@@ -73,6 +75,7 @@ private:
     std::shared_ptr<Integrator> m_integrator;
     std::vector<const Shape *> m_geometry_shapes; ///< Embree geometry id -> shape
     BoundingBox3f m_bbox;
+    double m_accel_seconds = 0.0;
     RTCDevice m_device = nullptr;
     RTCScene m_rtc_scene = nullptr;
 };
