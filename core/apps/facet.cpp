@@ -24,6 +24,7 @@ Usage:
   facet <scene.xml> [options]          the same
   facet plugins [kind|name]            list the plugins, or print one plugin's parameters
   facet bench <scene.xml> [options]    path tracer samples/s and rays/s against plain Embree
+  facet merge parts... -o out.exr      merge the parts of a render split by --crop and --pass
   facet compare ours.exr ref_mean.exr ref_var_xyz.exr --spp N
                                        statistical comparison with a reference render
   facet chi2 bsdf|emitter|microfacet ...
@@ -83,6 +84,7 @@ int run(int argc, char **argv) {
     const Command commands[] = {
         {"render", render_main},   {"plugins", plugins_main}, {"bench", bench_main},
         {"compare", compare_main}, {"chi2", chi2_main},       {"new-plugin", new_plugin_main},
+        {"merge", merge_main},
     };
     for (const Command &cmd : commands) {
         if (first == cmd.name) return cmd.run(argc - 1, argv + 1);
@@ -95,7 +97,8 @@ int run(int argc, char **argv) {
         return render_main(argc, argv);
     }
     throw facet::Error(fmt::format("unknown command '{}' (expected render, plugins, bench, "
-                                   "compare, chi2, new-plugin or a scene file; see facet --help)",
+                                   "merge, compare, chi2, new-plugin or a scene file; see facet "
+                                   "--help)",
                                    first));
 }
 

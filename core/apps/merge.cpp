@@ -1,0 +1,245 @@
+#include "merge.h"
+
+#include <facet/logger.h>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace facet::merge {
+
+namespace {
+
+std::string get(const Part &p, const char *key, const std::string &fallback = "") {
+    auto it = p.metadata.find(key);
+    return it == p.metadata.end() ? fallback : it->second;
+}
+
+long long get_int(const Part &p, const char *key, long long fallback) {
+    auto it = p.metadata.find(key);
+    if (it == p.metadata.end()) return fallback;
+    try {
+        size_t used = 0;
+        long long v = std::stoll(it->second, &used);
+        if (used == it->second.size()) return v;
+    } catch (const std::exception &) {}
+    FACET_THROW("{}: attribute {} is \"{}\", expected an integer", p.name, key, it->second);
+}
+
+std::string rect(int x0, int y0, int x1, int y1) {
+    return fmt::format("[{}, {}) x [{}, {})", x0, x1, y0, y1);
+}
+
+std::string rect_of(const Part &p) {
+    return rect(p.x, p.y, p.x + p.image.width, p.y + p.image.height);
+}
+
+std::string join(const std::vector<std::string> &v) {
+    std::string s;
+    for (const auto &x : v) s += (s.empty() ? "" : ", ") + x;
+    return s;
+}
+
+} // namespace
+
+Part read_part(const std::string &path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec))
+        FACET_THROW("cannot read part \"{}\": {}", path,
+                    fs::exists(path, ec) ? "not a regular file" : "no such file");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) FACET_THROW("cannot read part \"{}\": {}", path, OIIO::geterror());
+    const OIIO::ImageSpec &spec = in->spec();
+    Part part;
+    part.name = path;
+    part.full_width = spec.full_width;
+    part.full_height = spec.full_height;
+    part.x = spec.x - spec.full_x;
+    part.y = spec.y - spec.full_y;
+    part.half = spec.format == OIIO::TypeDesc::HALF;
+    for (const auto &f : spec.channelformats)
+        if (f != OIIO::TypeDesc::HALF) part.half = false;
+    part.image = Image(spec.width, spec.height, spec.nchannels);
+    part.image.channel_names.assign(spec.channelnames.begin(), spec.channelnames.end());
+    for (const OIIO::ParamValue &p : spec.extra_attribs) {
+        std::string name = p.name().string();
+        if (name.rfind("facet:", 0) == 0) part.metadata[name] = p.get_string();
+    }
+    bool ok =
+        in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part.image.data.data());
+    std::string err = ok ? "" : in->geterror();
+    in->close();
+    if (!ok) FACET_THROW("cannot read part \"{}\": {}", path, err);
+    return part;
+}
+
+Merged merge_parts(const std::vector<Part> &parts) {
+    if (parts.empty()) FACET_THROW("no parts to merge");
+    const Part &first = parts[0];
+    const int W = first.full_width, H = first.full_height, C = first.image.channels;
+    const long long passes = get_int(first, attr::passes, 1);
+    if (passes < 1)
+        FACET_THROW("{}: {} is {}, expected at least 1", first.name, attr::passes, passes);
+
+    // Everything that must agree between parts of one render.
+    for (const Part &p : parts) {
+        if (p.full_width != W || p.full_height != H)
+            FACET_THROW("{} is a part of a {}x{} image, {} of a {}x{} image: parts of different "
+                        "renders",
+                        p.name, p.full_width, p.full_height, first.name, W, H);
+        if (p.image.channel_names != first.image.channel_names)
+            FACET_THROW("{} has the channels {}, {} has {}: parts of different renders", p.name,
+                        join(p.image.channel_names), first.name, join(first.image.channel_names));
+        long long n = get_int(p, attr::passes, 1);
+        if (n != passes)
+            FACET_THROW("{} is a part of a render in {} pass{}, {} of one in {}", p.name, n,
+                        n == 1 ? "" : "es", first.name, passes);
+        for (const char *key : {attr::scene_hash, attr::seed, attr::spp_total}) {
+            auto a = first.metadata.find(key), b = p.metadata.find(key);
+            bool has_a = a != first.metadata.end(), has_b = b != p.metadata.end();
+            if (has_a != has_b || (has_a && a->second != b->second))
+                FACET_THROW("{} has {} {}, {} has {}: parts of different {}", p.name, key,
+                            has_b ? b->second : "(none)", first.name, has_a ? a->second : "(none)",
+                            std::strcmp(key, attr::seed) == 0        ? "seeds"
+                            : std::strcmp(key, attr::spp_total) == 0 ? "sample counts"
+                                                                     : "scenes");
+        }
+        if (auto it = p.metadata.find(attr::spp_target); it != p.metadata.end())
+            FACET_THROW("{} is incomplete: its render was stopped after {} of {} samples per "
+                        "pixel",
+                        p.name, get(p, attr::spp, "?"), it->second);
+        long long i = get_int(p, attr::pass, 0);
+        if (i < 0 || i >= passes)
+            FACET_THROW("{}: {} is {}, expected 0..{}", p.name, attr::pass, i, passes - 1);
+        if (p.x < 0 || p.y < 0 || p.x + p.image.width > W || p.y + p.image.height > H)
+            FACET_THROW("{}: its data window {} is not inside the {}x{} image", p.name, rect_of(p),
+                        W, H);
+        if (passes > 1 && get(p, attr::spp).empty())
+            FACET_THROW("{} has no {} attribute: passes are averaged by their sample counts",
+                        p.name, attr::spp);
+    }
+
+    Merged out;
+    out.passes = int(passes);
+    out.image = Image(W, H, C);
+    out.image.channel_names = first.image.channel_names;
+    out.half = std::all_of(parts.begin(), parts.end(), [](const Part &p) { return p.half; });
+
+    std::vector<double> sum, weight;
+    if (passes > 1) {
+        sum.assign(size_t(W) * H * C, 0.0);
+        weight.assign(size_t(W) * H, 0.0);
+    }
+    long long total_spp = 0;
+    bool uniform_spp = true;
+    for (long long pass = 0; pass < passes; ++pass) {
+        std::vector<const Part *> in_pass;
+        for (const Part &p : parts)
+            if (get_int(p, attr::pass, 0) == pass) in_pass.push_back(&p);
+        const std::string which =
+            passes > 1 ? fmt::format(" of pass {} (of {})", pass, passes) : std::string();
+        if (in_pass.empty())
+            FACET_THROW("pass {} of {} is missing: no part has {} {}", pass, passes, attr::pass,
+                        pass);
+        // Overlaps, by rectangle intersection.
+        for (size_t i = 0; i < in_pass.size(); ++i)
+            for (size_t j = i + 1; j < in_pass.size(); ++j) {
+                const Part &a = *in_pass[i], &b = *in_pass[j];
+                int x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
+                int x1 = std::min(a.x + a.image.width, b.x + b.image.width);
+                int y1 = std::min(a.y + a.image.height, b.y + b.image.height);
+                if (x0 < x1 && y0 < y1)
+                    FACET_THROW("{} ({}) and {} ({}) overlap{} in the pixels {}", a.name,
+                                rect_of(a), b.name, rect_of(b), which, rect(x0, y0, x1, y1));
+            }
+        // Holes: with no overlaps, the pass is complete when the areas add up.
+        long long area = 0;
+        for (const Part *p : in_pass) area += (long long)p->image.width * p->image.height;
+        if (area != (long long)W * H) {
+            std::vector<char> covered(size_t(W) * H, 0);
+            for (const Part *p : in_pass)
+                for (int y = 0; y < p->image.height; ++y)
+                    std::fill_n(covered.begin() + (size_t(p->y + y) * W + p->x), p->image.width, 1);
+            int x0 = W, y0 = H, x1 = 0, y1 = 0;
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x)
+                    if (!covered[size_t(y) * W + x]) {
+                        x0 = std::min(x0, x), y0 = std::min(y0, y);
+                        x1 = std::max(x1, x + 1), y1 = std::max(y1, y + 1);
+                    }
+            FACET_THROW("the parts{} leave {} of the {}x{} pixels uncovered, within {}: a part "
+                        "is missing",
+                        which, (long long)W * H - area, W, H, rect(x0, y0, x1, y1));
+        }
+        long long pass_spp = get_int(*in_pass[0], attr::spp, 0);
+        for (const Part *p : in_pass) {
+            const long long spp = get_int(*p, attr::spp, 0);
+            if (spp != pass_spp) uniform_spp = false;
+            for (int y = 0; y < p->image.height; ++y) {
+                const float *src = p->image.data.data() + size_t(y) * p->image.width * C;
+                const size_t row = size_t(p->y + y) * W + p->x;
+                if (passes == 1) {
+                    std::memcpy(out.image.data.data() + row * C, src,
+                                size_t(p->image.width) * C * sizeof(float));
+                    continue;
+                }
+                for (int x = 0; x < p->image.width; ++x) {
+                    for (int c = 0; c < C; ++c)
+                        sum[(row + x) * C + c] += double(spp) * double(src[size_t(x) * C + c]);
+                    weight[row + x] += double(spp);
+                }
+            }
+        }
+        total_spp += pass_spp;
+    }
+    if (passes > 1)
+        for (size_t i = 0; i < size_t(W) * H; ++i) {
+            const double inv = weight[i] > 0.0 ? 1.0 / weight[i] : 0.0;
+            for (int c = 0; c < C; ++c) out.image.data[i * C + c] = float(sum[i * C + c] * inv);
+        }
+
+    // Metadata: what all parts agree on, the total sample count and the summed render time.
+    for (const auto &[key, value] : first.metadata) {
+        if (key == attr::pass || key == attr::passes || key == attr::crop || key == attr::spp ||
+            key == attr::render_time || key == attr::sample_offset)
+            continue;
+        bool shared = std::all_of(parts.begin(), parts.end(), [&](const Part &p) {
+            auto it = p.metadata.find(key);
+            return it != p.metadata.end() && it->second == value;
+        });
+        if (shared) out.metadata[key] = value;
+    }
+    // The merged image reads as one render of the whole film.
+    if (uniform_spp && total_spp > 0) out.metadata[attr::spp] = std::to_string(total_spp);
+    out.metadata[attr::pass] = "0";
+    out.metadata[attr::passes] = "1";
+    out.metadata[attr::sample_offset] = "0";
+    out.metadata[attr::crop] = fmt::format("0 0 {} {}", W, H);
+    double seconds = 0.0;
+    bool timed = true;
+    for (const Part &p : parts) {
+        std::string t = get(p, attr::render_time);
+        if (t.empty()) {
+            timed = false;
+            break;
+        }
+        seconds += std::atof(t.c_str());
+    }
+    if (timed) out.metadata[attr::render_time] = fmt::format("{:.3f}", seconds);
+    out.metadata["facet:merged_parts"] = std::to_string(parts.size());
+    return out;
+}
+
+void write_merged(const Merged &merged, const std::string &path) {
+    ImageWriteOptions opts;
+    opts.half = merged.half;
+    opts.metadata = merged.metadata;
+    write_image(path, merged.image, opts);
+}
+
+} // namespace facet::merge

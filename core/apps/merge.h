@@ -1,0 +1,60 @@
+#pragma once
+
+// Merging the parts of a render split across processes or machines (`facet merge`, and
+// facet.merge / facet.distributed in Python, which compile this file too).
+//
+// A part is an image of a rectangle of the full image (its data window inside the display
+// window) from one pass of a render split into passes. Parts of one pass must cover the full
+// image exactly once; pixels are averaged over the passes with the passes' sample counts as
+// weights. With one pass the merged pixels are the parts' pixels, unchanged.
+
+#include <facet/image.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace facet::merge {
+
+/// Names of the EXR attributes a part carries (written by `facet render`).
+namespace attr {
+inline constexpr const char *spp = "facet:spp";
+inline constexpr const char *pass = "facet:pass_index";
+inline constexpr const char *passes = "facet:pass_count";
+inline constexpr const char *spp_total = "facet:spp_total";
+inline constexpr const char *spp_target = "facet:spp_target";
+inline constexpr const char *sample_offset = "facet:sample_offset";
+inline constexpr const char *film_size = "facet:film_size";
+inline constexpr const char *crop = "facet:crop";
+inline constexpr const char *scene_hash = "facet:scene_hash";
+inline constexpr const char *seed = "facet:seed";
+inline constexpr const char *render_time = "facet:render_time";
+} // namespace attr
+
+struct Part {
+    std::string name;                            ///< file name (or "part N") for messages
+    int full_width = 0, full_height = 0;         ///< display window
+    int x = 0, y = 0;                            ///< data window origin inside the display window
+    Image image;                                 ///< the data window's pixels
+    bool half = false;                           ///< stored as float16
+    std::map<std::string, std::string> metadata; ///< the facet:* string attributes
+};
+
+/// Reads a part with OpenImageIO (display and data windows, channels, facet:* attributes).
+Part read_part(const std::string &path);
+
+struct Merged {
+    Image image; ///< the full image
+    bool half = false;
+    std::map<std::string, std::string> metadata;
+    int passes = 1;
+};
+
+/// Checks the parts (same scene, size, channels and pass count; each pass covered exactly once,
+/// no overlaps, no holes) and merges them; a facet::Error names the offending parts otherwise.
+Merged merge_parts(const std::vector<Part> &parts);
+
+/// Writes the merged image through facet's writer (EXR: float16 when the parts were).
+void write_merged(const Merged &merged, const std::string &path);
+
+} // namespace facet::merge
