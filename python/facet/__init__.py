@@ -1,0 +1,231 @@
+"""facet: a physically based renderer for Mitsuba 3 scenes, from Python.
+
+    import facet
+    scene = facet.load_file("scenes/cornell-box/scene.xml", spp=64)
+    image = facet.render(scene, seed=1)
+    pixels, channels = image          # float32 (height, width, channels), ["R", "G", "B", ...]
+    facet.write(image, "cornell.exr")
+
+Errors are ``facet.Error`` (a RuntimeError) whose message starts with the scene location
+(``scene.xml:12:5: ...``, also in its ``file``, ``line`` and ``column`` attributes). A render
+releases the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
+"""
+
+import os as _os
+
+from . import _facet
+from ._facet import Error, Scene, Chi2Result
+
+__all__ = [
+    "Error",
+    "Scene",
+    "Image",
+    "Chi2Result",
+    "Plugin",
+    "load_file",
+    "load_string",
+    "render",
+    "write",
+    "read",
+    "plugins",
+    "add_plugin_dir",
+    "chi2",
+    "set_log_level",
+]
+
+
+def _param_value(key, value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float, str)):
+        return str(value)
+    if isinstance(value, _os.PathLike):
+        return _os.fspath(value)
+    if isinstance(value, (tuple, list)):
+        return ",".join(str(v) for v in value)
+    raise TypeError(f"scene parameter {key}={value!r}: expected a number, a string or a bool")
+
+
+def _params(params):
+    return {k: _param_value(k, v) for k, v in params.items()}
+
+
+def load_file(path, *, lenient=False, search_path=(), **params):
+    """Loads a Mitsuba 3 XML scene. Keyword arguments are the ``$name`` values (the ``-D`` options
+    of ``facet render``): ``facet.load_file("scene.xml", spp=64, res=256)``. ``lenient`` turns
+    unused parameters into warnings, ``search_path`` adds folders for meshes and textures."""
+    return _facet.load_file(_os.fspath(path), _params(params), lenient, [_os.fspath(p) for p in search_path])
+
+
+def load_string(xml, *, lenient=False, search_path=(), **params):
+    """Loads a scene given as XML text; locations in errors read ``string:line:col``."""
+    return _facet.load_string(xml, _params(params), lenient, [_os.fspath(p) for p in search_path])
+
+
+class Image(tuple):
+    """What ``render`` returns: a pair ``(pixels, channels)`` (so ``pixels, channels =
+    facet.render(...)`` works) that also carries ``metadata`` (the ``facet:`` attributes the CLI
+    writes into an EXR) and ``half`` (the film's component_format is float16)."""
+
+    def __new__(cls, pixels, channels, metadata=None, half=False):
+        self = super().__new__(cls, (pixels, list(channels)))
+        self.metadata = dict(metadata or {})
+        self.half = bool(half)
+        return self
+
+    @property
+    def pixels(self):
+        return self[0]
+
+    @property
+    def channels(self):
+        return self[1]
+
+    @property
+    def shape(self):
+        return self[0].shape
+
+    def __repr__(self):
+        h, w, c = self[0].shape
+        return f"<facet.Image {w}x{h} {self[1]}>"
+
+
+def render(scene, spp=None, seed=0, sensor=0, threads=None):
+    """Renders ``sensor`` of ``scene`` with its integrator and returns an ``Image``: a NumPy
+    float32 array of shape (height, width, channels) and the channel names (R, G, B, then A and
+    the AOVs when the scene asks for them). ``spp`` overrides the sampler's sample_count, ``seed``
+    is added to the sampler's seed, ``threads`` defaults to every core. The same scene, seed and
+    spp give the same pixels for any thread count, and the same pixels as ``facet render``."""
+    pixels, channels, metadata, half = _facet.render(scene, spp, int(seed), int(sensor), threads)
+    return Image(pixels, channels, metadata, half)
+
+
+def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="", view="Standard"):
+    """Writes an image through facet's writer (the one ``facet render`` uses): ``.exr`` keeps every
+    channel (float16 when the film says so, else float32), ``.hdr``/``.pfm`` are linear, ``.png``
+    and ``.jpg`` go through the OpenColorIO display transform. ``image`` is what ``render``
+    returns, a ``(pixels, channels)`` pair or an array (channels then default to R, G, B, A or Y).
+    """
+    import numpy as np
+
+    meta = {}
+    film_half = False
+    if isinstance(image, Image):
+        meta.update(image.metadata)
+        film_half = image.half
+    if isinstance(image, tuple):
+        pixels, names = image[0], image[1]
+    else:
+        pixels, names = image, None
+    if channels is not None:
+        names = list(channels)
+    pixels = np.ascontiguousarray(pixels, dtype=np.float32)
+    if names is None:
+        c = 1 if pixels.ndim == 2 else pixels.shape[2]
+        names = ["Y"] if c == 1 else list("RGBA"[:c]) if c <= 4 else []
+    if metadata:
+        meta.update({str(k): str(v) for k, v in metadata.items()})
+    _facet.write(pixels, list(names), _os.fspath(path), film_half if half is None else bool(half), meta,
+                 ocio_config, view)
+
+
+def read(path):
+    """Reads an image (any format OpenImageIO knows) as ``(pixels, channels)``, pixels float32 of
+    shape (height, width, channels)."""
+    pixels, channels = _facet.read(_os.fspath(path))
+    return pixels, channels
+
+
+class Plugin(tuple):
+    """One plugin: ``(name, kind, description)``, and ``doc``, its parameter table."""
+
+    def __new__(cls, name, kind, description, doc):
+        self = super().__new__(cls, (name, kind, description))
+        self.doc = doc
+        return self
+
+    name = property(lambda self: self[0])
+    kind = property(lambda self: self[1])
+    description = property(lambda self: self[2])
+
+
+def plugins(kind=None):
+    """The plugins on the search path as ``Plugin`` tuples ``(name, kind, description)``, sorted
+    by name; ``kind`` ("bsdf", "emitter", ...) keeps one kind."""
+    out = [Plugin(*p) for p in _facet.plugins()]
+    if kind is not None:
+        out = [p for p in out if p.kind == kind]
+    return out
+
+
+def add_plugin_dir(path):
+    """Adds a folder to the plugin search path (``-a`` of the CLI)."""
+    _facet.add_plugin_dir(_os.fspath(path))
+
+
+def set_log_level(level):
+    """"trace", "debug", "info" (the default), "warn", "error" or "off"."""
+    _facet.set_log_level(level)
+
+
+def _entries(params):
+    out = []
+    for key, value in params.items():
+        if isinstance(value, bool):
+            value = "true" if value else "false"
+        elif isinstance(value, (tuple, list)):
+            value = ",".join(str(v) for v in value)
+        out.append(f"{key}={value}")
+    return out
+
+
+def chi2(kind, name=None, *, xml=None, theta=30.0, phi=0.0, wi=None, ref=(0.25, -0.5, 1.5),
+         shape="rectangle", emission=False, component=None, mode="radiance", alpha=0.1,
+         alpha_v=None, visible=True, res=32, samples=1000000, seed=0, tests=1, significance=0.01,
+         adaptive=True, ires=7, **params):
+    """The chi-square test of ``facet chi2`` (facet::testing): draws ``samples`` directions from a
+    plugin and compares their histogram over (phi, cos theta) with its pdf.
+
+        r = facet.chi2("bsdf", "roughconductor", distribution="ggx", alpha=0.2, theta=60)
+        r.passed, r.statistic, r.dof, r.p_value, r.observed, r.expected
+
+    ``kind`` is "bsdf", "emitter" or "microfacet". Plugin parameters are keyword arguments (a
+    number becomes a float, a bool a boolean, a 3-tuple an rgb; "integer:name" keys name the
+    type) or ``xml`` gives the object. BSDFs are seen from ``theta``/``phi`` (degrees) or ``wi``;
+    emitters from ``ref`` (or their emitted rays with ``emission=True``); microfacet
+    distributions ("beckmann" or "ggx" as ``name``) take ``alpha``, ``alpha_v`` and ``visible``.
+    ``observed`` and ``expected`` are arrays of shape (res, 2 res), cos theta = -1 in row 0.
+    """
+    opts = dict(res=int(res), samples=int(samples), seed=int(seed), tests=int(tests),
+                significance=float(significance), adaptive=bool(adaptive), ires=int(ires))
+    if wi is not None and (theta != 30.0 or phi != 0.0):
+        raise ValueError("give the incident direction either as wi or as theta/phi")
+    direction = list(wi) if wi is not None else _facet.direction_from_angles(theta, phi)
+    if kind == "bsdf":
+        if xml is not None:
+            if params or name is not None:
+                raise ValueError("give the BSDF either by name and parameters or as xml")
+            text = xml
+        else:
+            if name is None:
+                raise ValueError("name the BSDF plugin to test (or give xml)")
+            text = _facet.chi2_object_xml("bsdf", name, _entries(params))
+        return _facet.chi2_bsdf(text, direction, mode, -1 if component is None else int(component), opts)
+    if kind == "emitter":
+        if xml is not None:
+            if params or name is not None:
+                raise ValueError("give the emitter either by name and parameters or as xml")
+            scene = xml if "<scene" in xml else f'<scene version="3.0.0">{xml}</scene>'
+        else:
+            if name is None:
+                raise ValueError("name the emitter plugin to test (or give xml)")
+            scene = _facet.chi2_emitter_scene_xml(name, _entries(params), shape)
+        return _facet.chi2_emitter(scene, list(ref), bool(emission), opts)
+    if kind == "microfacet":
+        if name not in ("beckmann", "ggx"):
+            raise ValueError(f"microfacet distribution {name!r}: expected 'beckmann' or 'ggx'")
+        if params:
+            raise ValueError(f"unknown microfacet arguments: {', '.join(params)}")
+        av = alpha if alpha_v is None else alpha_v
+        return _facet.chi2_microfacet(name, float(alpha), float(av), bool(visible), direction, opts)
+    raise ValueError(f"chi2 kind {kind!r}: expected 'bsdf', 'emitter' or 'microfacet'")

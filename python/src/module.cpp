@@ -1,0 +1,386 @@
+// facet._facet: the compiled half of the `facet` Python package (python/facet/__init__.py is the
+// public API). Loads scenes, renders them with the GIL released (Ctrl-C cancels the render and
+// raises KeyboardInterrupt), writes images through facet's writer, lists plugins, runs the
+// chi-square test of facet::testing and merges render parts (core/apps/merge.h).
+
+#include <facet/chi2.h>
+#include <facet/film.h>
+#include <facet/image.h>
+#include <facet/logger.h>
+#include <facet/plugin.h>
+#include <facet/render.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/xml.h>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <future>
+#include <optional>
+#include <thread>
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using namespace facet;
+
+namespace {
+
+/// A loaded scene and where it came from (the `facet:scene` metadata of its renders).
+struct PyScene {
+    std::shared_ptr<Scene> scene;
+    std::string path; ///< absolute file name; empty for load_string
+    std::map<std::string, std::string> params;
+};
+
+LoadOptions load_options(const std::map<std::string, std::string> &params, bool lenient,
+                         const std::vector<std::string> &search_path) {
+    LoadOptions opts;
+    opts.params = params;
+    opts.lenient = lenient;
+    opts.search_path = search_path;
+    return opts;
+}
+
+std::shared_ptr<Scene> as_scene(std::shared_ptr<Object> obj, const std::string &where) {
+    auto scene = std::dynamic_pointer_cast<Scene>(obj);
+    if (!scene)
+        FACET_THROW("{}: the root element is a <{}>, not a <scene>", where,
+                    object_type_name(obj->type()));
+    return scene;
+}
+
+PyScene load_file_py(const std::string &path, const std::map<std::string, std::string> &params,
+                     bool lenient, const std::vector<std::string> &search_path) {
+    if (!fs::exists(path)) FACET_THROW("scene file \"{}\" does not exist", path);
+    PyScene s;
+    s.path = fs::absolute(path).lexically_normal().string();
+    s.params = params;
+    py::gil_scoped_release release;
+    s.scene = facet::load_scene(path, load_options(params, lenient, search_path));
+    return s;
+}
+
+PyScene load_string_py(const std::string &xml, const std::map<std::string, std::string> &params,
+                       bool lenient, const std::vector<std::string> &search_path) {
+    PyScene s;
+    s.params = params;
+    py::gil_scoped_release release;
+    s.scene =
+        as_scene(facet::load_string(xml, load_options(params, lenient, search_path)), "string");
+    return s;
+}
+
+py::array_t<float> to_array(const Image &img) {
+    py::array_t<float> arr(
+        {py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(img.channels)});
+    std::memcpy(arr.mutable_data(), img.data.data(), img.data.size() * sizeof(float));
+    return arr;
+}
+
+Image from_array(const py::array_t<float, py::array::c_style | py::array::forcecast> &arr,
+                 const std::vector<std::string> &channels) {
+    if (arr.ndim() != 2 && arr.ndim() != 3)
+        FACET_THROW("an image is an array of shape (height, width) or (height, width, channels), "
+                    "not one with {} dimensions",
+                    arr.ndim());
+    int h = int(arr.shape(0)), w = int(arr.shape(1)), c = arr.ndim() == 3 ? int(arr.shape(2)) : 1;
+    if (!channels.empty() && int(channels.size()) != c)
+        FACET_THROW("{} channel names for an image of {} channels", channels.size(), c);
+    Image img(w, h, c);
+    img.channel_names = channels;
+    std::memcpy(img.data.data(), arr.data(), img.data.size() * sizeof(float));
+    return img;
+}
+
+/// Runs `fn` on a thread of its own while this thread waits with the GIL released, checking for
+/// Python signals (Ctrl-C) every 50 ms when it is the main thread. On a signal, `cancel` is set,
+/// the render is waited for and the Python exception (KeyboardInterrupt) is raised.
+template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel, Fn fn) {
+    using R = decltype(fn());
+    std::packaged_task<R()> task(std::move(fn));
+    std::future<R> future = task.get_future();
+    std::thread worker(std::move(task));
+    bool interrupted = false;
+    std::optional<py::error_already_set> pending;
+    for (;;) {
+        bool ready;
+        {
+            py::gil_scoped_release release;
+            ready = future.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
+        }
+        if (ready) break;
+        if (!interrupted && PyErr_CheckSignals() != 0) {
+            interrupted = true;
+            pending.emplace(); // takes the KeyboardInterrupt
+            cancel = true;
+        }
+    }
+    worker.join();
+    if (interrupted) throw *pending;
+    return future.get(); // rethrows the render's exception
+}
+
+py::dict metadata_dict(const std::map<std::string, std::string> &m) {
+    py::dict d;
+    for (const auto &[k, v] : m) d[py::str(k)] = py::str(v);
+    return d;
+}
+
+/// Returns (pixels, channel names, metadata, half).
+py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int sensor_index,
+                    std::optional<int> threads) {
+    const auto &sensors = s.scene->sensors();
+    if (sensor_index < 0 || size_t(sensor_index) >= sensors.size())
+        FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor_index,
+                    sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
+    if (spp && *spp < 1) FACET_THROW("spp={}: expected a positive number of samples", *spp);
+    if (threads && *threads < 1) FACET_THROW("threads={}: expected at least 1", *threads);
+    const Sensor &sensor = *sensors[size_t(sensor_index)];
+
+    RenderOptions opts;
+    opts.threads = threads ? *threads : 0;
+    opts.seed = seed;
+    opts.spp = spp ? *spp : 0;
+    opts.progress = false;
+    std::atomic<bool> cancel{false};
+    opts.cancel = &cancel;
+    int used_spp = opts.spp > 0 ? opts.spp : int(sensor.sampler().sample_count());
+
+    std::shared_ptr<Scene> keep = s.scene; // alive while the render thread runs
+    RenderResult result =
+        run_interruptible(cancel, [keep, &sensor, opts]() { return render(*keep, sensor, opts); });
+
+    std::map<std::string, std::string> meta;
+    meta["facet:spp"] = std::to_string(used_spp);
+    meta["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
+    if (!s.path.empty()) meta["facet:scene"] = s.path;
+    meta["facet:seed"] = std::to_string(seed);
+    if (result.timed_out)
+        meta["facet:blocks"] = fmt::format("{}/{}", result.blocks_done, result.blocks_total);
+    return py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
+                          sensor.film().half());
+}
+
+void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast> &pixels,
+              const std::vector<std::string> &channels, const std::string &path, bool half,
+              const std::map<std::string, std::string> &metadata, const std::string &ocio_config,
+              const std::string &view) {
+    Image img = from_array(pixels, channels);
+    ImageWriteOptions opts;
+    opts.half = half;
+    opts.metadata = metadata;
+    opts.ocio_config = ocio_config;
+    opts.view = view;
+    py::gil_scoped_release release;
+    write_image(path, img, opts);
+}
+
+py::tuple read_py(const std::string &path) {
+    Image img;
+    {
+        py::gil_scoped_release release;
+        img = read_image(path);
+    }
+    return py::make_tuple(to_array(img), img.channel_names);
+}
+
+/// [(name, kind, description, doc)] of every plugin on the search path.
+std::vector<py::tuple> plugins_py() {
+    PluginRegistry &registry = PluginRegistry::instance();
+    std::vector<py::tuple> out;
+    for (const std::string &name : registry.available()) {
+        const PluginDescriptor &d = registry.descriptor(name);
+        out.push_back(py::make_tuple(name, object_type_name(d.kind),
+                                     d.description ? d.description : "", d.doc ? d.doc : ""));
+    }
+    return out;
+}
+
+Chi2Options chi2_options(const py::dict &o) {
+    Chi2Options opts;
+    opts.res = o["res"].cast<int>();
+    opts.samples = o["samples"].cast<uint64_t>();
+    opts.seed = o["seed"].cast<uint32_t>();
+    opts.test_count = std::max(1u, o["tests"].cast<uint32_t>());
+    opts.significance = o["significance"].cast<double>();
+    opts.adaptive = o["adaptive"].cast<bool>();
+    opts.ires = o["ires"].cast<int>();
+    if (!(opts.significance > 0.0 && opts.significance < 1.0))
+        FACET_THROW("significance={} must be in (0, 1)", opts.significance);
+    if (opts.res < 2) FACET_THROW("res={}: expected at least 2 cells", opts.res);
+    if (opts.samples < 1) FACET_THROW("samples must be positive");
+    return opts;
+}
+
+Chi2Result run_adapter(const Chi2Adapter &adapter, const Chi2Options &opts) {
+    py::gil_scoped_release release;
+    return run_chi2(adapter, opts);
+}
+
+Vector3f vec3(const std::vector<float> &v, const char *what) {
+    if (v.size() != 3) FACET_THROW("{} expects 3 numbers, got {}", what, v.size());
+    return Vector3f(v[0], v[1], v[2]);
+}
+
+py::array_t<double> histogram(const std::vector<double> &v, int rows, int cols) {
+    py::array_t<double> a({py::ssize_t(rows), py::ssize_t(cols)});
+    if (!v.empty()) std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(double));
+    return a;
+}
+
+/// The Python exception type for facet::Error (a RuntimeError with file, line and column).
+PyObject *g_error_type = nullptr;
+
+} // namespace
+
+PYBIND11_MODULE(_facet, m) {
+    m.doc() = "facet's compiled module; use the `facet` package";
+
+    static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
+    g_error_type = error_type.ptr();
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const Error &e) {
+            py::object exc = py::reinterpret_borrow<py::object>(g_error_type)(e.what());
+            const Location &loc = e.location();
+            exc.attr("file") = loc.valid() ? py::object(py::str(loc.file)) : py::none();
+            exc.attr("line") = loc.valid() ? py::object(py::int_(loc.line)) : py::none();
+            exc.attr("column") = loc.valid() ? py::object(py::int_(loc.column)) : py::none();
+            PyErr_SetObject(g_error_type, exc.ptr());
+        }
+    });
+
+    py::class_<PyScene>(m, "Scene", "A loaded scene (facet.load_file / facet.load_string)")
+        .def_property_readonly("path", [](const PyScene &s) { return s.path; })
+        .def_property_readonly("params", [](const PyScene &s) { return s.params; })
+        .def_property_readonly("sensor_count",
+                               [](const PyScene &s) { return s.scene->sensors().size(); })
+        .def(
+            "film_size",
+            [](const PyScene &s, int sensor) {
+                const auto &sensors = s.scene->sensors();
+                if (sensor < 0 || size_t(sensor) >= sensors.size())
+                    FACET_THROW("sensor {}: the scene has {} sensors", sensor, sensors.size());
+                const Film &f = sensors[size_t(sensor)]->film();
+                return py::make_tuple(f.size().x, f.size().y);
+            },
+            py::arg("sensor") = 0, "(width, height) of the film of `sensor`")
+        .def("__repr__", [](const PyScene &s) {
+            return fmt::format("<facet.Scene {}>", s.path.empty() ? "(from a string)" : s.path);
+        });
+
+    m.def("load_file", &load_file_py, py::arg("path"), py::arg("params"), py::arg("lenient"),
+          py::arg("search_path"));
+    m.def("load_string", &load_string_py, py::arg("xml"), py::arg("params"), py::arg("lenient"),
+          py::arg("search_path"));
+    m.def("render", &render_py, py::arg("scene"), py::arg("spp"), py::arg("seed"),
+          py::arg("sensor"), py::arg("threads"));
+    m.def("write", &write_py, py::arg("pixels"), py::arg("channels"), py::arg("path"),
+          py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("view"));
+    m.def("read", &read_py, py::arg("path"));
+    m.def("plugins", &plugins_py);
+    m.def("add_plugin_dir",
+          [](const std::string &dir) { PluginRegistry::instance().add_search_dir(dir); });
+    m.def("plugin_search_path", []() { return PluginRegistry::instance().search_path(); });
+    m.def("set_log_level", [](const std::string &level) {
+        static const std::map<std::string, LogLevel> levels = {
+            {"trace", LogLevel::Trace}, {"debug", LogLevel::Debug}, {"info", LogLevel::Info},
+            {"warn", LogLevel::Warn},   {"error", LogLevel::Error}, {"off", LogLevel::Off}};
+        auto it = levels.find(level);
+        if (it == levels.end())
+            FACET_THROW("log level \"{}\": expected trace, debug, info, warn, error or off", level);
+        Logger::set_level(it->second);
+    });
+
+    py::class_<Chi2Result>(m, "Chi2Result", "What facet.chi2 found")
+        .def_readonly("passed", &Chi2Result::passed)
+        .def_readonly("statistic", &Chi2Result::statistic)
+        .def_readonly("dof", &Chi2Result::dof)
+        .def_readonly("p_value", &Chi2Result::p_value)
+        .def_readonly("significance", &Chi2Result::significance)
+        .def_readonly("failures", &Chi2Result::failures)
+        .def_readonly("notes", &Chi2Result::notes)
+        .def_readonly("samples", &Chi2Result::samples)
+        .def_readonly("pdf_integral", &Chi2Result::pdf_integral)
+        .def_readonly("description", &Chi2Result::description)
+        .def_property_readonly(
+            "observed",
+            [](const Chi2Result &r) { return histogram(r.observed, r.cos_res, r.phi_res); },
+            "Counts per cell: rows are cos theta from -1 to 1, columns phi from -pi to pi")
+        .def_property_readonly(
+            "expected",
+            [](const Chi2Result &r) { return histogram(r.expected, r.cos_res, r.phi_res); },
+            "Expected counts, laid out like `observed`")
+        .def_property_readonly("mean_weight",
+                               [](const Chi2Result &r) {
+                                   return py::make_tuple(r.mean_weight.r, r.mean_weight.g,
+                                                         r.mean_weight.b);
+                               })
+        .def("summary", &Chi2Result::summary)
+        .def("__repr__", [](const Chi2Result &r) {
+            return fmt::format("<facet.Chi2Result {} statistic={:.6g} dof={} p_value={:.6g}>",
+                               r.passed ? "passed" : "REJECTED", r.statistic, r.dof, r.p_value);
+        });
+
+    m.def("chi2_object_xml", [](const std::string &kind, const std::string &plugin,
+                                const std::vector<std::string> &entries) {
+        ObjectType t = object_type_from_name(kind);
+        if (t == ObjectType::Unknown) FACET_THROW("unknown object kind \"{}\"", kind);
+        return chi2_object_xml(t, plugin, entries);
+    });
+    m.def("chi2_emitter_scene_xml", &EmitterAdapter::scene_xml);
+    m.def("chi2_bsdf", [](const std::string &xml, const std::vector<float> &wi,
+                          const std::string &mode, int component, const py::dict &o) {
+        BSDFContext ctx;
+        if (mode == "importance")
+            ctx.mode = TransportMode::Importance;
+        else if (mode != "radiance")
+            FACET_THROW("mode \"{}\": expected radiance or importance", mode);
+        if (component >= 0) ctx.component = uint32_t(component);
+        Chi2Options opts = chi2_options(o);
+        std::unique_ptr<BSDFAdapter> adapter;
+        {
+            py::gil_scoped_release release;
+            adapter = std::make_unique<BSDFAdapter>(xml, vec3(wi, "wi"), ctx);
+        }
+        return run_adapter(*adapter, opts);
+    });
+    m.def("chi2_emitter", [](const std::string &scene_xml, const std::vector<float> &ref,
+                             bool emission, const py::dict &o) {
+        Chi2Options opts = chi2_options(o);
+        if (emission) {
+            std::unique_ptr<EmissionAdapter> adapter;
+            {
+                py::gil_scoped_release release;
+                adapter = std::make_unique<EmissionAdapter>(scene_xml);
+            }
+            return run_adapter(*adapter, opts);
+        }
+        Vector3f r = vec3(ref, "ref");
+        std::unique_ptr<EmitterAdapter> adapter;
+        {
+            py::gil_scoped_release release;
+            adapter = std::make_unique<EmitterAdapter>(scene_xml, Point3f(r.x, r.y, r.z));
+        }
+        return run_adapter(*adapter, opts);
+    });
+    m.def("chi2_microfacet", [](const std::string &type, float alpha_u, float alpha_v, bool visible,
+                                const std::vector<float> &wi, const py::dict &o) {
+        Chi2Options opts = chi2_options(o);
+        MicrofacetAdapter adapter(type, alpha_u, alpha_v, visible, vec3(wi, "wi"));
+        return run_adapter(adapter, opts);
+    });
+    m.def("direction_from_angles", [](float theta, float phi) {
+        Vector3f d = direction_from_angles(theta, phi);
+        return std::vector<float>{d.x, d.y, d.z};
+    });
+}

@@ -1,0 +1,23 @@
+"""Shared fixtures: where the repository and the build tree are (set by the ctest that runs
+pytest; derived from this file's place otherwise)."""
+
+import os
+import pathlib
+
+import pytest
+
+SOURCE_DIR = pathlib.Path(os.environ.get("FACET_SOURCE_DIR", pathlib.Path(__file__).parents[2]))
+BINARY_DIR = pathlib.Path(os.environ.get("FACET_BINARY_DIR", SOURCE_DIR / "build"))
+CORNELL = SOURCE_DIR / "scenes" / "cornell-box" / "scene.xml"
+FACET_CLI = BINARY_DIR / "bin" / "facet"
+
+
+@pytest.fixture
+def cornell():
+    return CORNELL
+
+
+@pytest.fixture
+def facet_cli():
+    assert FACET_CLI.exists(), f"{FACET_CLI} is missing: build the facet command first"
+    return FACET_CLI
