@@ -153,6 +153,8 @@ Merged merge_parts(const std::vector<Part> &parts) {
                 int x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
                 int x1 = std::min(a.x + a.image.width, b.x + b.image.width);
                 int y1 = std::min(a.y + a.image.height, b.y + b.image.height);
+                if (x0 < x1 && y0 < y1 && a.name == b.name)
+                    FACET_THROW("{} is given twice{}", a.name, which);
                 if (x0 < x1 && y0 < y1)
                     FACET_THROW("{} ({}) and {} ({}) overlap{} in the pixels {}", a.name,
                                 rect_of(a), b.name, rect_of(b), which, rect(x0, y0, x1, y1));

@@ -27,6 +27,7 @@ __all__ = [
     "render",
     "write",
     "read",
+    "merge",
     "plugins",
     "add_plugin_dir",
     "chi2",
@@ -65,13 +66,30 @@ def load_string(xml, *, lenient=False, search_path=(), **params):
 class Image(tuple):
     """What ``render`` returns: a pair ``(pixels, channels)`` (so ``pixels, channels =
     facet.render(...)`` works) that also carries ``metadata`` (the ``facet:`` attributes the CLI
-    writes into an EXR) and ``half`` (the film's component_format is float16)."""
+    writes into an EXR), ``half`` (the film's component_format is float16) and ``window``:
+    ``(x, y, full_width, full_height)``, where the pixels lie in the whole film (a crop's data
+    window inside its display window)."""
 
-    def __new__(cls, pixels, channels, metadata=None, half=False):
+    def __new__(cls, pixels, channels, metadata=None, half=False, window=None):
         self = super().__new__(cls, (pixels, list(channels)))
         self.metadata = dict(metadata or {})
         self.half = bool(half)
+        h, w = pixels.shape[:2]
+        self.window = tuple(int(v) for v in window) if window is not None else (0, 0, w, h)
         return self
+
+    def __reduce__(self):
+        return (Image, (self[0], self[1], self.metadata, self.half, self.window))
+
+    def to_part(self):
+        """A plain dict of everything (for sending a part between processes)."""
+        return dict(pixels=self[0], channels=list(self[1]), metadata=dict(self.metadata),
+                    half=self.half, window=self.window)
+
+    @classmethod
+    def from_part(cls, part):
+        return cls(part["pixels"], part["channels"], part["metadata"], part["half"],
+                   part["window"])
 
     @property
     def pixels(self):
@@ -90,14 +108,45 @@ class Image(tuple):
         return f"<facet.Image {w}x{h} {self[1]}>"
 
 
-def render(scene, spp=None, seed=0, sensor=0, threads=None):
+def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_index=0, passes=1):
     """Renders ``sensor`` of ``scene`` with its integrator and returns an ``Image``: a NumPy
     float32 array of shape (height, width, channels) and the channel names (R, G, B, then A and
     the AOVs when the scene asks for them). ``spp`` overrides the sampler's sample_count, ``seed``
     is added to the sampler's seed, ``threads`` defaults to every core. The same scene, seed and
-    spp give the same pixels for any thread count, and the same pixels as ``facet render``."""
-    pixels, channels, metadata, half = _facet.render(scene, spp, int(seed), int(sensor), threads)
-    return Image(pixels, channels, metadata, half)
+    spp give the same pixels for any thread count, and the same pixels as ``facet render``.
+
+    ``crop=(x0, y0, x1, y1)`` renders only film pixels [x0, x1) x [y0, y1) (the same pixels as
+    in a render of the whole film); ``pass_index=i, passes=n`` renders part i of n of a render
+    of n x spp samples per pixel (``--pass``/``--passes`` of the CLI). ``facet.merge`` puts such
+    parts back together."""
+    pixels, channels, metadata, half, window = _facet.render(
+        scene, spp, int(seed), int(sensor), threads,
+        None if crop is None else [int(v) for v in crop], int(pass_index), int(passes))
+    return Image(pixels, channels, metadata, half, window)
+
+
+def merge(parts, output=None):
+    """Merges the parts of a split render as ``facet merge`` does: crop windows placed where they
+    belong, passes averaged by their sample counts; with one pass the pixels are the parts'
+    pixels. ``parts`` are file names or rendered ``Image``s (mixed as you like). Raises
+    ``facet.Error`` naming the parts that overlap, leave holes or belong to different renders.
+    Returns the whole image (and writes it to ``output`` when given)."""
+    items = []
+    for p in parts:
+        if isinstance(p, (str, _os.PathLike)):
+            items.append(_os.fspath(p))
+        elif isinstance(p, Image):
+            items.append((p[0], list(p[1]), dict(p.metadata), p.half, list(p.window)))
+        elif isinstance(p, dict):
+            items.append((p["pixels"], list(p["channels"]), dict(p["metadata"]), bool(p["half"]),
+                          list(p["window"])))
+        else:
+            raise TypeError(f"cannot merge {type(p).__name__}: expected a file name or a facet.Image")
+    pixels, channels, metadata, half, window, _passes = _facet.merge(items)
+    image = Image(pixels, channels, metadata, half, window)
+    if output is not None:
+        write(image, output)
+    return image
 
 
 def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="", view="Standard"):
@@ -110,9 +159,11 @@ def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="
 
     meta = {}
     film_half = False
+    window = None
     if isinstance(image, Image):
         meta.update(image.metadata)
         film_half = image.half
+        window = image.window
     if isinstance(image, tuple):
         pixels, names = image[0], image[1]
     else:
@@ -125,8 +176,10 @@ def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="
         names = ["Y"] if c == 1 else list("RGBA"[:c]) if c <= 4 else []
     if metadata:
         meta.update({str(k): str(v) for k, v in metadata.items()})
+    if window is None:
+        window = (0, 0, pixels.shape[1], pixels.shape[0])
     _facet.write(pixels, list(names), _os.fspath(path), film_half if half is None else bool(half), meta,
-                 ocio_config, view)
+                 ocio_config, view, list(window))
 
 
 def read(path):

@@ -3,6 +3,8 @@
 // raises KeyboardInterrupt), writes images through facet's writer, lists plugins, runs the
 // chi-square test of facet::testing and merges render parts (core/apps/merge.h).
 
+#include "merge.h"
+
 #include <facet/chi2.h>
 #include <facet/film.h>
 #include <facet/image.h>
@@ -18,12 +20,16 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <future>
+#include <iterator>
+#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -38,7 +44,15 @@ struct PyScene {
     std::shared_ptr<Scene> scene;
     std::string path; ///< absolute file name; empty for load_string
     std::map<std::string, std::string> params;
+    std::string text; ///< the XML, for facet:scene_hash (as `facet render` computes it)
+    /// A render develops into the sensor's film: one render of a scene at a time.
+    std::shared_ptr<std::mutex> render_mutex = std::make_shared<std::mutex>();
 };
+
+std::string file_text(const std::string &path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
 
 LoadOptions load_options(const std::map<std::string, std::string> &params, bool lenient,
                          const std::vector<std::string> &search_path) {
@@ -64,6 +78,7 @@ PyScene load_file_py(const std::string &path, const std::map<std::string, std::s
     s.path = fs::absolute(path).lexically_normal().string();
     s.params = params;
     py::gil_scoped_release release;
+    s.text = file_text(path);
     s.scene = facet::load_scene(path, load_options(params, lenient, search_path));
     return s;
 }
@@ -134,9 +149,15 @@ py::dict metadata_dict(const std::map<std::string, std::string> &m) {
     return d;
 }
 
-/// Returns (pixels, channel names, metadata, half).
+py::tuple window_of(const Image &img) {
+    return py::make_tuple(img.x, img.y, img.full_width > 0 ? img.full_width : img.x + img.width,
+                          img.full_height > 0 ? img.full_height : img.y + img.height);
+}
+
+/// Returns (pixels, channel names, metadata, half, window).
 py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int sensor_index,
-                    std::optional<int> threads) {
+                    std::optional<int> threads, std::optional<std::array<int, 4>> crop,
+                    int pass_index, int pass_count) {
     const auto &sensors = s.scene->sensors();
     if (sensor_index < 0 || size_t(sensor_index) >= sensors.size())
         FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor_index,
@@ -150,30 +171,41 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     opts.seed = seed;
     opts.spp = spp ? *spp : 0;
     opts.progress = false;
+    if (crop) opts.crop = *crop;
+    opts.pass_index = pass_index;
+    opts.pass_count = pass_count;
     std::atomic<bool> cancel{false};
     opts.cancel = &cancel;
-    int used_spp = opts.spp > 0 ? opts.spp : int(sensor.sampler().sample_count());
 
     std::shared_ptr<Scene> keep = s.scene; // alive while the render thread runs
-    RenderResult result =
-        run_interruptible(cancel, [keep, &sensor, opts]() { return render(*keep, sensor, opts); });
+    std::shared_ptr<std::mutex> mutex = s.render_mutex;
+    RenderResult result = run_interruptible(cancel, [keep, mutex, &sensor, opts]() {
+        std::lock_guard<std::mutex> lock(*mutex);
+        return render(*keep, sensor, opts);
+    });
 
-    std::map<std::string, std::string> meta;
-    meta["facet:spp"] = std::to_string(used_spp);
+    // The attributes `facet render` writes, so that parts from here and from the CLI merge.
+    std::map<std::string, std::string> meta = render_metadata(result);
+    meta["facet:scene_hash"] =
+        scene_identity(s.text, s.params, result.film_width, result.film_height);
     meta["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
     if (!s.path.empty()) meta["facet:scene"] = s.path;
     meta["facet:seed"] = std::to_string(seed);
     if (result.timed_out)
         meta["facet:blocks"] = fmt::format("{}/{}", result.blocks_done, result.blocks_total);
     return py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
-                          sensor.film().half());
+                          sensor.film().half(), window_of(result.image));
 }
 
 void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast> &pixels,
               const std::vector<std::string> &channels, const std::string &path, bool half,
               const std::map<std::string, std::string> &metadata, const std::string &ocio_config,
-              const std::string &view) {
+              const std::string &view, const std::array<int, 4> &window) {
     Image img = from_array(pixels, channels);
+    img.x = window[0];
+    img.y = window[1];
+    img.full_width = window[2];
+    img.full_height = window[3];
     ImageWriteOptions opts;
     opts.half = half;
     opts.metadata = metadata;
@@ -190,6 +222,44 @@ py::tuple read_py(const std::string &path) {
         img = read_image(path);
     }
     return py::make_tuple(to_array(img), img.channel_names);
+}
+
+/// Merges parts given as file names or as (pixels, channels, metadata, half, window) tuples;
+/// returns (pixels, channels, metadata, half, window, passes).
+py::tuple merge_py(const py::list &items) {
+    std::vector<merge::Part> parts;
+    for (size_t i = 0; i < items.size(); ++i) {
+        py::handle item = items[i];
+        if (py::isinstance<py::str>(item)) {
+            std::string path = item.cast<std::string>();
+            py::gil_scoped_release release;
+            parts.push_back(merge::read_part(path));
+            continue;
+        }
+        auto t = item.cast<py::tuple>();
+        if (t.size() != 5)
+            FACET_THROW("part {}: expected a file name or a rendered facet.Image", i);
+        merge::Part p;
+        p.name = fmt::format("part {}", i);
+        p.image =
+            from_array(t[0].cast<py::array_t<float, py::array::c_style | py::array::forcecast>>(),
+                       t[1].cast<std::vector<std::string>>());
+        p.metadata = t[2].cast<std::map<std::string, std::string>>();
+        p.half = t[3].cast<bool>();
+        auto w = t[4].cast<std::array<int, 4>>();
+        p.x = w[0];
+        p.y = w[1];
+        p.full_width = w[2];
+        p.full_height = w[3];
+        parts.push_back(std::move(p));
+    }
+    merge::Merged m;
+    {
+        py::gil_scoped_release release;
+        m = merge::merge_parts(parts);
+    }
+    return py::make_tuple(to_array(m.image), m.image.channel_names, metadata_dict(m.metadata),
+                          m.half, py::make_tuple(0, 0, m.image.width, m.image.height), m.passes);
 }
 
 /// [(name, kind, description, doc)] of every plugin on the search path.
@@ -283,10 +353,13 @@ PYBIND11_MODULE(_facet, m) {
     m.def("load_string", &load_string_py, py::arg("xml"), py::arg("params"), py::arg("lenient"),
           py::arg("search_path"));
     m.def("render", &render_py, py::arg("scene"), py::arg("spp"), py::arg("seed"),
-          py::arg("sensor"), py::arg("threads"));
+          py::arg("sensor"), py::arg("threads"), py::arg("crop"), py::arg("pass_index"),
+          py::arg("pass_count"));
     m.def("write", &write_py, py::arg("pixels"), py::arg("channels"), py::arg("path"),
-          py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("view"));
+          py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("view"),
+          py::arg("window"));
     m.def("read", &read_py, py::arg("path"));
+    m.def("merge", &merge_py, py::arg("parts"));
     m.def("plugins", &plugins_py);
     m.def("add_plugin_dir",
           [](const std::string &dir) { PluginRegistry::instance().add_search_dir(dir); });
