@@ -19,6 +19,8 @@ int bench_main(int argc, char **argv);
 int compare_main(int argc, char **argv);
 /// `facet merge` (merge_cmd.cpp): puts the parts of a split render back together.
 int merge_main(int argc, char **argv);
+/// `facet colors` (colors_cmd.cpp): the OpenColorIO displays, views and looks.
+int colors_main(int argc, char **argv);
 
 /// `facet chi2` (chi2_cmd.cpp) and `facet new-plugin` (new_plugin_cmd.cpp).
 int chi2_main(int argc, char **argv);

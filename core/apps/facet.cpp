@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <tbb/version.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -30,6 +31,7 @@ Usage:
   facet chi2 bsdf|emitter|microfacet ...
                                        chi-square test of a plugin's sampling against its pdf
   facet new-plugin ...                 start a plugin of your own from the template
+  facet colors                         the OpenColorIO displays, views and looks for 8-bit outputs
 
 Run `facet <command> --help` for the options of a command; `facet --version` prints the
 version.
@@ -85,6 +87,7 @@ int run(int argc, char **argv) {
         {"render", render_main},   {"plugins", plugins_main}, {"bench", bench_main},
         {"compare", compare_main}, {"chi2", chi2_main},       {"new-plugin", new_plugin_main},
         {"merge", merge_main},
+        {"colors", colors_main},
     };
     for (const Command &cmd : commands) {
         if (first == cmd.name) return cmd.run(argc - 1, argv + 1);
@@ -97,8 +100,8 @@ int run(int argc, char **argv) {
         return render_main(argc, argv);
     }
     throw facet::Error(fmt::format("unknown command '{}' (expected render, plugins, bench, "
-                                   "merge, compare, chi2, new-plugin or a scene file; see facet "
-                                   "--help)",
+                                   "merge, compare, chi2, new-plugin, colors or a scene file; see "
+                                   "facet --help)",
                                    first));
 }
 
@@ -123,9 +126,18 @@ int parse(CLI::App &app, int argc, char **argv) {
 
 } // namespace facet::cli
 
+/// A listing that did not reach its destination (a full disk, `facet colors > /dev/full`) is a
+/// failure, not a success.
+static int check_stdout(int code) {
+    if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return code;
+    std::fprintf(stderr, "facet: error: cannot write to standard output: %s\n",
+                 std::strerror(errno));
+    return code != 0 ? code : 1;
+}
+
 int main(int argc, char **argv) {
     try {
-        return run(argc, argv);
+        return check_stdout(run(argc, argv));
     } catch (const std::exception &e) {
         // facet::Error derives from std::exception; its what() carries the scene location.
         std::fflush(stdout);

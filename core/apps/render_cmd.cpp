@@ -5,6 +5,7 @@
 #include <facet/film.h>
 #include <facet/image.h>
 #include <facet/logger.h>
+#include <facet/output_metadata.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
 #include <facet/scene.h>
@@ -12,7 +13,6 @@
 #include <facet/xml.h>
 
 #include <CLI/CLI.hpp>
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <tbb/info.h>
 
@@ -104,15 +104,13 @@ std::string output_path(const std::string &scene, const std::string &out, const 
     return path.string();
 }
 
-/// Catches a bad output name before a long render rather than after it.
-void check_output(const std::string &path) {
+/// Catches a bad output name (or display, view, look) before a long render rather than after it.
+void check_output(const std::string &path, const ImageWriteOptions &wopts) {
     fs::path p(path);
     fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
     if (!fs::is_directory(dir))
         FACET_THROW("cannot write \"{}\": folder \"{}\" does not exist", path, dir.string());
-    if (!OIIO::ImageOutput::create(path))
-        FACET_THROW("cannot write \"{}\": no image format for the extension \"{}\"", path,
-                    p.extension().string());
+    check_image_output(path, wopts); // PFM has no OpenImageIO writer: facet writes it itself
 }
 
 std::string format_seconds(double s) {
@@ -126,7 +124,7 @@ std::string format_seconds(double s) {
 
 int render_main(int argc, char **argv) {
     cli::SceneOptions opts;
-    std::string output, ocio_config, view = "Standard";
+    std::string output, ocio_config, display, view, looks;
     uint64_t seed = 0;
     int spp = 0;
     std::vector<int> crop;
@@ -154,7 +152,12 @@ int render_main(int argc, char **argv) {
         ->type_name("N");
     app.add_option("--ocio-config", ocio_config,
                    "OpenColorIO config for 8-bit outputs (default: $OCIO, else facet's own)");
-    app.add_option("--view", view, "OpenColorIO view for 8-bit outputs: Standard or Raw");
+    app.add_option("--display", display,
+                   "OpenColorIO display for 8-bit outputs (default: the config's default; "
+                   "`facet colors` lists them)");
+    app.add_option("--view", view,
+                   "OpenColorIO view of that display (default: the display's default)");
+    app.add_option("--look", looks, "OpenColorIO looks to apply (\"a, +b, -c\")");
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (app.count("--spp") > 0 && spp < 1)
         FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", spp);
@@ -169,6 +172,14 @@ int render_main(int argc, char **argv) {
                     sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
     const Sensor &sensor = *sensors[size_t(opts.sensor)];
     Film &film = sensor.film();
+
+    std::string out = output_path(opts.scene, output, film);
+    ImageWriteOptions wopts;
+    wopts.ocio_config = ocio_config;
+    wopts.display = display;
+    wopts.view = view;
+    wopts.looks = looks;
+    check_output(out, wopts);
 
     RenderOptions ropts;
     ropts.threads = opts.threads;
@@ -204,8 +215,6 @@ int render_main(int argc, char **argv) {
                              : "";
     int threads = cli::effective_threads(opts.threads);
 
-    std::string out = output_path(opts.scene, output, film);
-    check_output(out);
     // What ties the parts of one render together (checked by a merge).
     std::map<std::string, std::string> params;
     for (const std::string &define : opts.defines) {
@@ -245,14 +254,12 @@ int render_main(int argc, char **argv) {
     }
     uninstall_interrupt_handler();
 
-    ImageWriteOptions wopts;
-    wopts.ocio_config = ocio_config;
-    wopts.view = view;
     wopts.metadata = render_metadata(result);
     wopts.metadata["facet:scene_hash"] = scene_hash;
     wopts.metadata["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
     wopts.metadata["facet:scene"] = fs::absolute(opts.scene).lexically_normal().string();
     wopts.metadata["facet:seed"] = std::to_string(seed);
+    add_render_metadata(wopts, sensor, int(result.spp), result.seconds); // typed, as pbrt-v4 writes
     if (result.cancelled)
         wopts.metadata["facet:blocks"] =
             fmt::format("{}/{}", result.blocks_done, result.blocks_total);

@@ -3,6 +3,7 @@
 #include <facet/spectrum.h>
 
 #include <OpenColorIO/OpenColorIO.h>
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <dlfcn.h>
+#include <fcntl.h>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -37,29 +39,105 @@ bool is_linear_format(const std::string &ext) {
     return ext == ".exr" || ext == ".hdr" || ext == ".rgbe" || ext == ".pfm";
 }
 
-/// CPU processor for (config, display, view), created once per combination.
-OCIO::ConstCPUProcessorRcPtr display_processor(const std::string &config_path,
-                                               const std::string &display,
-                                               const std::string &view) {
+/// The channels of a developed film's colour (and alpha), as opposed to AOV channels.
+bool is_colour_channel(const std::string &name) {
+    return name == "R" || name == "G" || name == "B" || name == "A" || name == "X" || name == "Y" ||
+           name == "Z";
+}
+
+/// Typed attributes of an EXR: the caller's ints, floats and matrices, and the chromaticities
+/// of linear Rec.709 (the space facet renders in) for RGB and luminance images.
+void add_exr_metadata(OIIO::ImageSpec &spec, const ImageWriteOptions &opts) {
+    for (const auto &[key, value] : opts.int_metadata) spec.attribute(key, value);
+    for (const auto &[key, value] : opts.float_metadata) spec.attribute(key, value);
+    for (const auto &[key, value] : opts.matrix_metadata)
+        spec.attribute(key, OIIO::TypeMatrix44, &value.m[0][0]);
+    const bool xyz = spec.nchannels >= 3 && spec.channelnames[0] == "X" &&
+                     spec.channelnames[1] == "Y" && spec.channelnames[2] == "Z";
+    if (!xyz) {
+        // Red, green, blue and white (D65) xy, as OpenEXR's chromaticities attribute orders them.
+        static const float rec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+        spec.attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8), rec709);
+    }
+}
+
+/// The parsed config at `config_path`, read once.
+OCIO::ConstConfigRcPtr load_ocio_config(const std::string &config_path) {
     static std::mutex mutex;
-    static std::map<std::tuple<std::string, std::string, std::string>, OCIO::ConstCPUProcessorRcPtr>
-        cache;
+    static std::map<std::string, OCIO::ConstConfigRcPtr> cache;
     std::lock_guard<std::mutex> lock(mutex);
-    auto key = std::make_tuple(config_path, display, view);
-    auto it = cache.find(key);
+    auto it = cache.find(config_path);
     if (it != cache.end()) return it->second;
     try {
         OCIO::ConstConfigRcPtr config = OCIO::Config::CreateFromFile(config_path.c_str());
-        OCIO::ConstProcessorRcPtr proc = config->getProcessor(
-            OCIO::ROLE_SCENE_LINEAR, display.c_str(), view.c_str(), OCIO::TRANSFORM_DIR_FORWARD);
+        cache.emplace(config_path, config);
+        return config;
+    } catch (const OCIO::Exception &e) {
+        FACET_THROW("cannot read the OpenColorIO config \"{}\": {}", config_path, e.what());
+    }
+}
+
+std::string join_names(const std::vector<std::string> &names) {
+    if (names.empty()) return "(none)";
+    std::string out;
+    for (const auto &n : names) out += (out.empty() ? "\"" : ", \"") + n + "\"";
+    return out;
+}
+
+/// The look names in an OpenColorIO look list ("a, +b, -c", alternatives separated by '|').
+std::vector<std::string> look_names(const std::string &looks) {
+    std::vector<std::string> names;
+    std::string cur;
+    auto flush = [&] {
+        size_t b = cur.find_first_not_of(" \t+-"), e = cur.find_last_not_of(" \t");
+        if (b != std::string::npos && e >= b) names.push_back(cur.substr(b, e - b + 1));
+        cur.clear();
+    };
+    for (char c : looks) {
+        if (c == ',' || c == ':' || c == '|')
+            flush();
+        else
+            cur += c;
+    }
+    flush();
+    return names;
+}
+
+/// CPU processor for (config, display, view, looks), created once per combination.
+OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayView &dv) {
+    static std::mutex mutex;
+    static std::map<std::tuple<std::string, std::string, std::string, std::string>,
+                    OCIO::ConstCPUProcessorRcPtr>
+        cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto key = std::make_tuple(dv.config, dv.display, dv.view, dv.looks);
+    auto it = cache.find(key);
+    if (it != cache.end()) return it->second;
+    try {
+        OCIO::ConstConfigRcPtr config = load_ocio_config(dv.config);
+        OCIO::DisplayViewTransformRcPtr dvt = OCIO::DisplayViewTransform::Create();
+        dvt->setSrc(OCIO::ROLE_SCENE_LINEAR);
+        dvt->setDisplay(dv.display.c_str());
+        dvt->setView(dv.view.c_str());
+        OCIO::ConstProcessorRcPtr proc;
+        if (dv.looks.empty()) {
+            proc = config->getProcessor(dvt);
+        } else {
+            // The looks replace the view's own looks, as in OCIO's viewing pipeline.
+            OCIO::LegacyViewingPipelineRcPtr pipeline = OCIO::LegacyViewingPipeline::Create();
+            pipeline->setDisplayViewTransform(dvt);
+            pipeline->setLooksOverrideEnabled(true);
+            pipeline->setLooksOverride(dv.looks.c_str());
+            proc = pipeline->getProcessor(config);
+        }
         OCIO::ConstCPUProcessorRcPtr cpu = proc->getDefaultCPUProcessor();
         cache.emplace(key, cpu);
         return cpu;
     } catch (const OCIO::Exception &e) {
-        FACET_THROW(
-            "OpenColorIO: cannot build the display transform (display \"{}\", view \"{}\") from "
-            "config \"{}\": {}",
-            display, view, config_path, e.what());
+        FACET_THROW("OpenColorIO: cannot build the display transform (display \"{}\", view "
+                    "\"{}\"{}) from config \"{}\": {}",
+                    dv.display, dv.view, dv.looks.empty() ? "" : ", looks \"" + dv.looks + "\"",
+                    dv.config, e.what());
     }
 }
 
@@ -103,7 +181,7 @@ std::vector<uint8_t> to_display_8bit(const Image &image, const std::vector<int> 
             rgb[i * 3 + 2] = c.b;
         }
     }
-    auto cpu = display_processor(ocio_config_path(opts.ocio_config), opts.display, opts.view);
+    auto cpu = display_processor(resolve_display_view(opts));
     OCIO::PackedImageDesc desc(rgb.data(), long(image.width), long(image.height), 3);
     cpu->apply(desc);
 
@@ -140,40 +218,105 @@ struct TempFileGuard {
     }
 };
 
-/// Portable float map writer. OpenImageIO 2.4 reads PFM but has no PFM writer, and the format
+/// The PFM header encode_pfm() writes.
+std::string pfm_header(int width, int height, int channels) {
+    return fmt::format("{}\n{} {}\n-1.0\n", channels == 1 ? "Pf" : "PF", width, height);
+}
+
+/// Portable float map encoder. OpenImageIO 2.4 reads PFM but has no PFM writer, and the format
 /// is a 3-line header plus raw little-endian floats, bottom row first.
-bool write_pfm(const std::string &file, const float *pixels, int width, int height, int channels,
-               std::string &err) {
-    std::FILE *f = std::fopen(file.c_str(), "wb");
-    if (!f) {
-        err = std::strerror(errno);
-        return false;
-    }
-    bool ok = std::fprintf(f, "%s\n%d %d\n-1.0\n", channels == 1 ? "Pf" : "PF", width, height) > 0;
+std::vector<unsigned char> encode_pfm(const float *pixels, int width, int height, int channels) {
     static_assert(sizeof(float) == 4, "PFM stores 32-bit floats");
-    for (int y = height - 1; ok && y >= 0; --y) {
-        const size_t n = size_t(width) * size_t(channels);
-        ok = std::fwrite(pixels + size_t(y) * n, sizeof(float), n, f) == n;
+    const std::string header = pfm_header(width, height, channels);
+    const size_t row = size_t(width) * size_t(channels) * sizeof(float);
+    std::vector<unsigned char> bytes(header.begin(), header.end());
+    bytes.resize(header.size() + row * size_t(height));
+    for (int y = 0; y < height; ++y)
+        std::memcpy(bytes.data() + header.size() + row * size_t(height - 1 - y),
+                    pixels + size_t(y) * size_t(width) * size_t(channels), row);
+    return bytes;
+}
+
+/// Writes `bytes` to the new file `file`, checking every write, the flush to the disk and the
+/// close: on a full disk one of them fails (with stdio or an image library's own buffering, the
+/// failure can go unnoticed). Returns "" or the reason.
+std::string write_bytes(const std::string &file, const std::vector<unsigned char> &bytes) {
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) return std::strerror(errno);
+    std::string err;
+    size_t done = 0;
+    while (err.empty() && done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n > 0)
+            done += size_t(n);
+        else if (n < 0 && errno == EINTR)
+            continue;
+        else
+            err = n < 0 ? std::strerror(errno) : "no space left";
     }
-    if (!ok) err = std::strerror(errno);
-    if (std::fclose(f) != 0 && ok) {
-        ok = false;
+    // Some file systems (NFS, quotas, delayed allocation) report a full disk only here.
+    if (err.empty() && ::fdatasync(fd) != 0 && errno != EINVAL && errno != EROFS)
         err = std::strerror(errno);
-    }
-    return ok;
+    if (::close(fd) != 0 && err.empty()) err = std::strerror(errno);
+    return err;
+}
+
+/// Checks that the temporary file `file` really holds the image just encoded, before it
+/// replaces anything: its size is that of the encoded bytes, and OpenImageIO reads it back
+/// completely with the expected size and channel count; a PNG's or PFM's pixels must equal the
+/// ones written. Returns "" or what is wrong.
+std::string verify_written(const std::string &file, uintmax_t expected_size,
+                           const OIIO::ImageSpec &spec, const std::string &ext,
+                           const void *pixels) {
+    std::error_code ec;
+    const uintmax_t size = fs::file_size(file, ec);
+    if (ec) return fmt::format("cannot stat the written file: {}", ec.message());
+    if (size != expected_size)
+        return fmt::format("the written file has {} bytes instead of {}", size, expected_size);
+    auto in = OIIO::ImageInput::open(file);
+    if (!in) return fmt::format("the written file cannot be read back: {}", OIIO::geterror());
+    const OIIO::ImageSpec &back = in->spec();
+    // Formats without alpha (JPEG) drop it.
+    const bool dropped_alpha =
+        back.nchannels == spec.nchannels - 1 && spec.alpha_channel == spec.nchannels - 1;
+    if (back.width != spec.width || back.height != spec.height ||
+        (back.nchannels != spec.nchannels && !dropped_alpha))
+        return fmt::format("the written file reads back as {}x{} with {} channels", back.width,
+                           back.height, back.nchannels);
+    const bool compare = ext == ".png" || ext == ".pfm";
+    const OIIO::TypeDesc type = ext == ".png" ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
+    std::vector<unsigned char> data(back.image_pixels() * size_t(back.nchannels) * type.size());
+    bool ok = in->read_image(0, 0, 0, back.nchannels, type, data.data());
+    std::string err = ok ? "" : in->geterror();
+    in->close();
+    if (!ok) return fmt::format("the written file does not read back: {}", err);
+    if (compare && std::memcmp(data.data(), pixels, data.size()) != 0)
+        return "the pixels read back differ from the ones written";
+    return "";
 }
 
 } // namespace
+
+void check_image_path(const std::string &path) {
+    fs::path dir = fs::path(path).parent_path();
+    if (!dir.empty() && !fs::is_directory(dir))
+        FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path,
+                    dir.string());
+    const std::string ext = lower_extension(path);
+    if (ext == ".pfm") return; // facet's own encoder (encode_pfm)
+    if (!OIIO::ImageOutput::create(path)) {
+        std::string err = OIIO::geterror(); // clears OpenImageIO's error state
+        FACET_THROW("cannot write image \"{}\": no image format for the extension \"{}\" ({})",
+                    path, ext, err);
+    }
+}
 
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts) {
     if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
         image.data.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
         FACET_THROW("cannot write image \"{}\": invalid image ({}x{}, {} channels, {} values)",
                     path, image.width, image.height, image.channels, image.data.size());
-    fs::path dir = fs::path(path).parent_path();
-    if (!dir.empty() && !fs::is_directory(dir))
-        FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path,
-                    dir.string());
+    check_image_path(path);
 
     const std::string ext = lower_extension(path);
     const bool pfm = ext == ".pfm";
@@ -204,6 +347,16 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         spec.alpha_channel = -1;
         for (int c = 0; c < image.channels; ++c)
             if (spec.channelnames[c] == "A") spec.alpha_channel = c;
+        if (opts.half) {
+            // Only the leading colour channels are half; AOVs after them stay float32.
+            int colour = 0;
+            while (colour < image.channels && is_colour_channel(spec.channelnames[colour]))
+                ++colour;
+            if (colour < image.channels) {
+                spec.channelformats.assign(size_t(image.channels), OIIO::TypeDesc::FLOAT);
+                for (int c = 0; c < colour; ++c) spec.channelformats[c] = OIIO::TypeDesc::HALF;
+            }
+        }
         spec.attribute("compression", "zip");
         // A crop window: data window at (x, y) inside the full display window.
         spec.x = image.x;
@@ -211,6 +364,7 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         spec.full_x = spec.full_y = 0;
         spec.full_width = image.full_width > 0 ? image.full_width : image.x + image.width;
         spec.full_height = image.full_height > 0 ? image.full_height : image.y + image.height;
+        add_exr_metadata(spec, opts);
         pixels = image.data.data();
         pixel_type = OIIO::TypeDesc::FLOAT;
     } else {
@@ -238,16 +392,16 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
     }
     for (const auto &[key, value] : opts.metadata) spec.attribute(key, value);
 
-    const std::string tmp = temp_path_for(path);
-    TempFileGuard guard{tmp};
+    // The encoder writes to memory; facet writes the file itself and checks every step (an
+    // image library's own file output may miss a full disk, or even exit the process).
+    std::vector<unsigned char> bytes;
     if (pfm) {
-        std::string err;
-        if (!write_pfm(tmp, static_cast<const float *>(pixels), spec.width, spec.height,
-                       spec.nchannels, err))
-            FACET_THROW("cannot write image \"{}\": {}", path, err);
-    } else if (!out->open(tmp, spec))
-        FACET_THROW("cannot write image \"{}\": {}", path, out->geterror());
-    if (out) {
+        bytes =
+            encode_pfm(static_cast<const float *>(pixels), spec.width, spec.height, spec.nchannels);
+    } else {
+        OIIO::Filesystem::IOVecOutput memory(bytes);
+        if (!out->set_ioproxy(&memory) || !out->open(path, spec))
+            FACET_THROW("cannot write image \"{}\": {}", path, out->geterror());
         bool ok = out->write_image(pixel_type, pixels);
         std::string err = ok ? "" : out->geterror();
         if (!out->close() && ok) {
@@ -257,10 +411,105 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         out.reset();
         if (!ok) FACET_THROW("cannot write image \"{}\": {}", path, err);
     }
+    const std::string tmp = temp_path_for(path);
+    TempFileGuard guard{tmp};
+    const char *kept = fs::exists(path) ? "the existing file is unchanged" : "nothing was written";
+    if (std::string err = write_bytes(tmp, bytes); !err.empty())
+        FACET_THROW("cannot write image \"{}\": {}; {}", path, err, kept);
+    // Nothing replaces the old file unless the new one reads back complete.
+    if (std::string bad = verify_written(tmp, bytes.size(), spec, ext, pixels); !bad.empty())
+        FACET_THROW("cannot write image \"{}\": {} (disk full?); {}", path, bad, kept);
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
         FACET_THROW("cannot write image \"{}\": renaming the temporary file failed: {}", path,
                     std::strerror(errno));
     guard.armed = false;
+}
+
+OcioDisplays ocio_displays(const std::string &explicit_path) {
+    OcioDisplays out;
+    out.config = ocio_config_path(explicit_path);
+    OCIO::ConstConfigRcPtr config = load_ocio_config(out.config);
+    out.description = config->getDescription() ? config->getDescription() : "";
+    const char *def = config->getDefaultDisplay();
+    out.default_display = def ? def : "";
+    for (int i = 0, n = config->getNumDisplays(); i < n; ++i) {
+        OcioDisplays::Display d;
+        d.name = config->getDisplay(i);
+        const char *dview = config->getDefaultView(d.name.c_str());
+        d.default_view = dview ? dview : "";
+        for (int j = 0, m = config->getNumViews(d.name.c_str()); j < m; ++j)
+            d.views.push_back(config->getView(d.name.c_str(), j));
+        out.displays.push_back(std::move(d));
+    }
+    for (int i = 0, n = config->getNumLooks(); i < n; ++i)
+        out.looks.push_back(config->getLookNameByIndex(i));
+    return out;
+}
+
+DisplayView resolve_display_view(const ImageWriteOptions &opts) {
+    const OcioDisplays all = ocio_displays(opts.ocio_config);
+    OCIO::ConstConfigRcPtr config = load_ocio_config(all.config);
+    DisplayView dv;
+    dv.config = all.config;
+    dv.display = opts.display.empty() ? all.default_display : opts.display;
+    dv.looks = opts.looks;
+    std::vector<std::string> display_names;
+    for (const auto &d : all.displays) display_names.push_back(d.name);
+    const OcioDisplays::Display *display = nullptr;
+    for (const auto &d : all.displays)
+        if (d.name == dv.display) display = &d;
+    // A display the config defines but does not list as active is still valid.
+    const bool inactive =
+        !display && !dv.display.empty() && config->getDisplayAllByName(dv.display.c_str()) >= 0;
+    if (!display && !inactive)
+        FACET_THROW("the OpenColorIO config \"{}\" has no display \"{}\"; its displays: {} "
+                    "(default \"{}\")",
+                    all.config, dv.display, join_names(display_names), all.default_display);
+    std::vector<std::string> views;
+    std::string default_view;
+    if (display) {
+        views = display->views;
+        default_view = display->default_view;
+    } else {
+        for (int j = 0, m = config->getNumViews(OCIO::VIEW_DISPLAY_DEFINED, dv.display.c_str());
+             j < m; ++j)
+            views.push_back(config->getView(OCIO::VIEW_DISPLAY_DEFINED, dv.display.c_str(), j));
+        default_view = config->getDefaultView(dv.display.c_str());
+    }
+    dv.view = opts.view.empty() ? default_view : opts.view;
+    if (std::find(views.begin(), views.end(), dv.view) == views.end()) {
+        // Inactive views of the display are valid too.
+        bool defined = false;
+        for (int j = 0, m = config->getNumViews(OCIO::VIEW_DISPLAY_DEFINED, dv.display.c_str());
+             j < m; ++j)
+            defined |=
+                dv.view == config->getView(OCIO::VIEW_DISPLAY_DEFINED, dv.display.c_str(), j);
+        for (int j = 0, m = config->getNumViews(OCIO::VIEW_SHARED, dv.display.c_str()); j < m; ++j)
+            defined |= dv.view == config->getView(OCIO::VIEW_SHARED, dv.display.c_str(), j);
+        if (!defined)
+            FACET_THROW("the display \"{}\" of the OpenColorIO config \"{}\" has no view \"{}\"; "
+                        "its views: {} (default \"{}\")",
+                        dv.display, all.config, dv.view, join_names(views), default_view);
+    }
+    for (const std::string &look : look_names(dv.looks))
+        if (!config->getLook(look.c_str()))
+            FACET_THROW("the OpenColorIO config \"{}\" has no look \"{}\"; its looks: {}",
+                        all.config, look, join_names(all.looks));
+    return dv;
+}
+
+void check_image_output(const std::string &path, const ImageWriteOptions &opts) {
+    check_image_path(path);
+    const std::string ext = lower_extension(path);
+    if (ext == ".exr" || is_linear_format(ext)) {
+        if (!opts.display.empty() || !opts.view.empty() || !opts.looks.empty())
+            FACET_LOG(Warn,
+                      "\"{}\" stays scene-linear: the OpenColorIO display, view and looks apply "
+                      "to 8-bit outputs (.png, .jpg) only",
+                      path);
+        return;
+    }
+    resolve_display_view(opts);
 }
 
 Image read_image(const std::string &path) {

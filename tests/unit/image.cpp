@@ -4,7 +4,10 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -138,14 +141,17 @@ TEST_F(ImageIO, PngGoesThroughTheSrgbDisplayTransform) {
     Image r = read_image(path("raw.png"));
     EXPECT_NEAR(int(std::lround(r.at(1, 0, 0) * 255.f)), 128, 1);
 
-    // An unknown view names the problem.
+    // An unknown view names the problem and the display's views.
     ImageWriteOptions bad;
-    bad.view = "Filmic";
+    bad.view = "NoSuchView";
     try {
         write_image(path("bad.png"), img, bad);
         FAIL() << "expected an error";
     } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find("Filmic"), std::string::npos) << e.what();
+        std::string msg = e.what();
+        EXPECT_NE(msg.find("NoSuchView"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("\"Standard\", \"ACES 1.0 - SDR Video\", \"Raw\""), std::string::npos)
+            << msg;
     }
     EXPECT_FALSE(fs::exists(path("bad.png")));
 }
@@ -183,6 +189,58 @@ TEST_F(ImageIO, LinearFloatFormats) {
         float m = std::max(img.data[p], std::max(img.data[p + 1], img.data[p + 2]));
         for (size_t c = p; c < p + 3; ++c) EXPECT_NEAR(hdr.data[c], img.data[c], m / 128.f);
     }
+}
+
+TEST_F(ImageIO, PfmIsBottomRowFirstLittleEndianAndReadsBack) {
+    // Every pixel different, so a flipped or transposed file cannot pass.
+    Image img(4, 3, 3);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x)
+            for (int c = 0; c < 3; ++c) img.at(x, y, c) = float(100 * y + 10 * x + c) + 0.25f;
+    img.channel_names = {"R", "G", "B"};
+    check_image_path(path("a.pfm")); // no OpenImageIO writer, but facet writes it
+    write_image(path("a.pfm"), img);
+    const std::string bytes = file_bytes(path("a.pfm"));
+    const std::string header = "PF\n4 3\n-1.0\n"; // RGB, little-endian (negative scale)
+    ASSERT_EQ(bytes.substr(0, header.size()), header);
+    ASSERT_EQ(bytes.size(), header.size() + 4 * 3 * 3 * sizeof(float));
+    auto stored = [&](size_t i) {
+        float v;
+        std::memcpy(&v, bytes.data() + header.size() + i * sizeof(float), sizeof(float));
+        return v;
+    };
+    EXPECT_EQ(stored(0), img.at(0, 2, 0)); // the file starts with the bottom row
+    EXPECT_EQ(stored(3 * 4 * 2 + 3 * 1 + 2), img.at(1, 0, 2));
+    Image back = read_image(path("a.pfm"));
+    ASSERT_EQ(back.width, 4);
+    ASSERT_EQ(back.height, 3);
+    ASSERT_EQ(back.channels, 3);
+    EXPECT_EQ(back.data, img.data); // same orientation as written
+
+    // Grey (and grey + alpha) become a one-channel "Pf"; RGBA drops alpha and AOVs.
+    Image grey(2, 2, 2);
+    for (int i = 0; i < 8; ++i) grey.data[size_t(i)] = float(i);
+    grey.channel_names = {"Y", "A"};
+    write_image(path("g.pfm"), grey);
+    EXPECT_EQ(file_bytes(path("g.pfm")).substr(0, 10), "Pf\n2 2\n-1.");
+    Image gback = read_image(path("g.pfm"));
+    ASSERT_EQ(gback.channels, 1);
+    EXPECT_EQ(gback.at(1, 1, 0), 6.f);
+    Image rgba = gradient(3, 2, 5);
+    rgba.channel_names = {"R", "G", "B", "A", "depth"};
+    write_image(path("c.pfm"), rgba);
+    Image cback = read_image(path("c.pfm"));
+    ASSERT_EQ(cback.channels, 3);
+    EXPECT_EQ(cback.at(2, 1, 2), rgba.at(2, 1, 2));
+    EXPECT_EQ(listing(), (std::vector<std::string>{"a.pfm", "c.pfm", "g.pfm"}));
+}
+
+TEST_F(ImageIO, CheckImagePathRefusesWhatWriteImageWouldRefuse) {
+    for (const char *ok : {"a.exr", "a.png", "a.jpg", "a.hdr", "a.pfm", "A.PFM", "a.tif"})
+        EXPECT_NO_THROW(check_image_path(path(ok))) << ok;
+    EXPECT_THROW(check_image_path(path("a.notaformat")), Error);
+    EXPECT_THROW(check_image_path(path("missing/a.pfm")), Error);
+    EXPECT_TRUE(listing().empty()); // checking writes nothing
 }
 
 TEST_F(ImageIO, MissingFolderFailsClearlyWithoutTempFiles) {
@@ -229,6 +287,76 @@ TEST_F(ImageIO, FailedWriteLeavesTheOldFileUntouched) {
     EXPECT_EQ(listing(), (std::vector<std::string>{"dir.exr", "keep.exr"}));
 }
 
+namespace {
+
+/// Noise, so that compressed files are large.
+Image noise(int w, int h, int c) {
+    Image img(w, h, c);
+    uint32_t state = 12345u;
+    for (float &v : img.data) {
+        state = state * 1664525u + 1013904223u;
+        v = float(state >> 8) / float(1u << 24);
+    }
+    return img;
+}
+
+/// Within its scope every write past `bytes` bytes of a file fails with EFBIG (SIGXFSZ is
+/// ignored), as writes do on a full disk.
+class FileSizeLimit {
+public:
+    explicit FileSizeLimit(rlim_t bytes) {
+        m_old_handler = std::signal(SIGXFSZ, SIG_IGN);
+        getrlimit(RLIMIT_FSIZE, &m_old);
+        rlimit lim = m_old;
+        lim.rlim_cur = bytes;
+        m_ok = setrlimit(RLIMIT_FSIZE, &lim) == 0;
+    }
+    ~FileSizeLimit() {
+        setrlimit(RLIMIT_FSIZE, &m_old);
+        std::signal(SIGXFSZ, m_old_handler);
+    }
+    bool ok() const { return m_ok; }
+
+private:
+    rlimit m_old{};
+    void (*m_old_handler)(int) = nullptr;
+    bool m_ok = false;
+};
+
+} // namespace
+
+TEST_F(ImageIO, WriteThatRunsOutOfSpaceKeepsTheOldFileAndFails) {
+    for (const char *name : {"full.png", "full.exr", "full.pfm", "full.jpg", "full.hdr"}) {
+        SCOPED_TRACE(name);
+        Image small = noise(8, 8, 3);
+        small.channel_names = {"R", "G", "B"};
+        write_image(path(name), small);
+        const std::string before = file_bytes(path(name));
+        ASSERT_FALSE(before.empty());
+
+        Image big = noise(96, 96, 3);
+        big.channel_names = {"R", "G", "B"};
+        {
+            // Enough for the small file, far too little for the big one.
+            FileSizeLimit limit(before.size() + 600);
+            ASSERT_TRUE(limit.ok());
+            try {
+                write_image(path(name), big);
+                ADD_FAILURE() << "a write that ran out of space reported success";
+            } catch (const Error &e) {
+                std::string msg = e.what();
+                EXPECT_NE(msg.find(name), std::string::npos) << msg;
+            }
+        }
+        EXPECT_EQ(file_bytes(path(name)), before); // the old file, untouched
+        // No temporary file is left behind.
+        for (const std::string &f : listing()) EXPECT_EQ(f.find(".tmp"), std::string::npos) << f;
+        // Without the limit the same write works.
+        write_image(path(name), big);
+        EXPECT_EQ(read_image(path(name)).width, 96);
+    }
+}
+
 TEST_F(ImageIO, OverwriteReplacesAtomically) {
     write_image(path("x.exr"), gradient(3, 3, 3));
     Image second = gradient(3, 3, 3);
@@ -268,4 +396,205 @@ TEST(OcioConfig, SearchOrder) {
     EXPECT_EQ(fs::weakly_canonical(installed),
               fs::weakly_canonical(fs::path(FACET_BINARY_DIR) / "share" / "facet" / "ocio.config"));
     if (old) ::setenv("OCIO", saved.c_str(), 1);
+}
+
+TEST_F(ImageIO, ExrTypedMetadataAndRec709Chromaticities) {
+    Image img = gradient(4, 3, 3);
+    img.channel_names = {"R", "G", "B"};
+    ImageWriteOptions opts;
+    opts.half = true;
+    opts.int_metadata["samplesPerPixel"] = 488;
+    opts.float_metadata["renderTimeSeconds"] = 12.5f;
+    Matrix4f m;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) m.m[i][j] = float(4 * i + j) + 0.5f;
+    opts.matrix_metadata["worldToCamera"] = m;
+    write_image(path("m.exr"), img, opts);
+
+    auto in = OIIO::ImageInput::open(path("m.exr"));
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec &spec = in->spec();
+    const OIIO::ParamValue *p = spec.find_attribute("samplesPerPixel");
+    ASSERT_TRUE(p);
+    EXPECT_EQ(p->type(), OIIO::TypeInt);
+    EXPECT_EQ(p->get_int(), 488);
+    p = spec.find_attribute("renderTimeSeconds");
+    ASSERT_TRUE(p);
+    EXPECT_EQ(p->type(), OIIO::TypeFloat);
+    EXPECT_EQ(p->get_float(), 12.5f);
+    p = spec.find_attribute("worldToCamera");
+    ASSERT_TRUE(p) << "attributes: " << spec.serialize(OIIO::ImageSpec::SerialText);
+    EXPECT_EQ(p->type(), OIIO::TypeMatrix44);
+    const float *v = static_cast<const float *>(p->data());
+    for (int k = 0; k < 16; ++k) EXPECT_EQ(v[k], float(k) + 0.5f) << k; // row-major, in order
+    p = spec.find_attribute("chromaticities");
+    ASSERT_TRUE(p);
+    ASSERT_EQ(p->type(), OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8));
+    const float *c = static_cast<const float *>(p->data());
+    const float rec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+    for (int k = 0; k < 8; ++k) EXPECT_FLOAT_EQ(c[k], rec709[k]) << k;
+    in->close();
+
+    // XYZ pixels are not Rec.709: no chromaticities are claimed for them.
+    img.channel_names = {"X", "Y", "Z"};
+    write_image(path("xyz.exr"), img, opts);
+    in = OIIO::ImageInput::open(path("xyz.exr"));
+    ASSERT_TRUE(in);
+    EXPECT_FALSE(in->spec().find_attribute("chromaticities"));
+}
+
+TEST_F(ImageIO, HalfExrKeepsAovChannelsFloat32) {
+    Image img(3, 2, 6);
+    img.channel_names = {"R", "G", "B", "A", "prim", "dd"};
+    for (int i = 0; i < 6; ++i) {
+        float *px = img.data.data() + size_t(i) * 6;
+        px[0] = 0.3f + 0.1f * float(i);
+        px[1] = px[2] = 0.5f;
+        px[3] = 1.f;
+        px[4] = float(980000 + i);    // a primitive index: infinity as a half
+        px[5] = 1234.567f + float(i); // a depth: 1235 as a half
+    }
+    ImageWriteOptions opts;
+    opts.half = true;
+    write_image(path("aov.exr"), img, opts);
+    auto in = OIIO::ImageInput::open(path("aov.exr"));
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec &spec = in->spec();
+    for (int c = 0; c < spec.nchannels; ++c) {
+        const std::string &name = spec.channelnames[c];
+        OIIO::TypeDesc t = spec.channelformat(c);
+        if (name == "prim" || name == "dd")
+            EXPECT_EQ(t, OIIO::TypeDesc::FLOAT) << name;
+        else
+            EXPECT_EQ(t, OIIO::TypeDesc::HALF) << name; // colour and alpha stay half
+    }
+    in->close();
+    Image back = read_image(path("aov.exr"));
+    auto channel = [&](const std::string &n) {
+        return int(std::find(back.channel_names.begin(), back.channel_names.end(), n) -
+                   back.channel_names.begin());
+    };
+    const int prim = channel("prim"), dd = channel("dd");
+    ASSERT_LT(prim, back.channels);
+    ASSERT_LT(dd, back.channels);
+    for (int i = 0; i < 6; ++i) {
+        EXPECT_EQ(back.data[size_t(i) * back.channels + prim], float(980000 + i));
+        EXPECT_EQ(back.data[size_t(i) * back.channels + dd], 1234.567f + float(i));
+    }
+}
+
+namespace {
+
+/// Points $OCIO at the test config (without an sRGB display) for one scope.
+class StudioOcio {
+public:
+    StudioOcio() {
+        const char *old = std::getenv("OCIO");
+        m_had = old != nullptr;
+        if (old) m_old = old;
+        ::setenv("OCIO", FACET_TEST_DATA_DIR "/ocio/studio.config", 1);
+    }
+    ~StudioOcio() {
+        if (m_had)
+            ::setenv("OCIO", m_old.c_str(), 1);
+        else
+            ::unsetenv("OCIO");
+    }
+
+private:
+    bool m_had = false;
+    std::string m_old;
+};
+
+Image flat(float v) {
+    Image img(2, 2, 3);
+    std::fill(img.data.begin(), img.data.end(), v);
+    img.channel_names = {"R", "G", "B"};
+    return img;
+}
+
+} // namespace
+
+TEST_F(ImageIO, PngUsesTheConfigsDefaultDisplayAndView) {
+    StudioOcio studio;
+    auto code = [&](const std::string &name, const ImageWriteOptions &opts, float v = 0.25f) {
+        write_image(path(name), flat(v), opts);
+        return int(std::lround(read_image(path(name)).at(1, 1, 0) * 255.f));
+    };
+    ImageWriteOptions opts;
+    EXPECT_EQ(code("default.png", opts), 128); // Studio Monitor / Film: 0.25^(1/2)
+    opts.view = "Linear";
+    EXPECT_EQ(code("linear.png", opts), 64);
+    opts.view = "Pushed Film";                // the view's own look doubles first
+    EXPECT_EQ(code("pushed.png", opts), 180); // 255 sqrt(0.5)
+    opts.view = "";
+    opts.looks = "push";
+    EXPECT_EQ(code("look.png", opts), 180);
+    opts.looks = "push, dim"; // x2, then x0.5
+    EXPECT_EQ(code("looks.png", opts), 128);
+    opts.looks = "";
+    opts.display = "Projector"; // its default view, Lin
+    EXPECT_EQ(code("projector.png", opts), 64);
+
+    DisplayView dv = resolve_display_view({});
+    EXPECT_EQ(dv.display, "Studio Monitor");
+    EXPECT_EQ(dv.view, "Film");
+
+    OcioDisplays all = ocio_displays();
+    EXPECT_EQ(all.default_display, "Studio Monitor");
+    ASSERT_EQ(all.displays.size(), 2u);
+    EXPECT_EQ(all.displays[0].views, (std::vector<std::string>{"Film", "Linear", "Pushed Film"}));
+    EXPECT_EQ(all.looks, (std::vector<std::string>{"push", "dim"}));
+}
+
+TEST_F(ImageIO, WrongDisplayViewOrLookListsTheChoices) {
+    StudioOcio studio;
+    auto error = [&](const ImageWriteOptions &opts) -> std::string {
+        try {
+            write_image(path("x.png"), flat(0.5f), opts);
+        } catch (const Error &e) {
+            return e.what();
+        }
+        return "no error";
+    };
+    ImageWriteOptions opts;
+    opts.display = "sRGB"; // the name facet's own config uses
+    std::string msg = error(opts);
+    EXPECT_NE(msg.find("no display \"sRGB\""), std::string::npos) << msg;
+    EXPECT_NE(msg.find("\"Studio Monitor\", \"Projector\""), std::string::npos) << msg;
+    opts.display = "Studio Monitor";
+    opts.view = "Standard";
+    msg = error(opts);
+    EXPECT_NE(msg.find("no view \"Standard\""), std::string::npos) << msg;
+    EXPECT_NE(msg.find("\"Film\", \"Linear\", \"Pushed Film\""), std::string::npos) << msg;
+    opts.view = "";
+    opts.looks = "push, +glow";
+    msg = error(opts);
+    EXPECT_NE(msg.find("no look \"glow\""), std::string::npos) << msg;
+    EXPECT_NE(msg.find("\"push\", \"dim\""), std::string::npos) << msg;
+    EXPECT_TRUE(listing().empty());
+    // Linear formats do not go through the display: the same options only warn.
+    EXPECT_NO_THROW(check_image_output(path("x.exr"), opts));
+    EXPECT_THROW(check_image_output(path("x.png"), opts), Error);
+}
+
+TEST_F(ImageIO, FacetConfigHasAFilmicView) {
+    // ACES 1.0 SDR video: highlights roll off instead of clipping, mid grey is darker than the
+    // plain sRGB curve puts it, and the config needs no LUT file.
+    ImageWriteOptions aces;
+    aces.view = "ACES 1.0 - SDR Video";
+    ImageWriteOptions standard;
+    auto code = [&](const ImageWriteOptions &opts, float v) {
+        write_image(path("v.png"), flat(v), opts);
+        return int(std::lround(read_image(path("v.png")).at(0, 0, 1) * 255.f));
+    };
+    EXPECT_EQ(code(standard, 4.f), 255);
+    EXPECT_EQ(code(standard, 8.f), 255);
+    const int a4 = code(aces, 4.f), a8 = code(aces, 8.f), a18 = code(aces, 0.18f);
+    EXPECT_LT(a4, 255);
+    EXPECT_LT(a4, a8); // still distinguishes 4 from 8
+    EXPECT_EQ(code(standard, 0.18f), 118);
+    EXPECT_GT(a18, 60);
+    EXPECT_LT(a18, 118);
+    EXPECT_EQ(code(aces, 0.f), 0);
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <facet/assert.h>
+#include <facet/transform.h>
 
 #include <map>
 #include <string>
@@ -31,17 +32,61 @@ struct Image {
 };
 
 struct ImageWriteOptions {
-    bool half = false;       ///< float16 for EXR
+    /// EXR: float16 for the colour channels (the leading R, G, B, A, X, Y, Z channels of a
+    /// developed film). AOV channels after them always stay float32: a half holds integers
+    /// exactly only up to 2048 and overflows to infinity above 65504 (primitive indices, depths).
+    bool half = false;
     std::string ocio_config; ///< "" = $OCIO, else the installed config
-    std::string display = "sRGB";
-    std::string view = "Standard";
-    std::map<std::string, std::string> metadata;
+    std::string display;     ///< OpenColorIO display; "" = the config's default display
+    std::string view;        ///< view of that display; "" = the display's default view
+    /// OpenColorIO looks ("a, +b, -c"); "" = only the view's own. Given, they replace the view's.
+    std::string looks;
+    std::map<std::string, std::string> metadata; ///< string attributes (every format that has them)
+    /// Typed EXR attributes (other formats ignore them): int, float and 4×4 float matrices
+    /// (Matrix4f's row-major elements in order, as pbrt-v4 stores its matrices).
+    std::map<std::string, int> int_metadata;
+    std::map<std::string, float> float_metadata;
+    std::map<std::string, Matrix4f> matrix_metadata;
 };
 
-/// Writes with OpenImageIO to a temporary file next to `path`, then renames it over `path`.
-/// .exr/.hdr/.pfm stay scene-linear; 8-bit formats (.png, .jpg, ...) go through the OpenColorIO
-/// display/view transform of the chosen config.
+/// Writes with OpenImageIO (PFM: facet's own writer) to a temporary file next to `path`, checks
+/// that file (read back; see verify_written in image.cpp), then renames it over `path`: a failed
+/// write throws and leaves an existing `path` untouched. .exr/.hdr/.pfm stay scene-linear (an RGB
+/// EXR is tagged with the Rec.709 chromaticities); 8-bit formats (.png, .jpg, ...) go through
+/// the OpenColorIO display/view transform of the chosen config.
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts = {});
+/// Throws the error write_image() would give for `path` before any pixel exists: a missing folder
+/// or an extension no writer knows (.pfm is written by facet itself, the rest by OpenImageIO).
+/// Lets a command refuse a bad output name before a long render.
+void check_image_path(const std::string &path);
+/// check_image_path(), and for 8-bit formats resolve_display_view(): a wrong display, view or
+/// look name fails before a long render. Warns when display options meet a linear format.
+void check_image_output(const std::string &path, const ImageWriteOptions &opts);
+
+/// What an OpenColorIO config offers 8-bit outputs: its (active) displays in order, each with
+/// its views, and its looks.
+struct OcioDisplays {
+    struct Display {
+        std::string name, default_view;
+        std::vector<std::string> views;
+    };
+    std::string config; ///< path of the config
+    std::string description, default_display;
+    std::vector<Display> displays;
+    std::vector<std::string> looks;
+};
+/// Reads the config ocio_config_path(`config_path`) (parsed once per path).
+OcioDisplays ocio_displays(const std::string &config_path = "");
+
+/// The display transform of an 8-bit output.
+struct DisplayView {
+    std::string config, display, view, looks;
+};
+/// `opts`'s display, view and looks resolved in its config: the config's default display and
+/// that display's default view stand for empty names. A name the config does not have throws an
+/// error listing the config's displays, the display's views or the config's looks.
+DisplayView resolve_display_view(const ImageWriteOptions &opts);
+
 /// Reads any format OpenImageIO knows; 8-bit images are returned as stored (no decoding).
 Image read_image(const std::string &path);
 /// Path of the OCIO config facet uses: `explicit_path`, else $OCIO, else the installed one.
