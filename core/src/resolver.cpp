@@ -1,3 +1,4 @@
+#include <facet/checked.h>
 #include <facet/logger.h>
 #include <facet/resolver.h>
 
@@ -30,12 +31,35 @@ FileResolver &file_resolver() {
 }
 
 std::string read_file(const std::string &path, const std::string &what) {
+    // Only regular files: a device (/dev/zero, /dev/urandom) or a FIFO would be read until
+    // memory runs out, a folder fails later with a less clear error.
+    std::error_code ec;
+    fs::file_status st = fs::status(path, ec);
+    if (!fs::exists(st)) FACET_THROW("{}: cannot open \"{}\" (no such file)", what, path);
+    if (!fs::is_regular_file(st))
+        FACET_THROW("{}: cannot read \"{}\": not a regular file", what, path);
     std::FILE *f = std::fopen(path.c_str(), "rb");
     if (!f) FACET_THROW("{}: cannot open \"{}\"", what, path);
+    uintmax_t expected = fs::file_size(path, ec);
     std::string data;
+    if (!ec) {
+        try {
+            data.reserve(allocation_bytes(size_t(expected), 1, path, "file contents"));
+        } catch (...) {
+            std::fclose(f);
+            throw;
+        }
+    }
     char buf[1 << 16];
     size_t n;
-    while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0) data.append(buf, n);
+    while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0) {
+        // A file that grows while it is read must not grow without bound either.
+        if (data.size() + n > allocation_limit()) {
+            std::fclose(f);
+            allocation_bytes(data.size() + n, 1, path, "file contents");
+        }
+        data.append(buf, n);
+    }
     bool failed = std::ferror(f) != 0;
     std::fclose(f);
     if (failed) FACET_THROW("{}: error while reading \"{}\"", what, path);

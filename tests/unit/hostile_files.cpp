@@ -56,3 +56,70 @@ TEST(CheckedArithmetic, OverflowIsDetected) {
         EXPECT_CONTAINS(e.what(), "mesh.ply:3: vertex positions");
     }
 }
+namespace {
+
+class TempDir {
+public:
+    TempDir() {
+        static int counter = 0;
+        m_path = fs::temp_directory_path() /
+                 fmt::format("facet_hostile_{}_{}", long(::getpid()), counter++);
+        fs::create_directories(m_path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(m_path, ec);
+    }
+    std::string write(const std::string &name, const std::string &content) const {
+        std::string p = (m_path / name).string();
+        std::ofstream(p, std::ios::binary) << content;
+        return p;
+    }
+
+private:
+    fs::path m_path;
+};
+
+std::shared_ptr<Object> load(ObjectType kind, const std::string &type, const std::string &path) {
+    Properties props(type);
+    props.set_string("filename", path);
+    return PluginRegistry::instance().create(kind, props);
+}
+
+/// The facet::Error message of loading `path` with plugin `type` (a test failure otherwise,
+/// including for any other exception type).
+std::string error_of(const std::string &type, const std::string &path,
+                     ObjectType kind = ObjectType::Shape) {
+    try {
+        load(kind, type, path);
+    } catch (const Error &e) {
+        return e.what();
+    } catch (const std::exception &e) {
+        ADD_FAILURE() << "expected a facet::Error, got " << typeid(e).name() << ": " << e.what();
+        return "";
+    }
+    ADD_FAILURE() << "expected a facet::Error";
+    return "";
+}
+
+} // namespace
+
+// --- devices and other non-files -----------------------------------------------------------------
+
+TEST(HostileFiles, DevicesAreNotReadUntilMemoryRunsOut) {
+    if (!fs::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero on this system";
+    for (const char *type : {"ply", "obj"}) {
+        SCOPED_TRACE(type);
+        std::string msg = error_of(type, "/dev/zero");
+        EXPECT_CONTAINS(msg, "/dev/zero");
+        EXPECT_CONTAINS(msg, "not a regular file");
+    }
+    std::string msg = error_of("bitmap", "/dev/zero", ObjectType::Texture);
+    EXPECT_CONTAINS(msg, "not a regular file");
+    TempDir dir;
+    fs::path folder = fs::temp_directory_path() / fmt::format("facet_hostile_dir_{}", ::getpid());
+    fs::create_directories(folder);
+    msg = error_of("obj", folder.string());
+    EXPECT_CONTAINS(msg, "not a regular file");
+    fs::remove_all(folder);
+}
