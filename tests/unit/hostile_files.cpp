@@ -108,7 +108,7 @@ std::string error_of(const std::string &type, const std::string &path,
 
 TEST(HostileFiles, DevicesAreNotReadUntilMemoryRunsOut) {
     if (!fs::exists("/dev/zero")) GTEST_SKIP() << "no /dev/zero on this system";
-    for (const char *type : {"ply", "obj"}) {
+    for (const char *type : {"ply", "obj", "serialized"}) {
         SCOPED_TRACE(type);
         std::string msg = error_of(type, "/dev/zero");
         EXPECT_CONTAINS(msg, "/dev/zero");
@@ -122,4 +122,105 @@ TEST(HostileFiles, DevicesAreNotReadUntilMemoryRunsOut) {
     msg = error_of("obj", folder.string());
     EXPECT_CONTAINS(msg, "not a regular file");
     fs::remove_all(folder);
+}
+
+namespace {
+
+template <typename T> void put(std::string &s, T v) {
+    char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    s.append(b, sizeof(T));
+}
+
+std::string deflate(const std::string &raw) {
+    uLongf size = compressBound(uLong(raw.size()));
+    std::string packed(size, '\0');
+    EXPECT_EQ(compress(reinterpret_cast<Bytef *>(packed.data()), &size,
+                       reinterpret_cast<const Bytef *>(raw.data()), uLong(raw.size())),
+              Z_OK);
+    packed.resize(size);
+    return packed;
+}
+
+/// A version-4 serialized file holding one mesh whose stream is `raw`, and whose offset table entry
+/// is `offset` (the real offset, 0, unless a test forges one).
+std::string serialized_file(const std::string &raw, uint64_t offset = 0) {
+    std::string file;
+    put<uint16_t>(file, 0x041C);
+    put<uint16_t>(file, 4);
+    file += deflate(raw);
+    put<uint64_t>(file, offset);
+    put<uint32_t>(file, 1);
+    return file;
+}
+
+/// The inflated stream of a single-precision mesh: flags, name, counts, then the arrays.
+std::string serialized_stream(uint64_t nv, uint64_t nf, size_t real_values, size_t indices) {
+    std::string raw;
+    put<uint32_t>(raw, 0x1000);
+    raw += "m";
+    raw.push_back('\0');
+    put<uint64_t>(raw, nv);
+    put<uint64_t>(raw, nf);
+    for (size_t i = 0; i < real_values; ++i) put<float>(raw, float(i % 3));
+    for (size_t i = 0; i < indices; ++i) put<uint32_t>(raw, uint32_t(i % 3));
+    return raw;
+}
+
+} // namespace
+
+// --- serialized ----------------------------------------------------------------------------------
+
+TEST(HostileSerialized, OffsetNearTwoToThe64) {
+    TempDir dir;
+    // begin + 4 wrapped to 2, passed `begin + 4 <= end`, and the header was read 2 bytes before the
+    // buffer.
+    std::string file = serialized_file(serialized_stream(3, 1, 9, 3), ~uint64_t(0) - 1);
+    std::string msg = error_of("serialized", dir.write("offset.serialized", file));
+    EXPECT_CONTAINS(msg, "offset.serialized");
+    EXPECT_CONTAINS(msg, "corrupt offset for mesh 0");
+}
+
+TEST(HostileSerialized, CountsWhoseSizesWrapAround) {
+    TempDir dir;
+    // 2^62 vertices: 12 bytes each wraps to 0, which passed the size check.
+    std::string file = serialized_file(serialized_stream(uint64_t(1) << 62, 1, 9, 3));
+    std::string msg = error_of("serialized", dir.write("nv.serialized", file));
+    EXPECT_CONTAINS(msg, "nv.serialized");
+    // 2^62 + 1 triangles: 12 bytes each wraps to 12.
+    file = serialized_file(serialized_stream(3, (uint64_t(1) << 62) + 1, 9, 3));
+    msg = error_of("serialized", dir.write("nf.serialized", file));
+    EXPECT_CONTAINS(msg, "nf.serialized");
+}
+
+TEST(HostileSerialized, MemoryGrowsWithTheDataNotWithTheHeader) {
+    TempDir dir;
+    LimitGuard guard;
+    set_allocation_limit(size_t(1) << 20);
+    // 10^6 vertices fit the (lowered) limit for no array: refused before inflating anything.
+    std::string file = serialized_file(serialized_stream(1000000, 1, 9, 3));
+    std::string msg = error_of("serialized", dir.write("limit.serialized", file));
+    EXPECT_CONTAINS(msg, "limit.serialized");
+    EXPECT_CONTAINS(msg, "allocation limit");
+    // Within the limit but truncated: an error about the data, after reading what there is.
+    set_allocation_limit(size_t(1) << 30);
+    file = serialized_file(serialized_stream(1000000, 1, 9, 3));
+    msg = error_of("serialized", dir.write("short.serialized", file));
+    EXPECT_CONTAINS(msg, "short.serialized");
+    EXPECT_CONTAINS(msg, "truncated");
+}
+
+TEST(HostileSerialized, FlagsAndVersion) {
+    TempDir dir;
+    std::string raw = serialized_stream(3, 1, 9, 3);
+    uint32_t both = 0x3000;
+    std::memcpy(raw.data(), &both, 4);
+    std::string msg = error_of("serialized", dir.write("flags.serialized", serialized_file(raw)));
+    EXPECT_CONTAINS(msg, "flags.serialized");
+    EXPECT_CONTAINS(msg, "both single and double precision");
+    // A mesh header of version 5 inside a version-4 file.
+    std::string file = serialized_file(serialized_stream(3, 1, 9, 3));
+    file[2] = 5;
+    msg = error_of("serialized", dir.write("version.serialized", file));
+    EXPECT_CONTAINS(msg, "version 5");
 }
