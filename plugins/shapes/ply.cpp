@@ -37,6 +37,7 @@ are skipped with a warning.
 ```
 )DOC";
 
+#include <facet/checked.h>
 #include <facet/logger.h>
 #include <facet/mesh.h>
 #include <facet/plugin.h>
@@ -45,6 +46,7 @@ are skipped with a warning.
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 
@@ -309,6 +311,8 @@ private:
                          format, line_no);
         bool have_vertices = false, have_faces = false;
         for (const PlyElement &el : elements) {
+            if ((el.name == "vertex" && have_vertices) || (el.name == "face" && have_faces))
+                FACET_THROW("{}: the header declares more than one {} element", name, el.name);
             if (el.name == "vertex") {
                 read_vertices(el, reader, flip_tex_coords);
                 have_vertices = true;
@@ -333,8 +337,21 @@ private:
             reader.read(prop.type, prop.name.c_str());
             return;
         }
-        double count = reader.read(prop.count_type, prop.name.c_str());
-        for (int64_t k = 0; k < int64_t(count); ++k) reader.read(prop.type, prop.name.c_str());
+        size_t count = list_count(prop, reader, prop.name.c_str());
+        for (size_t k = 0; k < count; ++k) reader.read(prop.type, prop.name.c_str());
+    }
+
+    /// The length of a list, read with its count type: a whole number, and no more entries
+    /// than the rest of the file can hold (so a loop over them is bounded by the file).
+    static size_t list_count(const PlyProperty &prop, PlyReader &reader, const char *what) {
+        double count = reader.read(prop.count_type, what);
+        double most =
+            double(reader.remaining()) / double(reader.is_ascii() ? 1 : type_size(prop.type));
+        if (!(count >= 0.0) || count != std::floor(count) || count > most)
+            FACET_THROW("{}: bad list count {} for {} (a whole number of entries that the rest "
+                        "of the file holds)",
+                        reader.where(), count, what);
+        return size_t(count);
     }
 
     /// A named attribute made of some of an element's properties (one per channel).
@@ -466,7 +483,7 @@ private:
         for (const PlyProperty &p : el.props)
             per_element += reader.is_ascii() ? 1 : type_size(p.is_list ? p.count_type : p.type);
         size_t need = 0;
-        if (__builtin_mul_overflow(el.count, std::max<size_t>(per_element, 1), &need) ||
+        if (!checked_mul(el.count, std::max<size_t>(per_element, 1), need) ||
             need > reader.remaining() + (reader.is_ascii() || per_element == 0 ? 1 : 0))
             FACET_THROW("{}: the header declares {} {} elements, more than the file holds", m_name,
                         el.count, el.name);
@@ -510,7 +527,9 @@ private:
         std::vector<AttributeGroup> groups = group_attributes(el, "vertex_", reserved);
         check_count(el, reader);
 
+        // check_count() bounds n by the file size, so 3 n cannot wrap; the limit still applies.
         size_t n = el.count;
+        allocation_bytes(n, 3 * sizeof(float), m_name, "vertex positions");
         m_positions.resize(3 * n);
         if (normals) m_normals.resize(3 * n);
         if (uvs) m_uvs.resize(2 * n);
@@ -556,7 +575,9 @@ private:
         std::vector<AttributeGroup> groups = group_attributes(el, "face_", reserved);
         check_count(el, reader);
 
-        m_faces.reserve(3 * el.count);
+        // A triangle per face to begin with; polygons with more corners grow it with the data.
+        m_faces.reserve(allocation_bytes(el.count, 3 * sizeof(uint32_t), m_name, "faces") /
+                        sizeof(uint32_t));
         std::vector<uint32_t> polygon;
         std::vector<double> values(el.props.size(), 0.0);
         for (size_t f = 0; f < el.count; ++f) {
@@ -569,14 +590,15 @@ private:
                         values[i] = reader.read(prop.type, prop.name.c_str());
                     continue;
                 }
-                double count = reader.read(prop.count_type, "a face's vertex count");
+                size_t count = list_count(prop, reader, "a face's vertex count");
                 if (count < 3)
                     FACET_THROW("{}: face {} has {} vertices (at least 3 needed)", reader.where(),
                                 f, count);
                 polygon.clear();
-                for (int64_t k = 0; k < int64_t(count); ++k) {
+                for (size_t k = 0; k < count; ++k) {
                     double idx = reader.read(prop.type, "a vertex index");
-                    if (idx < 0 || idx >= 4294967295.0)
+                    // Written so that NaN fails too; ascii files may hold non-integers.
+                    if (!(idx >= 0.0 && idx < 4294967295.0) || idx != std::floor(idx))
                         FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f,
                                     idx);
                     polygon.push_back(uint32_t(idx));

@@ -224,3 +224,75 @@ TEST(HostileSerialized, FlagsAndVersion) {
     msg = error_of("serialized", dir.write("version.serialized", file));
     EXPECT_CONTAINS(msg, "version 5");
 }
+
+namespace {
+
+const char *ply_xyz = "property float x\nproperty float y\nproperty float z\n";
+
+} // namespace
+
+// --- PLY -----------------------------------------------------------------------------------------
+
+TEST(HostilePly, VertexCountWhoseTripleWrapsAround) {
+    TempDir dir;
+    // 3 * 6148914691236517206 = 2^64 + 2: a wrapped 3n would size the buffer for 2 floats and the
+    // loop would write the file's bytes past it.
+    std::string file = std::string("ply\nformat binary_little_endian 1.0\nelement vertex "
+                                   "6148914691236517206\n") +
+                       ply_xyz + "element face 1\nproperty list uchar int vertex_indices\n" +
+                       "end_header\n";
+    for (int i = 0; i < 9; ++i) put<float>(file, float(i));
+    put<uint8_t>(file, 3);
+    for (int i = 0; i < 3; ++i) put<int32_t>(file, i);
+    std::string msg = error_of("ply", dir.write("wrap.ply", file));
+    EXPECT_CONTAINS(msg, "wrap.ply");
+    EXPECT_CONTAINS(msg, "more than the file holds");
+}
+
+TEST(HostilePly, CountsAreCheckedAgainstTheFileBeforeAllocating) {
+    TempDir dir;
+    // 4e9 vertices in a file of a few bytes: refused before 48 GB are allocated.
+    std::string file = std::string("ply\nformat ascii 1.0\nelement vertex 4000000000\n") + ply_xyz +
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+                       "0 0 0\n";
+    std::string msg = error_of("ply", dir.write("big.ply", file));
+    EXPECT_CONTAINS(msg, "big.ply");
+    EXPECT_CONTAINS(msg, "4000000000 vertex elements");
+}
+
+TEST(HostilePly, ListCountsAndIndicesMustBeIntegersInRange) {
+    TempDir dir;
+    std::string head = std::string("ply\nformat ascii 1.0\nelement vertex 3\n") + ply_xyz +
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+                       "0 0 0\n1 0 0\n0 1 0\n";
+    // A count of 1e30 (converted to an integer: undefined behaviour) or 2.5.
+    std::string msg = error_of("ply", dir.write("count.ply", head + "1e30 0 1 2\n"));
+    EXPECT_CONTAINS(msg, "count.ply:13");
+    EXPECT_CONTAINS(msg, "list count");
+    msg = error_of("ply", dir.write("frac.ply", head + "2.5 0 1 2\n"));
+    EXPECT_CONTAINS(msg, "frac.ply:13");
+    EXPECT_CONTAINS(msg, "list count");
+    // A NaN index passed the range check (NaN compares false) and became an index.
+    msg = error_of("ply", dir.write("nan.ply", head + "3 nan 1 2\n"));
+    EXPECT_CONTAINS(msg, "nan.ply:13");
+    EXPECT_CONTAINS(msg, "bad vertex index");
+    msg = error_of("ply", dir.write("half.ply", head + "3 0.5 1 2\n"));
+    EXPECT_CONTAINS(msg, "bad vertex index");
+    // A list that skips over more values than the file has.
+    std::string other = std::string("ply\nformat binary_little_endian 1.0\nelement vertex 3\n") +
+                        ply_xyz + "property list uint double junk\n" +
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    for (int i = 0; i < 3; ++i) put<float>(other, 0.f);
+    put<uint32_t>(other, 0xffffffffu);
+    msg = error_of("ply", dir.write("skip.ply", other));
+    EXPECT_CONTAINS(msg, "skip.ply");
+}
+
+TEST(HostilePly, TwoVertexElementsAreAnError) {
+    TempDir dir;
+    std::string file = std::string("ply\nformat ascii 1.0\nelement vertex 1\n") + ply_xyz +
+                       "element vertex 1\n" + ply_xyz + "end_header\n0 0 0\n0 0 0\n";
+    std::string msg = error_of("ply", dir.write("two.ply", file));
+    EXPECT_CONTAINS(msg, "two.ply");
+    EXPECT_CONTAINS(msg, "more than one vertex element");
+}
