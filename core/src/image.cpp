@@ -1,3 +1,4 @@
+#include <facet/checked.h>
 #include <facet/image.h>
 #include <facet/logger.h>
 #include <facet/spectrum.h>
@@ -15,6 +16,7 @@
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -519,18 +521,53 @@ Image read_image(const std::string &path) {
                     fs::exists(path, ec) ? "not a regular file" : "no such file");
     auto in = OIIO::ImageInput::open(path);
     if (!in) FACET_THROW("cannot read image \"{}\": {}", path, OIIO::geterror());
-    const OIIO::ImageSpec &spec = in->spec();
-    Image img(spec.width, spec.height, spec.nchannels);
+    const OIIO::ImageSpec spec = in->spec();
+    // The header's sizes are checked before anything is allocated: positive, a 2D flat image,
+    // and a product that neither wraps nor exceeds the allocation limit.
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+        FACET_THROW("cannot read image \"{}\": it declares {}x{} pixels of {} channels", path,
+                    spec.width, spec.height, spec.nchannels);
+    if (spec.depth != 1 || spec.deep)
+        FACET_THROW("cannot read image \"{}\": {} images are not supported", path,
+                    spec.deep ? "deep" : "volume");
+    size_t row = 0, values = 0;
+    if (!checked_mul(size_t(spec.width), size_t(spec.nchannels), row) ||
+        !checked_mul(row, size_t(spec.height), values))
+        values = std::numeric_limits<size_t>::max();
+    allocation_bytes(values, sizeof(float), path, "image pixels");
+
+    Image img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.channels = spec.nchannels;
     img.channel_names.assign(spec.channelnames.begin(), spec.channelnames.end());
     // The data window (the pixels read) inside the display window (origin 0 in facet's files).
     img.x = spec.x - spec.full_x;
     img.y = spec.y - spec.full_y;
     img.full_width = spec.full_width;
     img.full_height = spec.full_height;
-    bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, img.data.data());
+    img.channel_names.resize(size_t(spec.nchannels));
+    // Read in bands of rows (whole tile rows for tiled files), growing the buffer as rows
+    // arrive: a header that claims gigabytes of pixels in a small, truncated file fails at its
+    // first missing row instead of after the whole buffer has been zeroed.
+    const int band = spec.tile_width > 0
+                         ? std::max(spec.tile_height, 1)
+                         : int(std::clamp<size_t>((size_t(1) << 22) / row, 1, 4096));
+    bool ok = true;
+    for (int y0 = 0; ok && y0 < spec.height; y0 += band) {
+        const int y1 = std::min(spec.height, y0 + std::max(band, 1));
+        img.data.resize(size_t(y1) * row);
+        float *dst = img.data.data() + size_t(y0) * row;
+        if (spec.tile_width > 0)
+            ok = in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1, spec.z,
+                                spec.z + 1, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, dst);
+        else
+            ok = in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0, spec.nchannels,
+                                    OIIO::TypeDesc::FLOAT, dst);
+    }
     std::string err = ok ? "" : in->geterror();
     in->close();
-    if (!ok) FACET_THROW("cannot read image \"{}\": {}", path, err);
+    if (!ok) FACET_THROW("cannot read image \"{}\": {}", path, err.empty() ? "read error" : err);
     return img;
 }
 

@@ -8,6 +8,7 @@
 #include <facet/plugin.h>
 #include <facet/texture.h>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -295,4 +296,72 @@ TEST(HostilePly, TwoVertexElementsAreAnError) {
     std::string msg = error_of("ply", dir.write("two.ply", file));
     EXPECT_CONTAINS(msg, "two.ply");
     EXPECT_CONTAINS(msg, "more than one vertex element");
+}
+
+// --- images --------------------------------------------------------------------------------------
+
+TEST(HostileImages, HeaderDimensionsAreCheckedBeforeAllocating) {
+    TempDir dir;
+    // A float map that claims 100000 x 100000 RGB pixels (120 GB) and holds 12 bytes.
+    std::string pfm = "PF\n100000 100000\n-1.0\n";
+    put<float>(pfm, 1.f);
+    put<float>(pfm, 2.f);
+    put<float>(pfm, 3.f);
+    std::string path = dir.write("huge.pfm", pfm);
+    try {
+        read_image(path);
+        ADD_FAILURE() << "expected an error";
+    } catch (const Error &e) {
+        EXPECT_CONTAINS(e.what(), "huge.pfm");
+        EXPECT_CONTAINS(e.what(), "allocation limit");
+    }
+    // Within the limit but truncated: refused once the data runs out, without first zeroing the
+    // whole buffer (the test would run out of memory or time otherwise).
+    pfm = "PF\n20000 20000\n-1.0\n";
+    for (int i = 0; i < 30; ++i) put<float>(pfm, 1.f);
+    path = dir.write("short.pfm", pfm);
+    try {
+        read_image(path);
+        ADD_FAILURE() << "expected an error";
+    } catch (const Error &e) {
+        EXPECT_CONTAINS(e.what(), "short.pfm");
+    }
+    // The envmap and bitmap plugins report it with the file name too.
+    std::string msg = error_of("envmap", dir.write("huge2.pfm", "PF\n100000 100000\n-1.0\n"),
+                               ObjectType::Emitter);
+    EXPECT_CONTAINS(msg, "huge2.pfm");
+}
+
+TEST(HostileImages, ValidImagesStillRead) {
+    TempDir dir;
+    std::string pfm = "PF\n2 1\n-1.0\n";
+    for (int i = 0; i < 6; ++i) put<float>(pfm, float(i));
+    Image img = read_image(dir.write("ok.pfm", pfm));
+    ASSERT_EQ(img.width, 2);
+    ASSERT_EQ(img.height, 1);
+    ASSERT_EQ(img.channels, 3);
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(img.data[size_t(i)], float(i));
+
+    // Tiled (8 x 8 tiles, partial at the edges) and scanline files with a data window that does not
+    // start at the origin, read in bands of rows: every pixel in its place.
+    const int w = 20, h = 13, c = 2;
+    std::vector<float> pixels(size_t(w) * h * c);
+    for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = float(i);
+    for (bool tiled : {true, false}) {
+        SCOPED_TRACE(tiled ? "tiled" : "scanlines");
+        std::string path = dir.write(tiled ? "tiled.exr" : "lines.exr", "");
+        OIIO::ImageSpec spec(w, h, c, OIIO::TypeDesc::FLOAT);
+        spec.x = 3;
+        spec.y = -5;
+        if (tiled) spec.tile_width = spec.tile_height = 8;
+        auto out = OIIO::ImageOutput::create(path);
+        ASSERT_TRUE(out && out->open(path, spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+        out->close();
+        Image back = read_image(path);
+        ASSERT_EQ(back.width, w);
+        ASSERT_EQ(back.height, h);
+        ASSERT_EQ(back.channels, c);
+        EXPECT_EQ(back.data, pixels);
+    }
 }
