@@ -1,0 +1,28 @@
+# Fuzz targets (tests/fuzz/<target>.cpp, each an LLVMFuzzerTestOneInput) and their replays.
+# In every build: fuzz_<target>_replay runs the entry point over the seed corpus
+# (tests/fuzz/corpus/<target>/) and over every input that once crashed it
+# (tests/fuzz/regressions/<target>/), as the ctest fuzz.<target> (label fuzz).
+# With -DFACET_FUZZ=ON (clang; implies FACET_SANITIZE): the libFuzzer executables
+# fuzz_<target>, run as README.md describes.
+set(FACET_FUZZ_TARGETS xml obj ply serialized image)
+set(_fuzz_dir ${CMAKE_CURRENT_SOURCE_DIR}/fuzz)
+foreach(t ${FACET_FUZZ_TARGETS})
+    set(_libs facet facet_warnings OpenImageIO::OpenImageIO pugixml::pugixml)
+    add_executable(fuzz_${t}_replay ${_fuzz_dir}/${t}.cpp ${_fuzz_dir}/replay.cpp)
+    target_link_libraries(fuzz_${t}_replay PRIVATE ${_libs})
+    add_dependencies(fuzz_${t}_replay facet_plugins)
+    set(_inputs ${_fuzz_dir}/corpus/${t})
+    if(EXISTS ${_fuzz_dir}/regressions/${t})
+        list(APPEND _inputs ${_fuzz_dir}/regressions/${t})
+    endif()
+    add_test(NAME fuzz.${t} COMMAND fuzz_${t}_replay ${_inputs}
+             WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
+    set_tests_properties(fuzz.${t} PROPERTIES LABELS fuzz TIMEOUT 300)
+    if(FACET_FUZZ)
+        add_executable(fuzz_${t} ${_fuzz_dir}/${t}.cpp)
+        target_compile_options(fuzz_${t} PRIVATE -fsanitize=fuzzer)
+        target_link_options(fuzz_${t} PRIVATE -fsanitize=fuzzer)
+        target_link_libraries(fuzz_${t} PRIVATE ${_libs})
+        add_dependencies(fuzz_${t} facet_plugins)
+    endif()
+endforeach()
