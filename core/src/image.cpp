@@ -513,12 +513,63 @@ void check_image_output(const std::string &path, const ImageWriteOptions &opts) 
     }
     resolve_display_view(opts);
 }
+namespace {
+
+/**
+ * OpenEXR (3.1) allocates every header attribute at the size the file gives before reading it,
+ * so a 1 KB file whose attribute claims 1.7 GB costs that much memory and a minute. The headers
+ * are scanned here first: every attribute must fit in the rest of the file. Only the first MiB
+ * is scanned (headers are a few KB; a longer one is left to OpenEXR).
+ */
+void check_exr_headers(const std::string &path) {
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) return; // OpenImageIO reports it
+    std::vector<unsigned char> buf(size_t(1) << 20);
+    size_t n = std::fread(buf.data(), 1, buf.size(), f);
+    std::fseek(f, 0, SEEK_END);
+    long file_size = std::ftell(f);
+    std::fclose(f);
+    if (n < 8 || buf[0] != 0x76 || buf[1] != 0x2f || buf[2] != 0x31 || buf[3] != 0x01) return;
+    const bool multipart = (buf[5] & 0x10) != 0; // version field bit 12
+    size_t pos = 8;
+    auto cstring = [&](std::string &out) {
+        out.clear();
+        while (pos < n && buf[pos] != 0 && out.size() < 256) out += char(buf[pos++]);
+        if (pos >= n || buf[pos] != 0) return false;
+        ++pos;
+        return true;
+    };
+    std::string name, type;
+    for (int header = 0; pos < n; ++header) {
+        if (buf[pos] == 0) break; // an empty header ends the list of a multi-part file
+        for (;;) {
+            if (pos >= n) return;
+            if (buf[pos] == 0) {
+                ++pos;
+                break;
+            }
+            if (!cstring(name) || !cstring(type) || pos + 4 > n) return;
+            int32_t size;
+            std::memcpy(&size, buf.data() + pos, 4);
+            pos += 4;
+            if (size < 0 || int64_t(size) > int64_t(file_size) - int64_t(pos))
+                FACET_THROW("cannot read image \"{}\": the EXR attribute \"{}\" claims {} bytes, "
+                            "more than the file holds",
+                            path, name, size);
+            pos += size_t(size);
+        }
+        if (!multipart) break;
+    }
+}
+
+} // namespace
 
 Image read_image(const std::string &path) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec))
         FACET_THROW("cannot read image \"{}\": {}", path,
                     fs::exists(path, ec) ? "not a regular file" : "no such file");
+    check_exr_headers(path);
     auto in = OIIO::ImageInput::open(path);
     if (!in) FACET_THROW("cannot read image \"{}\": {}", path, OIIO::geterror());
     const OIIO::ImageSpec spec = in->spec();

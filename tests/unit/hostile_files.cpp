@@ -332,6 +332,25 @@ TEST(HostileImages, HeaderDimensionsAreCheckedBeforeAllocating) {
     EXPECT_CONTAINS(msg, "huge2.pfm");
 }
 
+TEST(HostileImages, ExrAttributesLargerThanTheFile) {
+    TempDir dir;
+    // Found by the image fuzz target: a string attribute claiming 1.7 GB made OpenEXR allocate
+    // and fill that much (40 s and 1.8 GB for a 1 KB file).
+    std::string exr = "\x76\x2f\x31\x01";
+    put<uint32_t>(exr, 2);
+    exr += std::string("capDate") + '\0' + "string" + '\0';
+    put<int32_t>(exr, 1701994871);
+    exr += "2024:01:01 00:00:00";
+    std::string path = dir.write("attr.exr", exr);
+    try {
+        read_image(path);
+        ADD_FAILURE() << "expected an error";
+    } catch (const Error &e) {
+        EXPECT_CONTAINS(e.what(), "attr.exr");
+        EXPECT_CONTAINS(e.what(), "\"capDate\" claims 1701994871 bytes");
+    }
+}
+
 TEST(HostileImages, ValidImagesStillRead) {
     TempDir dir;
     std::string pfm = "PF\n2 1\n-1.0\n";
