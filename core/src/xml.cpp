@@ -43,6 +43,10 @@ namespace fs = std::filesystem;
 
 constexpr size_t NoNode = size_t(-1);
 constexpr int MaxIncludeDepth = 15;
+/// Deepest chain of objects inside objects (nested tags and references together), far above real
+/// scenes (a shape, its BSDF, a texture of that: a handful). Parsing, instantiation and some
+/// plugins recurse along such chains, so a deeper one is refused instead of exhausting the stack.
+constexpr size_t MaxObjectDepth = 256;
 
 // =============================================================================================
 // Tags
@@ -760,9 +764,15 @@ private:
         std::string id = attr(el, "id", "");
         std::string name = name_override.empty() ? property_name(el, true) : name_override;
 
+        if (m_object_depth >= MaxObjectDepth)
+            fail(el.loc, fmt::format("{} is nested more than {} objects deep (the limit of the "
+                                     "scene loader)",
+                                     el.bracketed(), MaxObjectDepth));
         size_t index = new_node(kind, type, id, el.loc);
         if (parent != NoNode) add_child(parent, name, index, el.loc);
+        ++m_object_depth;
         parse_children(el, index, is_root);
+        --m_object_depth;
         if (el.src->upgrade) upgrade_node(index);
         return index;
     }
@@ -1031,13 +1041,19 @@ private:
     /// Depth-first search from the root; a back edge is a reference cycle.
     void check_cycles(size_t root) {
         std::vector<int> state(m_nodes.size(), 0); // 0 new, 1 on the stack, 2 done
+        std::vector<size_t> height(m_nodes.size(), 0);
         std::vector<size_t> stack;
-        visit_for_cycles(root, state, stack);
+        visit_for_cycles(root, state, height, stack);
     }
 
-    void visit_for_cycles(size_t index, std::vector<int> &state, std::vector<size_t> &stack) {
+    /// Also bounds the depth of the object graph (`height`: the objects on the longest chain
+    /// that starts at a node), which references can make far deeper than the nesting of the
+    /// tags: instantiation and the plugins recurse along it.
+    void visit_for_cycles(size_t index, std::vector<int> &state, std::vector<size_t> &height,
+                          std::vector<size_t> &stack) {
         state[index] = 1;
         stack.push_back(index);
+        size_t h = 1;
         for (const Entry &e : m_nodes[index].entries) {
             if (e.child == NoNode) continue;
             if (state[e.child] == 1) {
@@ -1048,10 +1064,17 @@ private:
                 fail(e.location,
                      "circular reference detected: " + chain + m_nodes[e.child].describe());
             }
-            if (state[e.child] == 0) visit_for_cycles(e.child, state, stack);
+            if (state[e.child] == 0 && stack.size() <= MaxObjectDepth)
+                visit_for_cycles(e.child, state, height, stack);
+            if (state[e.child] != 2 || height[e.child] > MaxObjectDepth)
+                fail(e.location, fmt::format("objects are nested more than {} deep through "
+                                             "references (the limit of the scene loader)",
+                                             MaxObjectDepth));
+            h = std::max(h, height[e.child] + 1);
         }
         stack.pop_back();
         state[index] = 2;
+        height[index] = h;
     }
 
     // -- Instantiation --------------------------------------------------------------------------
@@ -1108,6 +1131,7 @@ private:
     std::vector<std::string> m_keys; ///< parameter names, longest first
     std::vector<SourceFile *> m_include_stack;
     std::vector<size_t> m_created; ///< nodes in creation order
+    size_t m_object_depth = 0;     ///< objects open around the element being parsed
 };
 
 } // namespace

@@ -1,0 +1,93 @@
+// Hostile scenes: inputs built to exhaust the stack, memory or Embree's assumptions must end in a
+// located facet::Error, never in a crash, an abort or gigabytes of allocations.
+
+#include <facet/bsdf.h>
+#include <facet/logger.h>
+#include <facet/scene.h>
+#include <facet/xml.h>
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+using namespace facet;
+
+namespace {
+
+/// `count` copies of `open`, then `middle`, then `count` copies of `close`.
+std::string nested(const std::string &open, const std::string &middle, const std::string &close,
+                   int count) {
+    std::string s;
+    for (int i = 0; i < count; ++i) s += open;
+    s += middle;
+    for (int i = 0; i < count; ++i) s += close;
+    return s;
+}
+
+/// Loads `xml` and expects a facet::Error whose message contains `needle`, located in the string
+/// (line `line`, any column when `line` is 0). Returns the message.
+std::string expect_load_error(const std::string &xml, const std::string &needle, int line = 0) {
+    try {
+        load_string(xml);
+    } catch (const Error &e) {
+        EXPECT_NE(e.message().find(needle), std::string::npos) << e.what();
+        EXPECT_EQ(e.location().file, "string") << e.what();
+        EXPECT_GT(e.location().line, 0) << e.what();
+        if (line > 0) {
+            EXPECT_EQ(e.location().line, line) << e.what();
+        }
+        return e.what();
+    }
+    ADD_FAILURE() << "no error for a hostile scene (expected \"" << needle << "\")";
+    return {};
+}
+
+} // namespace
+
+// -- Depth --------------------------------------------------------------------------------------
+
+TEST(HostileScene, DeeplyNestedElementsAreRefusedNotAStackOverflow) {
+    // Thousands of nested objects overflowed the loader's recursion (a segfault).
+    std::string xml = "<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n" +
+                      nested("<bsdf type=\"twosided\">", "<bsdf type=\"diffuse\"/>", "</bsdf>",
+                             100000) +
+                      "</shape></scene>";
+    expect_load_error(xml, "nested more than 256 objects deep", 3);
+}
+
+TEST(HostileScene, NestingUpToTheLimitLoads) {
+    // A root texture and 255 nested ones are 256 objects: the limit. One more is refused.
+    auto chain = [](int nested_textures) {
+        return "<texture version=\"3.0.0\" type=\"checkerboard\">" +
+               nested("<texture type=\"checkerboard\" name=\"color0\">", "", "</texture>",
+                      nested_textures) +
+               "</texture>";
+    };
+    EXPECT_TRUE(load_string(chain(255)));
+    expect_load_error(chain(256), "nested more than 256 objects deep", 1);
+}
+
+TEST(HostileScene, LongReferenceChainsAreRefused) {
+    // Each texture refers to the next one: a flat file whose object graph is deep. Checking
+    // cycles and instantiating both recurse along it.
+    auto chain = [](int first, int count, bool last = true) {
+        std::string xml;
+        for (int i = first; i < first + count; ++i)
+            xml += "<texture type=\"checkerboard\" id=\"t" + std::to_string(i) +
+                   "\"><ref name=\"color0\" id=\"t" + std::to_string(i + 1) + "\"/></texture>\n";
+        if (!last) return xml;
+        return xml + "<texture type=\"checkerboard\" id=\"t" + std::to_string(first + count) +
+               "\"/>\n";
+    };
+    const std::string head = "<scene version=\"3.0.0\">\n";
+    const std::string tail = "<shape type=\"sphere\"><bsdf type=\"diffuse\"><ref "
+                             "name=\"reflectance\" id=\"t0\"/></bsdf></shape></scene>";
+    expect_load_error(head + chain(0, 20000) + tail,
+                      "nested more than 256 deep through references");
+    // Chains declared in the order they are used never recurse deeply while loading, but the
+    // plugins' evaluation recurses along the whole graph: its depth is what counts.
+    std::string reversed;
+    for (int block = 9; block >= 0; --block) reversed += chain(block * 100, 100, block == 9);
+    expect_load_error(head + reversed + tail, "nested more than 256 deep through references");
+    EXPECT_TRUE(load_string(head + chain(0, 250) + tail));
+}
