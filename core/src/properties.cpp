@@ -1,6 +1,9 @@
 #include <facet/properties.h>
 #include <facet/texture.h>
 
+#include <cmath>
+#include <limits>
+
 namespace facet {
 
 namespace {
@@ -33,6 +36,35 @@ std::string entry_type_name(const Properties::Value &v) {
     return Properties::type_name(Properties::Type(v.index()));
 }
 
+/// Whether a number survives the conversion to the single precision plugins compute in.
+bool finite_float(double v) { return std::abs(v) <= double(std::numeric_limits<float>::max()); }
+
+/// Empty when every number in `v` is finite (as a float); otherwise what is wrong.
+std::string non_finite(const Properties::Value &v) {
+    auto check = [](std::initializer_list<double> values) {
+        for (double x : values)
+            if (!finite_float(x))
+                return std::string(std::isnan(x) ? "NaN" : "an infinite or out-of-range number");
+        return std::string();
+    };
+    if (auto d = std::get_if<double>(&v)) return check({*d});
+    if (auto p = std::get_if<Vector3f>(&v)) return check({p->x, p->y, p->z});
+    if (auto c = std::get_if<Color3f>(&v)) return check({c->r, c->g, c->b});
+    if (auto s = std::get_if<SpectrumData>(&v)) {
+        std::string why = check({s->value});
+        for (size_t i = 0; why.empty() && i < s->values.size(); ++i) why = check({s->values[i]});
+        for (size_t i = 0; why.empty() && i < s->wavelengths.size(); ++i)
+            why = check({s->wavelengths[i]});
+        return why;
+    }
+    if (auto t = std::get_if<Transform>(&v)) {
+        for (const auto &row : t->matrix.m)
+            for (float x : row)
+                if (std::string why = check({x}); !why.empty()) return why;
+    }
+    return {};
+}
+
 } // namespace
 
 const char *Properties::type_name(Type t) {
@@ -60,6 +92,12 @@ const char *Properties::type_name(Type t) {
 }
 
 void Properties::set(const std::string &name, Value value, const Location &loc, bool overwrite) {
+    // Every plugin computes in floats: a NaN or infinite parameter is refused here, where its
+    // location is known, rather than rendering black or NaN pixels.
+    if (std::string why = non_finite(value); !why.empty())
+        FACET_THROW_AT(loc.valid() ? loc : m_location,
+                       "{} \"{}\" contains {}: parameters must be finite numbers (got {})",
+                       entry_type_name(value), name, why, value_to_string(value));
     if (auto it = m_index.find(name); it != m_index.end()) {
         Entry &e = m_entries[it->second];
         if (!overwrite)

@@ -2,12 +2,15 @@
 // located facet::Error, never in a crash, an abort or gigabytes of allocations.
 
 #include <facet/bsdf.h>
+#include <facet/film.h>
 #include <facet/logger.h>
+#include <facet/plugin.h>
 #include <facet/scene.h>
 #include <facet/xml.h>
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 using namespace facet;
@@ -48,10 +51,10 @@ std::string expect_load_error(const std::string &xml, const std::string &needle,
 
 TEST(HostileScene, DeeplyNestedElementsAreRefusedNotAStackOverflow) {
     // Thousands of nested objects overflowed the loader's recursion (a segfault).
-    std::string xml = "<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n" +
-                      nested("<bsdf type=\"twosided\">", "<bsdf type=\"diffuse\"/>", "</bsdf>",
-                             100000) +
-                      "</shape></scene>";
+    std::string xml =
+        "<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n" +
+        nested("<bsdf type=\"twosided\">", "<bsdf type=\"diffuse\"/>", "</bsdf>", 100000) +
+        "</shape></scene>";
     expect_load_error(xml, "nested more than 256 objects deep", 3);
 }
 
@@ -90,4 +93,62 @@ TEST(HostileScene, LongReferenceChainsAreRefused) {
     for (int block = 9; block >= 0; --block) reversed += chain(block * 100, 100, block == 9);
     expect_load_error(head + reversed + tail, "nested more than 256 deep through references");
     EXPECT_TRUE(load_string(head + chain(0, 250) + tail));
+}
+
+// -- Non-finite parameters ------------------------------------------------------------------------
+
+TEST(HostileScene, NonFiniteParametersAreRefusedWhereTheyAreWritten) {
+    // A NaN reflectance used to render with a warning and an infinite radiance rendered black,
+    // both with success.
+    const std::string head = "<scene version=\"3.0.0\">\n";
+    expect_load_error(head + "<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"nan\"/>"
+                             "</bsdf></scene>",
+                      "rgb \"reflectance\" contains NaN", 2);
+    expect_load_error(head +
+                          "<shape type=\"sphere\">\n<emitter type=\"area\">\n"
+                          "<rgb name=\"radiance\" value=\"1, inf, 1\"/></emitter></shape></scene>",
+                      "rgb \"radiance\" contains an infinite", 4);
+    expect_load_error(head + "<emitter type=\"constant\"><float name=\"radiance\" value=\"-inf\"/>"
+                             "</emitter></scene>",
+                      "float \"radiance\" contains an infinite", 2);
+    // Finite as a double, infinite as the float the plugin computes with.
+    expect_load_error(head + "<shape type=\"sphere\"><float name=\"radius\" value=\"1e300\"/>"
+                             "</shape></scene>",
+                      "out-of-range", 2);
+    expect_load_error(head + "<shape type=\"sphere\"><point name=\"center\" value=\"0, nan, 0\"/>"
+                             "</shape></scene>",
+                      "vector \"center\" contains NaN", 2);
+    expect_load_error(head + "<bsdf type=\"diffuse\"><spectrum name=\"reflectance\" "
+                             "value=\"400:0.5, 500:nan\"/></bsdf></scene>",
+                      "spectrum \"reflectance\" contains NaN", 2);
+    expect_load_error(head + "<shape type=\"sphere\"><transform name=\"to_world\">"
+                             "<rotate x=\"1\" angle=\"nan\"/></transform></shape></scene>",
+                      "transform \"to_world\" contains NaN", 2);
+    expect_load_error(head + "<shape type=\"sphere\"><transform name=\"to_world\">"
+                             "<scale value=\"1e39\"/></transform></shape></scene>",
+                      "transform \"to_world\" contains an infinite", 2);
+}
+
+TEST(HostileScene, NonFiniteParameterValuesFromTheCommandLine) {
+    LoadOptions opts;
+    opts.params["r"] = "NaN";
+    try {
+        load_string("<scene version=\"3.0.0\">\n<bsdf type=\"diffuse\">\n"
+                    "<float name=\"reflectance\" value=\"$r\"/></bsdf></scene>",
+                    opts);
+        ADD_FAILURE() << "a NaN from -D was accepted";
+    } catch (const Error &e) {
+        EXPECT_EQ(e.location().line, 3) << e.what();
+        EXPECT_NE(e.message().find("contains NaN"), std::string::npos) << e.what();
+    }
+}
+
+TEST(HostileScene, NonFiniteValuesAreRefusedByPropertiesItself) {
+    // Scenes built in code (not from XML) go through the same check.
+    Properties props("diffuse");
+    EXPECT_THROW(props.set_float("reflectance", std::nan("")), Error);
+    EXPECT_THROW(props.set_color("reflectance", Color3f(1.f, INFINITY, 1.f)), Error);
+    EXPECT_THROW(props.set_vector("center", Vector3f(NAN, 0.f, 0.f)), Error);
+    props.set_float("reflectance", 0.5);
+    EXPECT_EQ(props.get_float("reflectance"), 0.5);
 }
