@@ -5,6 +5,10 @@ namespace facet {
 
 Sensor::Sensor(const Properties &props) {
     m_to_world = props.get_transform("to_world", Transform());
+    // A camera that scales by zero or sits beyond any scene sends rays Embree cannot take (it
+    // asserts on NaN or huge origins and directions).
+    if (std::string why = transform_problem(m_to_world); !why.empty())
+        FACET_THROW_AT(props.location("to_world"), "the sensor's to_world {}", why);
 
     // Mitsuba's sensors take a shutter interval; facet renders still scenes, so only check it.
     double open = props.get_float("shutter_open", 0.0);

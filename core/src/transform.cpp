@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 namespace facet {
 
 Matrix4f Matrix4f::from_rows(const float (&v)[16]) {
@@ -182,6 +184,34 @@ Transform Transform::perspective(float fov_deg, float near_clip, float far_clip)
     m.m[3][2] = 1.f;
     m.m[3][3] = 0.f;
     return Transform(m);
+}
+
+std::string transform_problem(const Transform &t, float max_entry, float max_inverse_entry) {
+    const auto &m = t.matrix.m;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            if (std::isnan(m[i][j])) return "has a NaN entry";
+            if (!(std::abs(m[i][j]) <= max_entry))
+                return fmt::format("has an entry of {} (at most {:g} is supported)", m[i][j],
+                                   max_entry);
+        }
+    if (m[3][0] != 0.f || m[3][1] != 0.f || m[3][2] != 0.f || m[3][3] != 1.f)
+        return "is projective (its last row is not 0, 0, 0, 1)";
+    const double det = double(m[0][0]) * (double(m[1][1]) * m[2][2] - double(m[1][2]) * m[2][1]) -
+                       double(m[0][1]) * (double(m[1][0]) * m[2][2] - double(m[1][2]) * m[2][0]) +
+                       double(m[0][2]) * (double(m[1][0]) * m[2][1] - double(m[1][1]) * m[2][0]);
+    if (det == 0.0) return "is singular (it scales by zero)";
+    // The stored inverse may have been built alongside the matrix; recompute it to be sure.
+    const Matrix4f inv = t.matrix.inverse();
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            if (!(std::abs(inv.m[i][j]) <= max_inverse_entry))
+                return fmt::format("is nearly singular (it shrinks by a factor of up to {:g}; "
+                                   "at most {:g} is supported)",
+                                   double(std::abs(inv.m[i][j])), max_inverse_entry);
+    for (int i = 0; i < 3; ++i)
+        if (!std::isfinite(inv.m[i][3])) return "has no finite inverse";
+    return {};
 }
 
 std::string Transform::to_string() const {

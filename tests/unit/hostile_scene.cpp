@@ -152,3 +152,34 @@ TEST(HostileScene, NonFiniteValuesAreRefusedByPropertiesItself) {
     props.set_float("reflectance", 0.5);
     EXPECT_EQ(props.get_float("reflectance"), 0.5);
 }
+
+// -- What reaches Embree --------------------------------------------------------------------------
+
+namespace {
+
+/// A scene with a perspective camera placed by `sensor_transform` (the contents of its
+/// <transform name="to_world">) around `body`; the sensor's transform is on line 3.
+std::string scene_with(const std::string &body,
+                       const std::string &sensor_transform =
+                           "<lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>",
+                       const std::string &film = "") {
+    return "<scene version=\"3.0.0\">\n<sensor type=\"perspective\">\n"
+           "<transform name=\"to_world\">" +
+           sensor_transform + "</transform>\n<film type=\"hdrfilm\">" + film +
+           "<integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/>"
+           "</film></sensor>\n" +
+           body + "</scene>";
+}
+
+} // namespace
+
+TEST(HostileScene, SensorTransformsEmbreeCannotTakeAreRefused) {
+    // Each of these aborted the process in Embree's ray assertion.
+    expect_load_error(scene_with("", "<scale value=\"0\"/>"), "to_world is singular", 3);
+    expect_load_error(scene_with("", "<translate x=\"1e18\"/>"), "to_world has an entry", 3);
+    expect_load_error(
+        scene_with("", "<lookat origin=\"1e30, 0, 0\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>"),
+        "to_world has an entry", 3);
+    expect_load_error(scene_with("", "<scale value=\"1e-20\"/>"), "nearly singular", 3);
+    EXPECT_TRUE(load_string(scene_with("", "<scale x=\"-1\"/><translate x=\"1e6\"/>")));
+}

@@ -52,4 +52,16 @@ struct Transform {
     std::string to_string() const;
 };
 
+/// Largest coordinate of scene geometry and sensor positions, far beyond real scenes (at 1e12
+/// a float cannot tell points 1e5 apart). Embree asserts that ray origins stay below 1.8e18:
+/// with this bound, hit points and the rays of instances (see transform_problem()) do.
+constexpr float MaxSceneCoordinate = 1e12f;
+
+/// Empty when `t` can place a sensor, shape or instance in the scene: its entries finite and at
+/// most `max_entry` in magnitude, its linear part invertible and the entries of its inverse at
+/// most `max_inverse_entry` (a bound on how much it may shrink). Otherwise a description of
+/// what is wrong ("scales by zero", ...), to follow "to_world ".
+std::string transform_problem(const Transform &t, float max_entry = MaxSceneCoordinate,
+                              float max_inverse_entry = MaxSceneCoordinate);
+
 } // namespace facet
