@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <pmmintrin.h>
 #include <vector>
@@ -69,6 +70,16 @@ void embree_error_callback(void *, RTCError code, const char *str) {
     FACET_LOG(Error, "Embree: {}: {}", embree_error_name(code), str ? str : "");
 }
 
+/// Embree's own precondition on rays (it asserts it and aborts): origin and direction below
+/// 1.8e18 in magnitude (so not NaN), tnear and tfar not NaN. Scenes are validated so that their
+/// rays meet it; this catches what a plugin computes from bad data (a NaN normal, say).
+inline bool embree_can_trace(const Ray &ray) {
+    constexpr float Large = 1.8e18f;
+    return std::abs(ray.o.x) <= Large && std::abs(ray.o.y) <= Large && std::abs(ray.o.z) <= Large &&
+           std::abs(ray.d.x) <= Large && std::abs(ray.d.y) <= Large && std::abs(ray.d.z) <= Large &&
+           !std::isnan(ray.mint) && !std::isnan(ray.maxt);
+}
+
 std::string object_label(const Object &obj) {
     return obj.id().empty() ? obj.to_string() : "\"" + obj.id() + "\"";
 }
@@ -108,6 +119,9 @@ Scene::Scene(const Properties &props) {
         switch (obj->type()) {
         case ObjectType::Shape: {
             auto shape = std::static_pointer_cast<Shape>(obj);
+            // Embree asserts on rays from hit points beyond its range: refuse such geometry here.
+            if (std::string why = bounds_problem(shape->bbox()); !why.empty())
+                FACET_THROW_AT(loc, "shape {}: its bounding box {}", object_label(*shape), why);
             m_shapes.push_back(shape);
             if (auto emitter = shape->emitter_ptr()) m_emitters.push_back(emitter);
             if (auto sensor = shape->sensor_ptr()) m_sensors.push_back(sensor);
@@ -222,6 +236,10 @@ uint64_t Scene::ray_count() {
 
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     count_ray();
+    if (!embree_can_trace(ray)) {
+        escaped(ray, si); // a NaN direction, say: Embree would abort the process
+        return false;
+    }
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
@@ -261,6 +279,7 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
 
 bool Scene::ray_test(const Ray &ray) const {
     count_ray();
+    if (!embree_can_trace(ray)) return false;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay r;

@@ -183,3 +183,28 @@ TEST(HostileScene, SensorTransformsEmbreeCannotTakeAreRefused) {
     expect_load_error(scene_with("", "<scale value=\"1e-20\"/>"), "nearly singular", 3);
     EXPECT_TRUE(load_string(scene_with("", "<scale x=\"-1\"/><translate x=\"1e6\"/>")));
 }
+
+TEST(HostileScene, ShapesBeyondEmbreesRangeAreRefused) {
+    expect_load_error(scene_with("<shape type=\"sphere\"><transform name=\"to_world\">"
+                                 "<translate x=\"1e30\"/></transform></shape>\n"),
+                      "bounding box reaches", 4);
+    expect_load_error(scene_with("<shape type=\"rectangle\"><transform name=\"to_world\">"
+                                 "<scale value=\"1e20\"/></transform></shape>\n"),
+                      "bounding box reaches", 4);
+}
+
+TEST(HostileScene, RaysEmbreeCannotTakeMissInsteadOfAborting) {
+    auto scene =
+        std::dynamic_pointer_cast<Scene>(load_string(scene_with("<shape type=\"sphere\"/>")));
+    ASSERT_TRUE(scene);
+    SurfaceInteraction si;
+    Ray good(Point3f(0.f, 0.f, 5.f), Vector3f(0.f, 0.f, -1.f), 0.f, Infinity);
+    EXPECT_TRUE(scene->ray_intersect(good, si));
+    // A NaN direction (from a NaN normal map texel, say) and an origin beyond Embree's range.
+    Ray nan_dir(Point3f(0.f, 0.f, 5.f), Vector3f(NAN, 0.f, -1.f), 0.f, Infinity);
+    EXPECT_FALSE(scene->ray_intersect(nan_dir, si));
+    EXPECT_FALSE(scene->ray_test(nan_dir));
+    Ray far(Point3f(1e19f, 0.f, 5.f), Vector3f(0.f, 0.f, -1.f), 0.f, Infinity);
+    EXPECT_FALSE(scene->ray_intersect(far, si));
+    EXPECT_FALSE(scene->ray_test(far));
+}

@@ -1,6 +1,12 @@
 #pragma once
 
+#include <facet/transform.h>
 #include <facet/vector.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <string>
 
 namespace facet {
 
@@ -25,5 +31,19 @@ struct BoundingBox3f {
     /// Radius of the bounding sphere around center().
     float bounding_sphere_radius() const { return valid() ? norm(max - min) * 0.5f : 0.f; }
 };
+
+/// Empty when `b` (possibly empty) lies within ±MaxSceneCoordinate; otherwise what is wrong, to
+/// follow "its bounding box ".
+inline std::string bounds_problem(const BoundingBox3f &b) {
+    const float values[6] = {b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z};
+    for (float v : values)
+        if (std::isnan(v)) return "is NaN";
+    if (!b.valid()) return {}; // empty: nothing reaches Embree
+    for (float v : values)
+        if (!(std::abs(v) <= MaxSceneCoordinate))
+            return fmt::format("reaches {:g}, beyond the supported coordinate range of ±{:g}", v,
+                               MaxSceneCoordinate);
+    return {};
+}
 
 } // namespace facet
