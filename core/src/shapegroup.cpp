@@ -12,6 +12,15 @@ ShapeGroup::ShapeGroup(const Properties &props) {
                            object_type_name(obj->type()));
         if (dynamic_cast<const ShapeGroup *>(shape.get()))
             FACET_THROW_AT(props.location(name), "shapegroup: shape groups cannot be nested");
+        // Embree (as built here) traverses one level of instances and aborts on a second.
+        if (dynamic_cast<const InstanceShape *>(shape.get()))
+            FACET_THROW_AT(props.location(name),
+                           "shapegroup: a shape group cannot contain an instance (nested "
+                           "instancing is not supported; put the inner group's shapes in this "
+                           "group instead)");
+        if (std::string why = bounds_problem(shape->bbox()); !why.empty())
+            FACET_THROW_AT(props.location(name), "shapegroup: the bounding box of \"{}\" {}", name,
+                           why);
         if (shape->emitter())
             FACET_THROW_AT(props.location(name),
                            "shapegroup: emitters inside a shape group are not supported");

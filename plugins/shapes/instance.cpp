@@ -2,7 +2,9 @@ static const char *DOC = R"DOC(
 # instance: a placed copy of a shapegroup
 
 Adds the shapes of a `shapegroup` to the scene under `to_world`, as an Embree instance of the
-group's acceleration structure (one level of instancing). Instances cannot be emitters.
+group's acceleration structure (one level of instancing: a shapegroup cannot contain an
+instance). Instances cannot be emitters. `to_world` must be invertible and may shrink the group
+by a factor of at most 10⁴.
 
 | Parameter | Type       | Default  | Description                               |
 |-----------|------------|----------|-------------------------------------------|
@@ -22,7 +24,7 @@ group's acceleration structure (one level of instancing). Instances cannot be em
 
 namespace facet {
 
-class Instance final : public Shape {
+class Instance final : public InstanceShape {
 public:
     explicit Instance(const Properties &props) {
         for (const auto &[name, obj] : props.objects()) {
@@ -35,6 +37,9 @@ public:
         }
         if (!m_group) FACET_THROW_AT(props.location(), "instance: no shapegroup given");
         m_to_world = props.get_transform("to_world", Transform());
+        if (std::string why = transform_problem(m_to_world, MaxSceneCoordinate, MaxInstanceShrink);
+            !why.empty())
+            FACET_THROW_AT(props.location("to_world"), "instance: to_world {}", why);
         BoundingBox3f local = m_group->bbox();
         for (int i = 0; i < 8; ++i) {
             Point3f corner((i & 1) ? local.max.x : local.min.x, (i & 2) ? local.max.y : local.min.y,

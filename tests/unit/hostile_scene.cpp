@@ -193,6 +193,29 @@ TEST(HostileScene, ShapesBeyondEmbreesRangeAreRefused) {
                       "bounding box reaches", 4);
 }
 
+TEST(HostileScene, NestedInstancesAreRefused) {
+    // Embree (one instance level in this build) aborted on an instance inside a shapegroup.
+    expect_load_error(scene_with("<shape type=\"shapegroup\" id=\"inner\"><shape type=\"sphere\"/>"
+                                 "</shape>\n<shape type=\"shapegroup\" id=\"outer\">\n"
+                                 "<shape type=\"instance\"><ref id=\"inner\"/></shape></shape>\n"
+                                 "<shape type=\"instance\"><ref id=\"outer\"/></shape>\n"),
+                      "cannot contain an instance", 5);
+}
+
+TEST(HostileScene, InstanceTransformsEmbreeCannotTakeAreRefused) {
+    const std::string group =
+        "<shape type=\"shapegroup\" id=\"g\"><shape type=\"sphere\"/></shape>\n";
+    auto instance = [&](const std::string &ops) {
+        return scene_with(group +
+                          "<shape type=\"instance\"><ref id=\"g\"/>\n"
+                          "<transform name=\"to_world\">" +
+                          ops + "</transform></shape>\n");
+    };
+    expect_load_error(instance("<scale value=\"0\"/>"), "instance: to_world is singular", 5);
+    expect_load_error(instance("<scale value=\"1e-6\"/>"), "nearly singular", 5);
+    EXPECT_TRUE(load_string(instance("<scale value=\"1e-3\"/><translate x=\"100\"/>")));
+}
+
 TEST(HostileScene, RaysEmbreeCannotTakeMissInsteadOfAborting) {
     auto scene =
         std::dynamic_pointer_cast<Scene>(load_string(scene_with("<shape type=\"sphere\"/>")));

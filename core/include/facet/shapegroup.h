@@ -36,4 +36,15 @@ private:
     mutable RTCScene m_scene = nullptr;
 };
 
+/// Base class of the `instance` plugin: lets a group recognise (and refuse) a nested instance.
+class InstanceShape : public Shape {
+protected:
+    InstanceShape() = default;
+};
+
+/// Most an instance's to_world may shrink (the largest entry of its inverse): the rays of an
+/// instance are the world's rays under the inverse, and Embree asserts that they stay below
+/// 1.8e18; with world coordinates below MaxSceneCoordinate this bound keeps them there.
+constexpr float MaxInstanceShrink = 1e4f;
+
 } // namespace facet
