@@ -231,3 +231,26 @@ TEST(HostileScene, RaysEmbreeCannotTakeMissInsteadOfAborting) {
     EXPECT_FALSE(scene->ray_intersect(far, si));
     EXPECT_FALSE(scene->ray_test(far));
 }
+
+// -- Memory ---------------------------------------------------------------------------------------
+
+TEST(HostileScene, NestedAdaptersCannotMultiplyComponentsWithoutBound) {
+    // 26 nested twosided took gigabytes from a 1 kB file: each level doubles the components.
+    std::string twosided =
+        "<bsdf version=\"3.0.0\" type=\"twosided\">" +
+        nested("<bsdf type=\"twosided\">", "<bsdf type=\"diffuse\"/>", "</bsdf>", 25) + "</bsdf>";
+    expect_load_error(twosided, "more than the 1024 facet supports", 1);
+    // The same through references: a blendbsdf of the same BSDF twice, 26 times over.
+    std::string blend = "<scene version=\"3.0.0\">\n<bsdf type=\"diffuse\" id=\"b0\"/>\n";
+    for (int i = 1; i <= 26; ++i)
+        blend += "<bsdf type=\"blendbsdf\" id=\"b" + std::to_string(i) + "\"><ref id=\"b" +
+                 std::to_string(i - 1) + "\"/><ref id=\"b" + std::to_string(i - 1) +
+                 "\"/></bsdf>\n";
+    expect_load_error(blend + "</scene>", "more than the 1024 facet supports");
+    // Ten levels are 1024 components: still accepted.
+    auto ten = std::dynamic_pointer_cast<BSDF>(load_string(
+        "<bsdf version=\"3.0.0\" type=\"twosided\">" +
+        nested("<bsdf type=\"twosided\">", "<bsdf type=\"diffuse\"/>", "</bsdf>", 9) + "</bsdf>"));
+    ASSERT_TRUE(ten);
+    EXPECT_EQ(ten->component_count(), 1024u);
+}

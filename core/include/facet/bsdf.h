@@ -2,6 +2,7 @@
 
 #include <facet/color.h>
 #include <facet/interaction.h>
+#include <facet/logger.h>
 #include <facet/object.h>
 
 #include <utility>
@@ -87,6 +88,11 @@ struct BSDFSample {
     uint32_t sampled_component = uint32_t(-1);
 };
 
+/// Most components a BSDF may have. Adapters list their nested BSDFs' components (twosided
+/// twice for a single nested one), so nesting them doubles the count per level: 26 nested
+/// twosided took gigabytes. Real materials have a handful.
+constexpr size_t MaxBSDFComponents = 1024;
+
 class BSDF : public Object {
 public:
     ObjectType type() const override { return ObjectType::BSDF; }
@@ -123,6 +129,11 @@ public:
 protected:
     /// Sets the per-component flags and their union.
     void set_components(std::vector<BSDFFlags> components) {
+        if (components.size() > MaxBSDFComponents)
+            FACET_THROW("the BSDF would have {} components, more than the {} facet supports "
+                        "(nested twosided or blendbsdf adapters multiply their nested BSDFs' "
+                        "components)",
+                        components.size(), MaxBSDFComponents);
         m_components = std::move(components);
         m_flags = BSDFFlags::Empty;
         for (BSDFFlags f : m_components) m_flags |= f;
