@@ -175,6 +175,18 @@ void Film::reset_crop_window() {
 }
 
 void Film::prepare(const std::vector<std::string> &aov_names) {
+    // The accumulation buffer (doubles) and the developed image (floats) of every channel:
+    // refused beyond a budget instead of failing in the allocator (or the kernel's OOM killer).
+    constexpr uint64_t BudgetBytes = uint64_t(8) << 30;
+    const uint64_t pixels = uint64_t(m_crop_size.x) * uint64_t(m_crop_size.y);
+    uint64_t bytes = 0;
+    if (__builtin_mul_overflow(pixels, (4 + uint64_t(aov_names.size())) * 12, &bytes) ||
+        bytes > BudgetBytes)
+        FACET_THROW("a {}x{} film with {} AOV channels needs {:.1f} GiB for its buffers, more "
+                    "than the {} GiB budget: lower the resolution, crop it or use fewer AOVs",
+                    m_crop_size.x, m_crop_size.y, aov_names.size(),
+                    double(pixels) * double(4 + aov_names.size()) * 12.0 / double(1 << 30),
+                    BudgetBytes >> 30);
     m_aov_names = aov_names;
     size_t channels = 4 + aov_names.size();
     m_storage.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * channels, 0.0);

@@ -8,7 +8,7 @@ everything (float16 or float32, AOV channels, metadata); `.hdr`/`.rgbe`/`.pfm` k
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
-| width | integer | 768 | Image width in pixels |
+| width | integer | 768 | Image width in pixels (width·height at most 2²⁷) |
 | height | integer | 576 | Image height in pixels |
 | crop_offset_x | integer | 0 | Left column of the crop window (the part that is rendered; an EXR keeps it as its data window inside the full display window) |
 | crop_offset_y | integer | 0 | Top row of the crop window |
@@ -48,6 +48,15 @@ public:
     enum class PixelFormat { RGB, RGBA, Luminance, LuminanceAlpha, XYZ, XYZA };
 
     explicit HDRFilm(const Properties &props) : Film(props) {
+        // Far above real renders (16384x8192); a hostile size fails here, not in the allocator.
+        constexpr int64_t MaxPixels = int64_t(1) << 27;
+        int64_t pixels = 0;
+        if (__builtin_mul_overflow(int64_t(m_size.x), int64_t(m_size.y), &pixels) ||
+            pixels > MaxPixels)
+            FACET_THROW_AT(props.location(),
+                           "the film is {}x{} pixels, more than the {} pixels (2^27, e.g. "
+                           "16384x8192) hdrfilm supports",
+                           m_size.x, m_size.y, MaxPixels);
         std::string file_format = lower(props.get_string("file_format", "openexr"));
         if (file_format == "openexr" || file_format == "exr")
             m_extension = ".exr";

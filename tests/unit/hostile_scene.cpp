@@ -254,3 +254,27 @@ TEST(HostileScene, NestedAdaptersCannotMultiplyComponentsWithoutBound) {
     ASSERT_TRUE(ten);
     EXPECT_EQ(ten->component_count(), 1024u);
 }
+
+TEST(HostileScene, FilmSizesAreBounded) {
+    expect_load_error(scene_with("", "",
+                                 "<integer name=\"width\" value=\"1000000\"/>"
+                                 "<integer name=\"height\" value=\"1000000\"/>"),
+                      "more than the 134217728 pixels", 3);
+}
+
+TEST(HostileScene, FilmBuffersHaveABudget) {
+    // 8192x8192 is a valid film, but not with 24 AOV channels (26 GiB of buffers): refused
+    // before allocating.
+    Properties props("hdrfilm");
+    props.set_int("width", 8192);
+    props.set_int("height", 8192);
+    auto film = PluginRegistry::instance().create_as<Film>(ObjectType::Film, props);
+    std::vector<std::string> aovs;
+    for (int i = 0; i < 24; ++i) aovs.push_back("aov" + std::to_string(i));
+    try {
+        film->prepare(aovs);
+        ADD_FAILURE() << "no error for 26 GiB of film buffers";
+    } catch (const Error &e) {
+        EXPECT_NE(e.message().find("GiB budget"), std::string::npos) << e.what();
+    }
+}
