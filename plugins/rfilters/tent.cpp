@@ -6,7 +6,7 @@ centre to 0 at `radius`.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
-| radius | float | 1.0 | Radius of the filter in pixels (must be > 0) |
+| radius | float | 1.0 | Radius of the filter in pixels (more than 0, at most 64) |
 
 ```xml
 <rfilter type="tent">
@@ -24,9 +24,10 @@ class TentFilter final : public ReconstructionFilter {
 public:
     explicit TentFilter(const Properties &props) {
         double radius = props.get_float("radius", 1.0);
-        if (!(radius > 0.0) || !std::isfinite(radius))
+        if (!(radius > 0.0) || !(radius <= MaxFilterRadius) || !std::isfinite(1.f / float(radius)))
             FACET_THROW_AT(props.location("radius"),
-                           "radius must be a positive number of pixels, got {}", radius);
+                           "radius must be a positive number of pixels, at most {}, got {}",
+                           MaxFilterRadius, radius);
         m_radius = float(radius);
         m_inv_radius = 1.f / m_radius;
     }

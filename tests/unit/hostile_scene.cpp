@@ -278,3 +278,26 @@ TEST(HostileScene, FilmBuffersHaveABudget) {
         EXPECT_NE(e.message().find("GiB budget"), std::string::npos) << e.what();
     }
 }
+
+TEST(HostileScene, FilterRadiiAreBounded) {
+    // A huge stddev overflowed the float-to-int conversion of the block border; a large one
+    // allocated terabytes of image block.
+    auto filter = [](const std::string &rfilter) {
+        return scene_with("", "<lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>",
+                          rfilter);
+    };
+    expect_load_error(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e30\"/>"
+                             "</rfilter>"),
+                      "stddev must be a positive number of pixels, at most 16", 3);
+    expect_load_error(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e5\"/>"
+                             "</rfilter>"),
+                      "at most 16", 3);
+    expect_load_error(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e-30\"/>"
+                             "</rfilter>"),
+                      "too small", 3);
+    expect_load_error(filter("<rfilter type=\"tent\"><float name=\"radius\" value=\"1e9\"/>"
+                             "</rfilter>"),
+                      "at most 64", 3);
+    EXPECT_TRUE(load_string(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" "
+                                   "value=\"16\"/></rfilter>")));
+}
