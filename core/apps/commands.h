@@ -52,6 +52,10 @@ void add_scene_options(CLI::App &app, SceneOptions &opts);
 /// -t < 1) and the Embree device, then loads the scene with the -D values.
 std::shared_ptr<Scene> load_scene(SceneOptions &opts);
 
+/// Names what the command is doing ("loading \"scene.xml\""): main() adds it to the error when
+/// memory runs out, which std::bad_alloc itself does not say.
+void set_activity(const std::string &what);
+
 /// Threads a render will use: `threads`, or every core when it is 0.
 int effective_threads(int threads);
 

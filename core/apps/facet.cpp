@@ -14,9 +14,15 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <string>
 
 namespace {
+
+std::string g_activity; ///< see facet::cli::set_activity()
+
+/// " while loading \"scene.xml\"", or nothing.
+std::string while_activity() { return g_activity.empty() ? "" : " while " + g_activity; }
 
 const char *USAGE = R"(facet: a physically based renderer for Mitsuba 3 scenes
 
@@ -109,6 +115,8 @@ int run(int argc, char **argv) {
 
 namespace facet::cli {
 
+void set_activity(const std::string &what) { g_activity = what; }
+
 int parse(CLI::App &app, int argc, char **argv) {
     try {
         app.parse(argc, argv);
@@ -138,10 +146,19 @@ static int check_stdout(int code) {
 int main(int argc, char **argv) {
     try {
         return check_stdout(run(argc, argv));
+    } catch (const std::bad_alloc &) {
+        std::fflush(stdout);
+        std::fprintf(stderr, "facet: error: out of memory (std::bad_alloc)%s\n",
+                     while_activity().c_str());
+        return 1;
     } catch (const std::exception &e) {
         // facet::Error derives from std::exception; its what() carries the scene location.
         std::fflush(stdout);
-        std::fprintf(stderr, "facet: error: %s\n", one_line(e.what()).c_str());
+        // A plugin's allocation failure arrives wrapped (located, naming the plugin).
+        std::string msg = one_line(e.what());
+        if (size_t at = msg.find("std::bad_alloc"); at != std::string::npos)
+            msg.replace(at, 14, "out of memory (std::bad_alloc)" + while_activity());
+        std::fprintf(stderr, "facet: error: %s\n", msg.c_str());
         return 1;
     } catch (...) {
         std::fprintf(stderr, "facet: error: unknown exception\n");

@@ -87,6 +87,7 @@ std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
     if (!fs::exists(opts.scene)) FACET_THROW("scene file \"{}\" does not exist", opts.scene);
     // The first call fixes Embree's thread count; it must come before the scene builds its BVH.
     embree_device(opts.threads);
+    set_activity(fmt::format("loading \"{}\"", opts.scene));
     return facet::load_scene(opts.scene, load);
 }
 
@@ -244,6 +245,8 @@ int render_main(int argc, char **argv) {
                    threads, threads == 1 ? "" : "s");
         std::fflush(stdout);
     }
+    cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
+                                  film.crop_size().x, film.crop_size().y, range.count));
     RenderResult result;
     try {
         result = render(*scene, sensor, ropts);
@@ -263,6 +266,7 @@ int render_main(int argc, char **argv) {
     if (result.cancelled)
         wopts.metadata["facet:blocks"] =
             fmt::format("{}/{}", result.blocks_done, result.blocks_total);
+    cli::set_activity(fmt::format("writing \"{}\"", out));
     const auto write_start = std::chrono::steady_clock::now();
     film.write(result.image, out, wopts);
     const double write_seconds =
