@@ -47,6 +47,8 @@ Properties valid_properties(const std::string &name) {
         p.set_string("filename", asset("chi2/envmap_spot.exr"));
     } else if (name == "obj" || name == "ply" || name == "serialized") {
         p.set_string("filename", asset("data/plugin_docs/triangle." + name));
+    } else if (name == "sdfgrid") {
+        p.set_string("filename", asset("data/plugin_docs/sdfgrid.vol"));
     } else if (name == "aov") {
         p.set_string("aovs", "dd:depth");
     } else if (name == "thinlens") {
