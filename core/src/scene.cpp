@@ -122,9 +122,11 @@ Scene::Scene(const Properties &props) {
             // Embree asserts on rays from hit points beyond its range: refuse such geometry here.
             if (std::string why = bounds_problem(shape->bbox()); !why.empty())
                 FACET_THROW_AT(loc, "shape {}: its bounding box {}", object_label(*shape), why);
-            m_shapes.push_back(shape);
-            if (auto emitter = shape->emitter_ptr()) m_emitters.push_back(emitter);
-            if (auto sensor = shape->sensor_ptr()) m_sensors.push_back(sensor);
+            for (auto &part : expand_shape(shape)) { // a `merge` stands for its shapes
+                m_shapes.push_back(part);
+                if (auto emitter = part->emitter_ptr()) m_emitters.push_back(emitter);
+                if (auto sensor = part->sensor_ptr()) m_sensors.push_back(sensor);
+            }
             break;
         }
         case ObjectType::Emitter: {

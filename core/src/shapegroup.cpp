@@ -21,13 +21,15 @@ ShapeGroup::ShapeGroup(const Properties &props) {
         if (std::string why = bounds_problem(shape->bbox()); !why.empty())
             FACET_THROW_AT(props.location(name), "shapegroup: the bounding box of \"{}\" {}", name,
                            why);
-        if (shape->emitter())
-            FACET_THROW_AT(props.location(name),
-                           "shapegroup: emitters inside a shape group are not supported");
         props.mark_queried(name);
-        m_bbox.expand(shape->bbox());
-        m_area += shape->surface_area();
-        m_shapes.push_back(std::move(shape));
+        for (auto &part : expand_shape(shape)) {
+            if (part->emitter())
+                FACET_THROW_AT(props.location(name),
+                               "shapegroup: emitters inside a shape group are not supported");
+            m_bbox.expand(part->bbox());
+            m_area += part->surface_area();
+            m_shapes.push_back(std::move(part));
+        }
     }
     if (m_shapes.empty()) FACET_THROW_AT(props.location(), "shapegroup: the group is empty");
 }
@@ -63,6 +65,34 @@ PositionSample ShapeGroup::sample_position(const Point2f &) const {
 
 std::string ShapeGroup::to_string() const {
     return fmt::format("ShapeGroup[{} shapes]", m_shapes.size());
+}
+
+ShapeList::~ShapeList() = default;
+
+BoundingBox3f ShapeList::bbox() const {
+    BoundingBox3f box;
+    for (const auto &shape : m_shapes) box.expand(shape->bbox());
+    return box;
+}
+
+float ShapeList::surface_area() const {
+    float area = 0.f;
+    for (const auto &shape : m_shapes) area += shape->surface_area();
+    return area;
+}
+
+void ShapeList::compute_surface_interaction(const Ray &, float, uint32_t, const Point2f &,
+                                            SurfaceInteraction &) const {
+    FACET_THROW("{}: a shape list is only visible through the shapes it stands for", to_string());
+}
+
+PositionSample ShapeList::sample_position(const Point2f &) const {
+    FACET_THROW("{}: a shape list is only visible through the shapes it stands for", to_string());
+}
+
+std::vector<std::shared_ptr<Shape>> expand_shape(const std::shared_ptr<Shape> &shape) {
+    if (auto list = dynamic_cast<const ShapeList *>(shape.get())) return list->shapes();
+    return {shape};
 }
 
 } // namespace facet

@@ -47,4 +47,26 @@ protected:
 /// 1.8e18; with world coordinates below MaxSceneCoordinate this bound keeps them there.
 constexpr float MaxInstanceShrink = 1e4f;
 
+/// A shape that stands for other shapes (`merge`): the scene and shape groups hold its shapes()
+/// in its place and never the list itself. Declared in core so the scene can expand it.
+class ShapeList : public Shape {
+public:
+    ~ShapeList() override;
+    const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
+
+    BoundingBox3f bbox() const override;
+    float surface_area() const override;
+    RTCGeometry embree_geometry(RTCDevice) const override { return nullptr; }
+    void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
+                                     const Point2f &uv, SurfaceInteraction &si) const override;
+    PositionSample sample_position(const Point2f &u) const override;
+
+protected:
+    ShapeList() = default;
+    std::vector<std::shared_ptr<Shape>> m_shapes;
+};
+
+/// The shapes `shape` stands for: a ShapeList's shapes, otherwise the shape itself.
+std::vector<std::shared_ptr<Shape>> expand_shape(const std::shared_ptr<Shape> &shape);
+
 } // namespace facet
