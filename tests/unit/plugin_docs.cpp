@@ -49,6 +49,8 @@ Properties valid_properties(const std::string &name) {
         p.set_string("filename", asset("data/plugin_docs/triangle." + name));
     } else if (name == "sdfgrid") {
         p.set_string("filename", asset("data/plugin_docs/sdfgrid.vol"));
+    } else if (name == "merge") {
+        p.set_object("ball", make(ObjectType::Shape, Properties("sphere")));
     } else if (name == "aov") {
         p.set_string("aovs", "dd:depth");
     } else if (name == "thinlens") {

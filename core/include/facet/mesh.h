@@ -36,6 +36,7 @@ public:
     const std::vector<float> &uvs() const { return m_uvs; }
     const std::vector<uint32_t> &faces() const { return m_faces; }
     const std::string &name() const { return m_name; }
+    bool flip_normals() const { return m_flip_normals; }
 
     /// A named per-vertex or per-face quantity carried by the mesh (Mitsuba's mesh attributes:
     /// `vertex_color`, `vertex_tint_color`, `face_weight`, ...), read by `mesh_attribute`.
