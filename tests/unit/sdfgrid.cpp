@@ -438,3 +438,84 @@ TEST(SDFGrid, HostileFilesAreRefused) {
     refuse(temp_dir(), "is not a regular file");
     refuse(temp_dir() + "/missing.vol", "cannot open");
 }
+
+TEST(SDFGrid, ClosedSurfaceHasNoPinholes) {
+    // Rays aimed at the inside of a closed surface must all hit it, also those that run exactly
+    // along the grid's sample planes and lines, where neighbouring voxels share faces and edges.
+    const int n = 17;
+    auto sdf = [](double x, double y, double z) {
+        return std::sqrt((x - 0.5) * (x - 0.5) + (y - 0.5) * (y - 0.5) + (z - 0.5) * (z - 0.5)) -
+               0.375;
+    };
+    std::string path = write_field("pinholes.vol", n, n, n, sdf);
+    auto scene = grid_scene(path);
+    int missed = 0, rays = 0;
+    // Axis-aligned rays through every sample line (and half-way between them).
+    for (int i = 4; i <= 12; ++i)
+        for (int j = 4; j <= 12; ++j)
+            for (int axis = 0; axis < 3; ++axis)
+                for (float sign : {-1.f, 1.f}) {
+                    float a = float(i) / 16.f, b = float(j) / 16.f;
+                    if ((a - 0.5f) * (a - 0.5f) + (b - 0.5f) * (b - 0.5f) > 0.3f * 0.3f) continue;
+                    Point3f o;
+                    Vector3f d(0.f);
+                    o[axis] = sign > 0 ? -1.f : 2.f;
+                    o[(axis + 1) % 3] = a;
+                    o[(axis + 2) % 3] = b;
+                    d[axis] = sign;
+                    ++rays;
+                    missed += !scene->ray_test(Ray(o, d));
+                }
+    // Random rays from outside towards the inner half of the ball.
+    PCG32 rng(11);
+    for (int k = 0; k < 20000; ++k) {
+        Vector3f target(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f);
+        Vector3f dir = normalize(
+            Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
+        Point3f t = Point3f(0.5f) + target * 0.3f;
+        ++rays;
+        missed += !scene->ray_test(Ray(t - dir * 2.f, dir));
+    }
+    EXPECT_EQ(missed, 0) << "of " << rays << " rays";
+
+    // A zero set lying exactly on a sample plane: every crossing is on a face shared by two
+    // voxels, each of which sees a value of zero up to rounding there.
+    std::string flat_path =
+        write_field("zero_plane.vol", 9, 9, 9, [](double x, double y, double z) {
+            return (z - 0.5) * (1.0 + 0.3 * x + 0.2 * y);
+        });
+    auto flat = grid_scene(flat_path);
+    missed = 0;
+    for (int k = 0; k < 20000; ++k) {
+        Point3f target(0.05f + 0.9f * rng.next_float(), 0.05f + 0.9f * rng.next_float(), 0.5f);
+        Vector3f dir = normalize(
+            Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f, -0.05f - rng.next_float()));
+        missed += !flat->ray_test(Ray(target - dir * (1.5f / std::abs(dir.z)), dir));
+    }
+    EXPECT_EQ(missed, 0) << "rays through the zero sample plane that missed";
+}
+
+TEST(SDFGrid, InstancedLikeMitsuba) {
+    // Mitsuba's instancing case: the diagonal plane in a shapegroup placed twice.
+    VolHeader h;
+    const float s = float(std::sqrt(2.0) / 2.0);
+    std::string path = write_vol("diagonal_instanced.vol", h, {-s, -s, 0, 0, 0, 0, s, s});
+    auto scene = std::dynamic_pointer_cast<Scene>(
+        load_string("<scene version=\"3.0.0\"><shape type=\"shapegroup\" id=\"g\"><shape "
+                    "type=\"sdfgrid\"><string name=\"filename\" value=\"" +
+                    path +
+                    "\"/></shape></shape><shape type=\"instance\"><ref id=\"g\"/></shape><shape "
+                    "type=\"instance\"><ref id=\"g\"/><transform name=\"to_world\"><translate "
+                    "x=\"8\"/></transform></shape></scene>"));
+    for (float tx : {0.f, 8.f})
+        for (float x : {-0.5f, 0.25f, 0.75f, 1.5f})
+            for (float y : {-0.5f, 0.3f, 0.9f, 1.5f}) {
+                Ray ray(Point3f(tx + x, y, 3.f), Vector3f(0, 0, -1));
+                bool expected = x >= 0.f && x <= 1.f && y >= 0.f && y <= 1.f;
+                SurfaceInteraction si;
+                ASSERT_EQ(scene->ray_intersect(ray, si), expected) << tx << " " << x << " " << y;
+                if (!expected) continue;
+                EXPECT_NEAR(si.t, 2.f + y, 1e-5f);
+                expect_vec_near(si.n, Vector3f(0, s, s), 1e-5f, "normal");
+            }
+}
