@@ -193,7 +193,10 @@ Scene::Scene(const Properties &props) {
     rtcRetainDevice(m_device);
     const auto accel_start = std::chrono::steady_clock::now();
     m_rtc_scene = rtcNewScene(m_device);
-    rtcSetSceneFlags(m_rtc_scene, RTC_SCENE_FLAG_ROBUST);
+    // As in Mitsuba 3: Embree's fast triangle test unless the scene asks for the robust
+    // (watertight, slower) one.
+    m_robust = props.get_bool("embree_use_robust_intersections", false);
+    rtcSetSceneFlags(m_rtc_scene, m_robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
     try {
         for (auto &shape : m_shapes) {

@@ -65,6 +65,9 @@ public:
     double accel_build_seconds() const { return m_accel_seconds; }
     RTCScene embree_scene() const { return m_rtc_scene; }
     RTCDevice embree_device() const { return m_device; }
+    /// The scene option `embree_use_robust_intersections` (default false, as in Mitsuba 3):
+    /// Embree's robust (watertight) triangle test instead of its fast one.
+    bool robust_intersections() const { return m_robust; }
     std::string to_string() const override;
 
 private:
@@ -78,6 +81,7 @@ private:
     double m_accel_seconds = 0.0;
     RTCDevice m_device = nullptr;
     RTCScene m_rtc_scene = nullptr;
+    bool m_robust = false;
 };
 
 /// Embree device shared by all scenes of the process; `threads` = 0 lets Embree decide.
