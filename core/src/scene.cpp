@@ -3,6 +3,7 @@
 #include <facet/emitter.h>
 #include <facet/integrator.h>
 #include <facet/logger.h>
+#include <facet/mesh.h>
 #include <facet/plugin.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
@@ -188,6 +189,20 @@ Scene::Scene(const Properties &props) {
     }
     for (auto &emitter : m_emitters)
         if (emitter->is_infinite()) m_environment.push_back(emitter);
+    for (auto &emitter : m_emitters) {
+        EmitterEntry entry;
+        entry.emitter = emitter.get();
+        const Shape *shape = emitter->shape();
+        Color3f radiance;
+        if (shape && shape->is_mesh() && emitter->uniform_area_radiance(radiance) &&
+            shape->surface_area() > 0.f) {
+            entry.mesh = static_cast<const Mesh *>(shape);
+            entry.radiance = radiance;
+            entry.inv_area = 1.f / shape->surface_area();
+        }
+        emitter->set_scene_index(uint32_t(m_emitter_table.size()));
+        m_emitter_table.push_back(entry);
+    }
 
     m_device = facet::embree_device(); // the free function, not the accessor of the same name
     rtcRetainDevice(m_device);
@@ -305,18 +320,45 @@ bool Scene::ray_test(const Ray &ray) const {
     return r.tfar == -Infinity;
 }
 
+namespace {
+
+/// Solid-angle density of a triangle light at the point of `ds` seen along ds.d from ds.dist
+/// away: the area density converted (dA = r² / |cos θ| dω), zero from behind (only the front side
+/// emits). The one formula for both the sample and pdf_emitter_direction(), so they agree.
+inline float triangle_light_pdf(float inv_area, const DirectionSample &ds) {
+    float cos_theta = -dot(ds.n, ds.d);
+    if (!(cos_theta > 0.f)) return 0.f;
+    return inv_area * (ds.dist * ds.dist) / cos_theta;
+}
+
+} // namespace
+
 std::pair<DirectionSample, Color3f>
 Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility) const {
-    const size_t count = m_emitters.size();
+    const size_t count = m_emitter_table.size();
     if (count == 0) return {DirectionSample(), Color3f(0.f)};
     // Uniform emitter selection; the sample is stretched back to [0, 1) for the emitter.
     float scaled = u.x * float(count);
     size_t index = std::min(size_t(scaled), count - 1);
     u.x = std::min(scaled - float(index), OneMinusEpsilon);
-    const Emitter *emitter = m_emitters[index].get();
+    const EmitterEntry &entry = m_emitter_table[index];
 
-    auto [ds, weight] = emitter->sample_direction(ref, u);
-    ds.emitter = emitter;
+    DirectionSample ds;
+    Color3f weight;
+    if (entry.mesh) {
+        // A triangle light: a point uniform in area on the mesh (no virtual call).
+        static_cast<PositionSample &>(ds) = entry.mesh->Mesh::sample_position(u);
+        ds.d = ds.p - ref.p;
+        ds.dist = norm(ds.d);
+        if (!(ds.dist > 0.f)) return {ds, Color3f(0.f)};
+        ds.d /= ds.dist;
+        ds.pdf = triangle_light_pdf(entry.inv_area, ds);
+        if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
+        weight = entry.radiance / ds.pdf;
+    } else {
+        std::tie(ds, weight) = entry.emitter->sample_direction(ref, u);
+    }
+    ds.emitter = entry.emitter;
     if (!(ds.pdf > 0.f) || weight.is_black()) return {ds, Color3f(0.f)};
     // Delta emitters report pdf 1 (not a density): it is left as returned, as in
     // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
@@ -331,8 +373,13 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
 }
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {
-    if (!ds.emitter || m_emitters.empty()) return 0.f;
-    return ds.emitter->pdf_direction(ref, ds) / float(m_emitters.size());
+    if (!ds.emitter || m_emitter_table.empty()) return 0.f;
+    const float count = float(m_emitter_table.size());
+    const uint32_t index = ds.emitter->scene_index();
+    if (index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter &&
+        m_emitter_table[index].mesh)
+        return triangle_light_pdf(m_emitter_table[index].inv_area, ds) / count;
+    return ds.emitter->pdf_direction(ref, ds) / count;
 }
 
 void Scene::escaped(const Ray &ray, SurfaceInteraction &si) {

@@ -68,9 +68,10 @@ DirectionSample Shape::sample_direction(const Interaction &ref, const Point2f &u
         return ds;
     }
     ds.d /= ds.dist;
-    // Area density to solid angle: dA = r² / |cos θ| dω.
-    float cos_theta = absdot(ps.n, ds.d);
-    ds.pdf = cos_theta > 0.f ? ps.pdf * dist2 / cos_theta : 0.f;
+    // Area density to solid angle: dA = r² / |cos θ| dω, computed as pdf_direction() does, so
+    // that it gives back exactly this pdf for the sample.
+    float cos_theta = absdot(ds.n, ds.d);
+    ds.pdf = cos_theta > 0.f ? ps.pdf * ds.dist * ds.dist / cos_theta : 0.f;
     return ds;
 }
 

@@ -81,6 +81,12 @@ public:
         return {origin.spawn_ray(d), radiance_at(at) * (Pi / ps.pdf)};
     }
 
+    bool uniform_area_radiance(Color3f &radiance) const override {
+        if (m_radiance->is_spatially_varying()) return false;
+        radiance = m_radiance->mean();
+        return true;
+    }
+
     Color3f eval(const SurfaceInteraction &si) const override {
         if (Frame::cos_theta(si.wi) <= 0.f) return Color3f(0.f);
         return m_radiance->eval(si);

@@ -58,6 +58,14 @@ public:
         FACET_THROW("{} cannot sample emitted rays", to_string());
     }
 
+    /// For the scene's flat emitter table: true (with the radiance) for an emitter that is
+    /// exactly a constant `radiance` leaving the front side of its shape, sampled uniformly by
+    /// area, so that the scene may sample a triangle mesh carrying it without virtual calls.
+    virtual bool uniform_area_radiance(Color3f & /*radiance*/) const { return false; }
+    /// Position in the emitter list of the scene that holds it (set by the scene).
+    uint32_t scene_index() const { return m_scene_index; }
+    void set_scene_index(uint32_t index) { m_scene_index = index; }
+
     /// Called by the shape that owns an area emitter.
     virtual void set_shape(const Shape *shape) { m_shape = shape; }
     const Shape *shape() const { return m_shape; }
@@ -71,6 +79,7 @@ public:
 protected:
     EmitterFlags m_flags = EmitterFlags::Empty;
     const Shape *m_shape = nullptr;
+    uint32_t m_scene_index = uint32_t(-1);
 };
 
 } // namespace facet

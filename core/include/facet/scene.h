@@ -76,6 +76,16 @@ private:
     std::vector<std::shared_ptr<Emitter>> m_environment;
     std::vector<std::shared_ptr<Sensor>> m_sensors;
     std::shared_ptr<Integrator> m_integrator;
+    /// One entry per emitter of m_emitters, in the same order. Constant-radiance area lights on
+    /// triangle meshes (the common light) are sampled and their pdf computed from the entry by
+    /// one non-virtual path; every other emitter goes through its own virtual methods.
+    struct EmitterEntry {
+        const Emitter *emitter = nullptr;
+        const Mesh *mesh = nullptr; ///< set for a triangle light
+        Color3f radiance;           ///< of a triangle light
+        float inv_area = 0.f;       ///< of a triangle light: its area density
+    };
+    std::vector<EmitterEntry> m_emitter_table;
     std::vector<const Shape *> m_geometry_shapes; ///< Embree geometry id -> shape
     BoundingBox3f m_bbox;
     double m_accel_seconds = 0.0;
