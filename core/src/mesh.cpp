@@ -103,6 +103,95 @@ void Mesh::initialize(const Transform &to_world, bool face_normals, bool flip_no
 
     // Embree reads vertices with 16-byte loads: keep one float of padding after the last one.
     m_positions.push_back(0.f);
+    build_face_table();
+}
+
+namespace {
+
+/// Tangent vectors of a face in the (u, v) parametrisation: from the texture coordinates when
+/// they give a regular map, else (dp_du, dp_dv) completing n (uvs without area), or the two edges
+/// (no uvs: the barycentrics are the parametrisation). Returns false when it fell back to n.
+inline void face_tangents(const Vector3f &dp0, const Vector3f &dp1, const Point2f *uv,
+                          const Normal3f &n, Vector3f &dp_du, Vector3f &dp_dv) {
+    if (!uv) {
+        dp_du = dp0;
+        dp_dv = dp1;
+        return;
+    }
+    const Vector2f duv0 = uv[1] - uv[0], duv1 = uv[2] - uv[0];
+    float det = duv0.x * duv1.y - duv0.y * duv1.x;
+    if (det != 0.f) {
+        float inv = 1.f / det;
+        dp_du = (dp0 * duv1.y - dp1 * duv0.y) * inv;
+        dp_dv = (dp1 * duv0.x - dp0 * duv1.x) * inv;
+        if (is_finite(dp_du) && is_finite(dp_dv)) return;
+    }
+    coordinate_system(n, dp_du, dp_dv);
+}
+
+/// Shading frame: the shading normal and dp_du made orthogonal to it (Gram-Schmidt).
+inline Frame shading_frame(const Normal3f &ns, const Vector3f &dp_du) {
+    Vector3f s = dp_du - ns * dot(ns, dp_du);
+    float s_len = norm(s);
+    if (s_len > 1e-6f * norm(dp_du) && std::isfinite(s_len)) {
+        s /= s_len;
+        return Frame(s, cross(ns, s), ns);
+    }
+    return Frame(ns);
+}
+
+} // namespace
+
+void Mesh::build_face_table() {
+    m_face_table.clear();
+    m_face_table.shrink_to_fit();
+    const size_t nf = face_count();
+    auto vn = [&](uint32_t i) {
+        return Normal3f(m_normals[3 * i], m_normals[3 * i + 1], m_normals[3 * i + 2]);
+    };
+    if (has_vertex_normals())
+        for (size_t f = 0; f < nf; ++f) {
+            Normal3f a = vn(m_faces[3 * f]), b = vn(m_faces[3 * f + 1]), c = vn(m_faces[3 * f + 2]);
+            // Equal up to the rounding of normals computed per vertex (recomputed normals of a
+            // planar polygon differ in the last bits): interpolating them changes nothing.
+            if (!(max_component(abs(a - b)) <= 1e-6f && max_component(abs(a - c)) <= 1e-6f) ||
+                !(norm(a) > 0.f))
+                return; // smooth (or broken): per hit
+        }
+    m_face_table.resize(9 * nf);
+    for (size_t f = 0; f < nf; ++f) {
+        const uint32_t i0 = m_faces[3 * f], i1 = m_faces[3 * f + 1], i2 = m_faces[3 * f + 2];
+        const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
+        const Vector3f dp0 = p1 - p0, dp1 = p2 - p0;
+        Normal3f n = cross(dp0, dp1);
+        float n_len = norm(n);
+        if (!(n_len > 0.f)) { // a degenerate face has no normal of its own: per hit
+            m_face_table.clear();
+            return;
+        }
+        n = n / n_len;
+        if (m_flip_normals) n = -n;
+        Normal3f ns = n;
+        if (has_vertex_normals()) {
+            Normal3f v = normalize(vn(i0) + vn(i1) + vn(i2));
+            ns = m_flip_normals ? -v : v;
+        }
+        Point2f uv[3];
+        if (has_uvs())
+            for (int k = 0; k < 3; ++k) {
+                uint32_t i = m_faces[3 * f + k];
+                uv[k] = Point2f(m_uvs[2 * i], m_uvs[2 * i + 1]);
+            }
+        Vector3f dp_du, dp_dv;
+        face_tangents(dp0, dp1, has_uvs() ? uv : nullptr, n, dp_du, dp_dv);
+        Frame frame = shading_frame(ns, dp_du);
+        float *out = &m_face_table[9 * f];
+        for (int k = 0; k < 3; ++k) {
+            out[k] = n[k];
+            out[3 + k] = frame.n[k];
+            out[6 + k] = frame.s[k];
+        }
+    }
 }
 
 void Mesh::recompute_vertex_normals() {
@@ -136,6 +225,7 @@ void Mesh::recompute_vertex_normals() {
             m_normals[3 * i + 2] = float(n.z);
         }
     }
+    build_face_table();
 }
 
 void Mesh::add_attribute(std::string name, uint32_t channels, std::vector<float> data) {
@@ -195,47 +285,58 @@ RTCGeometry Mesh::embree_geometry(RTCDevice device) const {
     return geom;
 }
 
-void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
+void Mesh::compute_surface_interaction(const Ray &ray, float /*t*/, uint32_t prim_index,
                                        const Point2f &uv, SurfaceInteraction &si) const {
+    // Geometry only: the scene sets t and wi (an instance sets them for its members).
     const uint32_t i0 = m_faces[3 * prim_index], i1 = m_faces[3 * prim_index + 1],
                    i2 = m_faces[3 * prim_index + 2];
     const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
     // Embree's (u, v) weight vertices 1 and 2.
     const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
 
-    si.t = t;
     si.shape = this;
     si.prim_index = prim_index;
     // Interpolating the vertices is more accurate than ray(t) far from the ray origin.
     si.p = p0 * b0 + p1 * b1 + p2 * b2;
-
     const Vector3f dp0 = p1 - p0, dp1 = p2 - p0;
+
+    const Point2f *uvs = nullptr;
+    Point2f uv_corner[3];
+    if (has_uvs()) {
+        uv_corner[0] = Point2f(m_uvs[2 * i0], m_uvs[2 * i0 + 1]);
+        uv_corner[1] = Point2f(m_uvs[2 * i1], m_uvs[2 * i1 + 1]);
+        uv_corner[2] = Point2f(m_uvs[2 * i2], m_uvs[2 * i2 + 1]);
+        si.uv = uv_corner[0] * b0 + uv_corner[1] * b1 + uv_corner[2] * b2;
+        uvs = uv_corner;
+    } else {
+        // Without texture coordinates the barycentrics serve as (u, v).
+        si.uv = Point2f(b1, b2);
+    }
+
+    if (!m_face_table.empty()) {
+        // A flat mesh: normals and frame of the face were computed at load.
+        const float *f = &m_face_table[9 * size_t(prim_index)];
+        si.n = Normal3f(f[0], f[1], f[2]);
+        const Normal3f ns(f[3], f[4], f[5]);
+        const Vector3f s(f[6], f[7], f[8]);
+        si.sh_frame.n = ns;
+        si.sh_frame.s = s;
+        si.sh_frame.t = cross(ns, s);
+        if (uvs) {
+            face_tangents(dp0, dp1, uvs, si.n, si.dp_du, si.dp_dv);
+        } else {
+            si.dp_du = dp0;
+            si.dp_dv = dp1;
+        }
+        return;
+    }
+
     Normal3f n = cross(dp0, dp1);
     float n_len = norm(n);
     n = n_len > 0.f ? n / n_len : -ray.d;
     if (m_flip_normals) n = -n;
     si.n = n;
-
-    bool have_dp = false;
-    if (has_uvs()) {
-        const Point2f uv0(m_uvs[2 * i0], m_uvs[2 * i0 + 1]), uv1(m_uvs[2 * i1], m_uvs[2 * i1 + 1]),
-            uv2(m_uvs[2 * i2], m_uvs[2 * i2 + 1]);
-        si.uv = uv0 * b0 + uv1 * b1 + uv2 * b2;
-        const Vector2f duv0 = uv1 - uv0, duv1 = uv2 - uv0;
-        float det = duv0.x * duv1.y - duv0.y * duv1.x;
-        if (det != 0.f) {
-            float inv = 1.f / det;
-            si.dp_du = (dp0 * duv1.y - dp1 * duv0.y) * inv;
-            si.dp_dv = (dp1 * duv0.x - dp0 * duv1.x) * inv;
-            have_dp = is_finite(si.dp_du) && is_finite(si.dp_dv);
-        }
-        if (!have_dp) coordinate_system(n, si.dp_du, si.dp_dv);
-    } else {
-        // Without texture coordinates the barycentrics serve as (u, v).
-        si.uv = Point2f(b1, b2);
-        si.dp_du = dp0;
-        si.dp_dv = dp1;
-    }
+    face_tangents(dp0, dp1, uvs, n, si.dp_du, si.dp_dv);
 
     Normal3f ns = n;
     if (has_vertex_normals()) {
@@ -246,17 +347,7 @@ void Mesh::compute_surface_interaction(const Ray &ray, float t, uint32_t prim_in
         float len = norm(interp);
         if (len > 0.f && std::isfinite(len)) ns = m_flip_normals ? -interp / len : interp / len;
     }
-
-    // Shading frame: the shading normal and dp_du made orthogonal to it (Gram-Schmidt).
-    Vector3f s = si.dp_du - ns * dot(ns, si.dp_du);
-    float s_len = norm(s);
-    if (s_len > 1e-6f * norm(si.dp_du) && std::isfinite(s_len)) {
-        s /= s_len;
-        si.sh_frame = Frame(s, cross(ns, s), ns);
-    } else {
-        si.sh_frame = Frame(ns);
-    }
-    si.wi = si.to_local(-ray.d);
+    si.sh_frame = shading_frame(ns, si.dp_du);
 }
 
 PositionSample Mesh::sample_position(const Point2f &u_) const {
@@ -275,8 +366,13 @@ PositionSample Mesh::sample_position(const Point2f &u_) const {
     Point2f b = warp::square_to_uniform_triangle(u);
     float b0 = 1.f - b.x - b.y;
     ps.p = p0 * b0 + p1 * b.x + p2 * b.y;
-    Normal3f n = normalize(cross(p1 - p0, p2 - p0));
-    ps.n = m_flip_normals ? -n : n;
+    if (!m_face_table.empty()) {
+        const float *t = &m_face_table[9 * f];
+        ps.n = Normal3f(t[0], t[1], t[2]);
+    } else {
+        Normal3f n = normalize(cross(p1 - p0, p2 - p0));
+        ps.n = m_flip_normals ? -n : n;
+    }
     if (has_uvs())
         ps.uv = Point2f(m_uvs[2 * i0], m_uvs[2 * i0 + 1]) * b0 +
                 Point2f(m_uvs[2 * i1], m_uvs[2 * i1 + 1]) * b.x +

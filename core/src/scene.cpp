@@ -289,10 +289,17 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
         FACET_ASSERT(rh.hit.instID[0] < m_geometry_shapes.size());
         m_geometry_shapes[rh.hit.instID[0]]->compute_instance_interaction(
             ray, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, uv, si);
+        si.instance_index = rh.hit.instID[0];
     } else {
         FACET_ASSERT(rh.hit.geomID < m_geometry_shapes.size());
-        m_geometry_shapes[rh.hit.geomID]->compute_surface_interaction(ray, rh.ray.tfar,
-                                                                      rh.hit.primID, uv, si);
+        const Shape *shape = m_geometry_shapes[rh.hit.geomID];
+        // The shape fills in its geometry; the hit is finished here, once for every shape.
+        shape->compute_surface_interaction(ray, rh.ray.tfar, rh.hit.primID, uv, si);
+        si.t = rh.ray.tfar;
+        si.shape = shape;
+        si.prim_index = rh.hit.primID;
+        si.instance_index = uint32_t(-1);
+        si.wi = si.to_local(-ray.d);
     }
     return true;
 }

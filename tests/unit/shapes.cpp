@@ -108,6 +108,9 @@ public:
         if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
         m_shape->compute_surface_interaction(ray, rh.ray.tfar, rh.hit.primID,
                                              Point2f(rh.hit.u, rh.hit.v), si);
+        // What Scene::ray_intersect() adds to the geometry the shape filled in.
+        si.t = rh.ray.tfar;
+        si.wi = si.to_local(-ray.d);
         return true;
     }
 
@@ -697,6 +700,9 @@ TEST(ShapeIntersection, RectangleUvFrameAndFlip) {
     Properties props;
     props.set_transform("to_world", scale(2, 1, 1));
     auto rect = make_shape("rectangle", props);
+    // Flat: normals and frame of its faces come from the table built at load.
+    ASSERT_TRUE(std::dynamic_pointer_cast<Mesh>(rect));
+    EXPECT_TRUE(std::dynamic_pointer_cast<Mesh>(rect)->flat_faces());
     SingleShape scene(rect);
     SurfaceInteraction si;
     ASSERT_TRUE(scene.intersect(Ray(Point3f(1.f, 0.5f, 2.f), Vector3f(0, 0, -1)), si));
@@ -729,6 +735,7 @@ TEST(ShapeIntersection, MeshShadingNormalsAreInterpolated) {
                                             "vn -1 0 1\nvn 1 0 1\nvn 0 0 1\n"
                                             "f 1//1 2//2 3//3\n");
     auto mesh = make_mesh("obj", file_props(path));
+    EXPECT_FALSE(mesh->flat_faces()); // smooth: the frame is built at every hit
     SingleShape scene(mesh);
     SurfaceInteraction si;
     ASSERT_TRUE(scene.intersect(Ray(Point3f(0.5f, 0.25f, 1.f), Vector3f(0, 0, -1)), si));

@@ -37,6 +37,9 @@ public:
     const std::vector<uint32_t> &faces() const { return m_faces; }
     const std::string &name() const { return m_name; }
     bool flip_normals() const { return m_flip_normals; }
+    /// The shading normal is constant over every face, so normals and shading frames of the
+    /// faces were computed at load (hits only interpolate the position and uv).
+    bool flat_faces() const { return !m_face_table.empty(); }
 
     /// A named per-vertex or per-face quantity carried by the mesh (Mitsuba's mesh attributes:
     /// `vertex_color`, `vertex_tint_color`, `face_weight`, ...), read by `mesh_attribute`.
@@ -78,6 +81,14 @@ protected:
     bool m_flip_normals = false;
 
 private:
+    /// Fills m_face_table when the shading normal is constant over every face (no vertex
+    /// normals, or equal ones at the three corners of each face): then the geometric normal and
+    /// the shading frame of each face are computed once here instead of at every hit.
+    void build_face_table();
+
+    /// Per face when the mesh is flat (else empty): geometric normal, shading normal and the
+    /// shading frame's s, 9 floats (the frame's t is cross(ns, s)).
+    std::vector<float> m_face_table;
     std::vector<Attribute> m_attributes;
     std::vector<float> m_area_cdf; ///< cumulative triangle areas, normalised
     float m_area = 0.f;

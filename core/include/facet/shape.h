@@ -43,8 +43,11 @@ public:
         FACET_THROW("shape {} is not an instance", to_string());
     }
 
-    /// Fills `si` for a hit at distance t on primitive `prim_index`; `uv` is what Embree
-    /// reported (barycentrics for triangles, whatever the user geometry stored otherwise).
+    /// Fills the geometry of `si` (p, n, uv, dp_du, dp_dv, sh_frame, and shape and prim_index)
+    /// for a hit at distance t on primitive `prim_index`; `uv` is what Embree reported
+    /// (barycentrics for triangles, whatever the user geometry stored otherwise). The scene
+    /// then sets t, shape, prim_index and wi (in sh_frame) for a direct hit; an instance sets
+    /// t and wi for the hits on its members. Shapes may set them too (the same values).
     virtual void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
                                              const Point2f &uv, SurfaceInteraction &si) const = 0;
 
