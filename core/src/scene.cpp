@@ -35,7 +35,9 @@ struct alignas(64) RayCounter {
 };
 std::mutex g_ray_counter_mutex;
 std::vector<RayCounter *> *g_ray_counters = new std::vector<RayCounter *>();
-thread_local RayCounter *t_ray_counter = nullptr;
+// initial-exec: a plain thread-pointer-relative load instead of a __tls_get_addr call per ray
+// (libfacet is loaded with the program, or early enough that its few bytes of static TLS fit).
+thread_local RayCounter *t_ray_counter __attribute__((tls_model("initial-exec"))) = nullptr;
 
 inline void count_ray() {
     RayCounter *c = t_ray_counter;

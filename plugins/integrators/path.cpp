@@ -54,7 +54,8 @@ public:
         Color3f result(0.f), throughput(1.f);
         float eta = 1.f;
         uint32_t depth = 0;
-        SurfaceInteraction si, prev_si;
+        SurfaceInteraction si;
+        Interaction prev_si; // the previous vertex: MIS only needs its position and normal
         // The camera ray behaves like a delta bounce: whatever it hits is counted in full.
         float prev_bsdf_pdf = 1.f;
         bool prev_bsdf_delta = true;
