@@ -120,7 +120,10 @@ public:
     float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
         if (!(m_aperture_radius > 0.f)) return 0.f;
         const Point3f lens = m_world_to_local.apply_point(ds.p);
-        if (lens.x * lens.x + lens.y * lens.y > m_aperture_radius * m_aperture_radius) return 0.f;
+        // A little slack: a rim point sample_direction() drew comes back from world space
+        // rounded, and must keep its density.
+        const float r2 = m_aperture_radius * m_aperture_radius;
+        if (lens.x * lens.x + lens.y * lens.y > r2 * (1.f + 1e-4f)) return 0.f;
         const Vector3f w = m_world_to_local.apply_point(ref.p) - Point3f(lens.x, lens.y, 0.f);
         const float dist2 = dot(w, w);
         if (!(w.z > 0.f) || !(dist2 > 0.f)) return 0.f;
