@@ -122,7 +122,7 @@ foreach(_line IN LISTS _chi2_lines)
         endif()
         string(REGEX REPLACE "=/.*/" "=" _a "${_a}") # file names without their folder
         string(REGEX REPLACE "[^A-Za-z0-9_=.,:+-]" "_" _a "${_a}")
-        if(_test MATCHES "\\.(theta|phi|wi|ref|component|alpha|alpha-v|visible|shape|mode)$")
+        if(_test MATCHES "\\.(theta|phi|wi|ref|ref-local|aperture|film|component|alpha|alpha-v|visible|shape|mode)$")
             set(_test "${_test}=${_a}")
         else()
             set(_test "${_test}.${_a}")

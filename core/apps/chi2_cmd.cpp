@@ -1,4 +1,5 @@
-// `facet chi2 bsdf|emitter|microfacet ...`: the chi-square test of facet/chi2.h on any plugin.
+// `facet chi2 bsdf|emitter|sensor|microfacet ...`: the chi-square test of facet/chi2.h on any
+// plugin.
 
 #include "commands.h"
 
@@ -9,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -203,6 +205,32 @@ int chi2_main(int argc, char **argv) {
         "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
     add_common(*emitter, eo);
 
+    // sensor
+    CommonOptions so;
+    std::string sensor_name, sensor_xml, sensor_ref, sensor_ref_local, aperture_text = "0.5,0.5",
+                                                                       film_text;
+    std::vector<std::string> sensor_params;
+    CLI::App *sensor = app.add_subcommand(
+        "sensor", "Test a sensor's importance (light tracing): facet chi2 sensor <name> "
+                  "[key=value ...]; its camera rays, or its aperture seen from --ref");
+    sensor->add_option("name", sensor_name, "Sensor plugin name");
+    sensor->add_option("params", sensor_params, "Parameters, as for bsdf");
+    sensor->add_option("--xml", sensor_xml,
+                       "The sensor as XML text or an .xml file, a <sensor> or a whole <scene> "
+                       "(its first sensor is tested), instead of a name");
+    sensor->add_option("--film", film_text,
+                       "Film size width,height in pixels for a sensor given by name (default: "
+                       "the plugin's default film)");
+    sensor->add_option("--aperture", aperture_text,
+                       "Aperture sample u,v in [0,1) of the camera rays (default 0.5,0.5: the "
+                       "lens centre)");
+    sensor->add_option("--ref", sensor_ref,
+                       "Test the aperture sampling of sample_direction() from this world point "
+                       "x,y,z against pdf_direction() (thin lens), instead of the camera rays");
+    sensor->add_option("--ref-local", sensor_ref_local,
+                       "As --ref, with the point in the camera's frame (before to_world)");
+    add_common(*sensor, so);
+
     // microfacet
     CommonOptions mo;
     std::string distr_name, visible_text = "true";
@@ -273,6 +301,45 @@ int chi2_main(int argc, char **argv) {
         }
         EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]));
         return run(adapter, eo, slug("emitter", emitter_name, everything));
+    }
+    if (sensor->parsed()) {
+        add_plugin_dirs(so.plugin_dirs);
+        std::string text;
+        if (!sensor_xml.empty()) {
+            if (!sensor_name.empty() || !sensor_params.empty() || !film_text.empty())
+                FACET_THROW("give the sensor either by name and key=value parameters (and "
+                            "--film) or --xml");
+            text = read_xml_argument(sensor_xml);
+            if (text.find("<scene") == std::string::npos &&
+                text.find("version=") == std::string::npos)
+                text = "<scene version=\"3.0.0\">" + text + "</scene>";
+            sensor_name = "xml";
+        } else {
+            if (sensor_name.empty()) FACET_THROW("name the sensor plugin to test (or give --xml)");
+            Point2i film(0, 0);
+            if (!film_text.empty()) {
+                auto f = parse_floats(film_text, 2, "--film");
+                if (!(f[0] >= 1.f && f[1] >= 1.f) || f[0] != std::floor(f[0]) ||
+                    f[1] != std::floor(f[1]))
+                    FACET_THROW("--film \"{}\": expected two positive whole numbers", film_text);
+                film = Point2i(int(f[0]), int(f[1]));
+            }
+            text = SensorAdapter::sensor_xml(sensor_name, sensor_params, film);
+        }
+        std::shared_ptr<Sensor> camera = SensorAdapter::load(text);
+        if (!sensor_ref.empty() && !sensor_ref_local.empty())
+            FACET_THROW("give the reference point either with --ref or with --ref-local");
+        if (!sensor_ref.empty() || !sensor_ref_local.empty()) {
+            auto r = parse_floats(sensor_ref.empty() ? sensor_ref_local : sensor_ref, 3,
+                                  sensor_ref.empty() ? "--ref-local" : "--ref");
+            Point3f ref(r[0], r[1], r[2]);
+            if (!sensor_ref_local.empty()) ref = camera->to_world().apply_point(ref);
+            SensorAdapter adapter(camera, ref);
+            return run(adapter, so, slug("sensor", sensor_name, everything));
+        }
+        auto a = parse_floats(aperture_text, 2, "--aperture");
+        SensorAdapter adapter(camera, Point2f(a[0], a[1]));
+        return run(adapter, so, slug("sensor", sensor_name, everything));
     }
     // microfacet
     add_plugin_dirs(mo.plugin_dirs);

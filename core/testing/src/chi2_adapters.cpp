@@ -1,5 +1,5 @@
-// What the chi-square test drives: BSDFs, emitters and microfacet distributions, plus the XML
-// text of an object given as key=value entries (the `facet chi2` command line).
+// What the chi-square test drives: BSDFs, emitters, sensors and microfacet distributions, plus the
+// XML text of an object given as key=value entries (the `facet chi2` command line).
 
 #include <facet/chi2.h>
 #include <facet/emitter.h>
@@ -8,6 +8,7 @@
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/scene.h>
+#include <facet/sensor.h>
 #include <facet/shape.h>
 #include <facet/xml.h>
 
@@ -340,6 +341,197 @@ double EmissionAdapter::pdf(const Vector3f &d) const { return m_emitter->pdf_ray
 
 std::string EmissionAdapter::to_string() const {
     return fmt::format("{}, emitted ray directions", m_emitter->to_string());
+}
+
+// -- Sensors ----------------------------------------------------------------------------------
+
+namespace {
+
+Interaction point_at(const Point3f &p) {
+    Interaction it;
+    it.p = p;
+    it.n = Normal3f(0.f); // a point in space
+    it.t = 0.f;
+    return it;
+}
+
+} // namespace
+
+std::shared_ptr<Sensor> SensorAdapter::load(const std::string &xml) {
+    std::shared_ptr<Object> obj = load_string(xml);
+    if (obj && obj->type() == ObjectType::Scene) {
+        const auto &sensors = std::static_pointer_cast<Scene>(obj)->sensors();
+        if (sensors.empty()) FACET_THROW("SensorAdapter: the scene has no sensor");
+        return sensors.front();
+    }
+    return load_as<Sensor>(xml, ObjectType::Sensor);
+}
+
+std::string SensorAdapter::sensor_xml(const std::string &plugin,
+                                      const std::vector<std::string> &entries,
+                                      const Point2i &film_size) {
+    std::string film;
+    if (film_size.x > 0 && film_size.y > 0)
+        film = fmt::format("<film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/>"
+                           "<integer name=\"height\" value=\"{}\"/></film>",
+                           film_size.x, film_size.y);
+    return chi2_object_xml(ObjectType::Sensor, plugin, entries, film);
+}
+
+SensorAdapter::SensorAdapter(std::shared_ptr<Sensor> sensor, const Point2f &aperture_sample)
+    : m_sensor(std::move(sensor)), m_mode(Mode::RayDirections), m_aperture(aperture_sample) {
+    if (!m_sensor) FACET_THROW("SensorAdapter: no sensor");
+    if (!m_sensor->supports_direction_sampling())
+        FACET_THROW("{}: the sensor does not support sampling a direction towards it",
+                    m_sensor->to_string());
+    if (!(m_aperture.x >= 0.f && m_aperture.x < 1.f && m_aperture.y >= 0.f && m_aperture.y < 1.f))
+        FACET_THROW("SensorAdapter: the aperture sample ({}, {}) must lie in [0, 1)²", m_aperture.x,
+                    m_aperture.y);
+    m_world_to_local = m_sensor->to_world().inverse();
+    // Rays through three film positions: one origin (pinhole, a lens point) or one direction.
+    const Ray a = m_sensor->sample_ray(0.f, Point2f(0.5f, 0.5f), m_aperture).first;
+    const Ray b = m_sensor->sample_ray(0.f, Point2f(0.f, 0.5f), m_aperture).first;
+    const Ray c = m_sensor->sample_ray(0.f, Point2f(0.5f, 0.f), m_aperture).first;
+    const float extent = std::max(norm(b.o - a.o), norm(c.o - a.o));
+    const float scale = std::max({1.f, std::abs(a.o.x), std::abs(a.o.y), std::abs(a.o.z)});
+    // Importance is evaluated at a point well inside the clipping range of the centre ray.
+    m_dist = std::isfinite(a.maxt) && a.mint > 0.f ? std::sqrt(a.mint * a.maxt)
+                                                   : std::max(1.f, 10.f * a.mint);
+    if (extent <= 1e-5f * scale) {
+        m_origin = a.o;
+    } else if (dot(a.d, b.d) > 1.f - 1e-6f && dot(a.d, c.d) > 1.f - 1e-6f) {
+        // Parallel rays: their origins seen from behind the film, which then spans about
+        // ±45° horizontally.
+        m_mode = Mode::RayOrigins;
+        m_origin = a.o;
+        m_dir = a.d;
+        m_view = a.o - a.d * norm(b.o - a.o);
+    } else {
+        FACET_THROW("{}: its camera rays have neither one origin nor one direction (for a given "
+                    "aperture sample), which this test does not cover",
+                    m_sensor->to_string());
+    }
+}
+
+SensorAdapter::SensorAdapter(std::shared_ptr<Sensor> sensor, const Point3f &ref)
+    : m_sensor(std::move(sensor)), m_mode(Mode::Aperture), m_ref(ref) {
+    if (!m_sensor) FACET_THROW("SensorAdapter: no sensor");
+    if (!m_sensor->supports_direction_sampling())
+        FACET_THROW("{}: the sensor does not support sampling a direction towards it",
+                    m_sensor->to_string());
+    m_world_to_local = m_sensor->to_world().inverse();
+    auto [ds, weight] = m_sensor->sample_direction(point_at(m_ref), Point2f(0.5f, 0.5f));
+    if (ds.delta)
+        FACET_THROW("{}: seen from a point the sensor is a delta (a pinhole or parallel rays), "
+                    "which has no direction density: test its camera rays instead (no reference "
+                    "point)",
+                    m_sensor->to_string());
+}
+
+std::pair<DirectionSample, float> SensorAdapter::importance(const Point3f &p) const {
+    auto [ds, weight] = m_sensor->sample_direction(point_at(p), m_aperture);
+    return {ds, weight.g};
+}
+
+std::string SensorAdapter::check_round_trip(const Point3f &p, const Point2f &film) const {
+    auto [ds, weight] = importance(p);
+    if (!(weight > 0.f))
+        return fmt::format("sample_direction() gives no importance to {}, on the camera ray "
+                           "through film position ({}, {})",
+                           vec_str(Vector3f(p)), film.x, film.y);
+    const Point2i size = m_sensor->film().size();
+    const float du = ds.uv.x - film.x * float(size.x), dv = ds.uv.y - film.y * float(size.y);
+    const float tol = 1e-3f * float(std::max(size.x, size.y));
+    if (!(std::abs(du) <= tol && std::abs(dv) <= tol))
+        return fmt::format("sample_direction() towards {} finds film position ({}, {}) px, but "
+                           "the camera ray was traced through ({}, {}) px",
+                           vec_str(Vector3f(p)), ds.uv.x, ds.uv.y, film.x * float(size.x),
+                           film.y * float(size.y));
+    return {};
+}
+
+Chi2Sample SensorAdapter::sample(const float *u) const {
+    Chi2Sample s;
+    if (m_mode == Mode::Aperture) {
+        auto [ds, weight] = m_sensor->sample_direction(point_at(m_ref), Point2f(u[0], u[1]));
+        if (weight.is_black() || !(ds.pdf > 0.f)) return s;
+        s.kind = Chi2Sample::Kind::Smooth;
+        s.has_weight = true;
+        s.weight = weight;
+        s.d = ds.d;
+        s.sampled_pdf = ds.pdf;
+        s.pdf = m_sensor->pdf_direction(point_at(m_ref), ds);
+        return s;
+    }
+    const Point2f film(u[0], u[1]);
+    auto [ray, weight] = m_sensor->sample_ray(0.f, film, m_aperture);
+    if (weight.is_black()) return s;
+    s.kind = Chi2Sample::Kind::Smooth;
+    s.has_weight = true;
+    s.weight = weight;
+    Point3f on_ray;
+    if (m_mode == Mode::RayDirections) {
+        if (norm(ray.o - m_origin) > 1e-4f * std::max(1.f, norm(Vector3f(m_origin))))
+            s.problem =
+                fmt::format("the camera ray through ({}, {}) starts at {}, not at {}", film.x,
+                            film.y, vec_str(Vector3f(ray.o)), vec_str(Vector3f(m_origin)));
+        s.d = ray.d;
+        on_ray = ray.o + ray.d * m_dist;
+    } else {
+        if (dot(ray.d, m_dir) < 1.f - 1e-5f)
+            s.problem = fmt::format("the camera ray through ({}, {}) has direction {}, not {}",
+                                    film.x, film.y, vec_str(ray.d), vec_str(m_dir));
+        s.d = normalize(ray.o - m_view);
+        on_ray = ray.o + ray.d * m_dist;
+    }
+    s.pdf = float(pdf(s.d));
+    if (s.problem.empty()) s.problem = check_round_trip(on_ray, film);
+    return s;
+}
+
+double SensorAdapter::pdf(const Vector3f &d) const {
+    switch (m_mode) {
+    case Mode::Aperture: {
+        // The point of the aperture plane (local z = 0) that d from the reference point reaches.
+        const Point3f o = m_world_to_local.apply_point(m_ref);
+        const Vector3f ld = m_world_to_local.apply_vector(d);
+        if (!(o.z * ld.z < 0.f)) return 0.0;
+        DirectionSample ds;
+        ds.p = m_sensor->to_world().apply_point(o + ld * (-o.z / ld.z));
+        ds.d = d;
+        ds.dist = norm(ds.p - m_ref);
+        return m_sensor->pdf_direction(point_at(m_ref), ds);
+    }
+    case Mode::RayDirections: {
+        auto [ds, weight] = importance(m_origin + d * m_dist);
+        return double(weight) * double(ds.dist) * double(ds.dist);
+    }
+    case Mode::RayOrigins: {
+        const float cos_plane = dot(d, m_dir);
+        if (!(cos_plane > 0.f)) return 0.0;
+        const float t = dot(m_origin - m_view, m_dir) / cos_plane;
+        const Point3f o = m_view + d * t;
+        auto [ds, weight] = importance(o + m_dir * m_dist);
+        return double(weight) * double(t) * double(t) / double(cos_plane);
+    }
+    }
+    return 0.0;
+}
+
+std::string SensorAdapter::to_string() const {
+    switch (m_mode) {
+    case Mode::Aperture:
+        return fmt::format("{}, aperture seen from {}", m_sensor->to_string(),
+                           vec_str(Vector3f(m_ref)));
+    case Mode::RayDirections:
+        return fmt::format("{}, camera ray directions from {} (aperture sample {}, {})",
+                           m_sensor->to_string(), vec_str(Vector3f(m_origin)), m_aperture.x,
+                           m_aperture.y);
+    case Mode::RayOrigins:
+        return fmt::format("{}, camera ray origins seen from {}", m_sensor->to_string(),
+                           vec_str(Vector3f(m_view)));
+    }
+    return m_sensor->to_string();
 }
 
 // -- Microfacet distributions -----------------------------------------------------------------

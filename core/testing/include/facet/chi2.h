@@ -3,6 +3,7 @@
 #include <facet/bsdf.h>
 #include <facet/color.h>
 #include <facet/emitter.h>
+#include <facet/sensor.h>
 #include <facet/vector.h>
 
 #include <cstdint>
@@ -230,6 +231,61 @@ public:
 private:
     std::shared_ptr<Scene> m_scene;
     std::shared_ptr<Emitter> m_emitter;
+};
+
+/// A sensor's importance as the light tracer uses it (sample_direction(), pdf_direction()).
+///
+/// Camera rays (the first constructor): the directions of sample_ray() for uniform film
+/// positions and one fixed aperture sample, so that every ray leaves the same lens point,
+/// against the density that sample_direction()'s weight implies there. The weight is the
+/// importance towards a point with the 1/dist² of the connection, and for a light path to
+/// estimate what camera rays estimate it must equal the camera rays' solid-angle density over
+/// dist²: pdf(d) = weight · dist² for the point at distance dist along d. For a sensor whose rays
+/// are parallel (orthographic) the rays' origins on the film plane are seen from a point behind
+/// the film instead, and the weight (the importance per unit film area) times dist²/cos is
+/// their density. Each sample also checks that sample_direction() finds the film position the
+/// ray was traced through.
+///
+/// From a reference point (the second constructor): the aperture points that sample_direction()
+/// draws, seen from `ref`, against pdf_direction() (the thin lens; a pinhole or orthographic
+/// sensor is a delta seen from a point and has no density to test). The aperture is taken to lie
+/// in the camera's local z = 0 plane, and `ref` should be seen from every aperture point (on the
+/// plane in focus, say): a sample that misses the film fails and breaks the pdf's integral check.
+class SensorAdapter : public Chi2Adapter {
+public:
+    explicit SensorAdapter(std::shared_ptr<Sensor> sensor,
+                           const Point2f &aperture_sample = Point2f(0.5f, 0.5f));
+    SensorAdapter(std::shared_ptr<Sensor> sensor, const Point3f &ref);
+
+    /// Loads `<sensor version="3.0.0" type="...">...</sensor>` (or the first sensor of a
+    /// `<scene>`) with load_string.
+    static std::shared_ptr<Sensor> load(const std::string &xml);
+    /// The XML text of sensor `plugin` with `entries` (see chi2_object_xml) and an hdrfilm of
+    /// `film_size` pixels (the plugin's default film when either is zero).
+    static std::string sensor_xml(const std::string &plugin,
+                                  const std::vector<std::string> &entries,
+                                  const Point2i &film_size = Point2i(0, 0));
+
+    int sample_dim() const override { return 2; }
+    Chi2Sample sample(const float *u) const override;
+    double pdf(const Vector3f &d) const override;
+    std::string to_string() const override;
+
+private:
+    enum class Mode { RayDirections, RayOrigins, Aperture };
+    /// The importance weight towards world point p (aperture sample m_aperture) and the record.
+    std::pair<DirectionSample, float> importance(const Point3f &p) const;
+    /// "" when sample_direction() towards a point on the ray finds film position `film`.
+    std::string check_round_trip(const Point3f &p, const Point2f &film) const;
+    std::shared_ptr<Sensor> m_sensor;
+    Mode m_mode;
+    Point2f m_aperture;
+    Point3f m_ref;      ///< Aperture: the reference point
+    Point3f m_origin;   ///< RayDirections: the rays' origin; RayOrigins: the film centre
+    Point3f m_view;     ///< RayOrigins: the point behind the film the origins are seen from
+    Vector3f m_dir;     ///< RayOrigins: the rays' direction
+    float m_dist = 1.f; ///< distance along a ray of the point importance is evaluated at
+    Transform m_world_to_local;
 };
 
 /// A microfacet distribution's normal sampling (facet/microfacet.h) for incident direction wi.
