@@ -3,7 +3,9 @@ static const char *DOC = R"DOC(
 
 An environment that surrounds the scene and sends the same `radiance` from every direction.
 Directions are sampled uniformly over the sphere (pdf 1/4π); the sampled point lies beyond the
-scene's bounding sphere, so shadow rays towards it cross the whole scene.
+scene's bounding sphere, so shadow rays towards it cross the whole scene. Emitted rays (for the
+particle tracer) come from a uniform direction and a uniform point of the disk of the bounding
+sphere's radius facing it, just outside the sphere, as in Mitsuba.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -17,6 +19,7 @@ scene's bounding sphere, so shadow rays towards it cross the whole scene.
 )DOC";
 
 #include <facet/emitter.h>
+#include <facet/frame.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/scene.h>
@@ -65,6 +68,17 @@ public:
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override {
         return InvFourPi;
+    }
+
+    /// A ray entering the bounding sphere: travel direction w uniform on the sphere, origin on
+    /// the disk of radius r facing it (centre c - w r). Power per ray: L 4π · π r².
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+        const Vector3f w = warp::square_to_uniform_sphere(u_dir);
+        const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
+        const Frame frame(w);
+        const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y - w) * m_radius;
+        const float area = Pi * m_radius * m_radius;
+        return {Ray(o, w), radiance_along(-w) * (4.f * Pi * area)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override { return m_radiance->eval(si); }

@@ -13,7 +13,9 @@ Negative pixel values are kept.
 Directions are sampled in proportion to the luminance times sin θ on the same grid,
 interpolated bilinearly between grid points. With `mis_compensation` the map's mean luminance
 is subtracted first (clamped at zero; Karlík et al. 2019), which helps when the emitter is
-combined with BSDF sampling by MIS; it is skipped for near-constant maps.
+combined with BSDF sampling by MIS; it is skipped for near-constant maps. Emitted rays (for the
+particle tracer) come from a direction drawn the same way and a uniform point of the disk of the
+scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba.
 
 | Parameter           | Type      | Default  | Description                                                        |
 |---------------------|-----------|----------|--------------------------------------------------------------------|
@@ -37,6 +39,7 @@ combined with BSDF sampling by MIS; it is skipped for near-constant maps.
 
 #include <facet/distribution.h>
 #include <facet/emitter.h>
+#include <facet/frame.h>
 #include <facet/image.h>
 #include <facet/plugin.h>
 #include <facet/resolver.h>
@@ -141,6 +144,23 @@ public:
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
         return pdf_local(normalize(m_to_world.inverse().apply_vector(ds.d)));
+    }
+
+    /// A ray entering the bounding sphere (the particle tracer): the direction it comes from is
+    /// drawn as sample_direction() draws it, the origin uniformly on the disk of the sphere's
+    /// radius facing that direction, just outside the sphere. Power per ray: L / pdf · π r².
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir))
+                                            : warp::square_to_uniform_sphere(u_dir);
+        const Vector3f from = normalize(m_to_world.apply_vector(local));
+        local = normalize(m_to_world.inverse().apply_vector(from));
+        const float pdf = pdf_local(local);
+        if (!(pdf > 0.f)) return {Ray(), Color3f(0.f)};
+        const float radius = m_radius * (1.f + RayEpsilon);
+        const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
+        const Frame frame(from);
+        const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y + from) * radius;
+        return {Ray(o, -from), lookup(local) * (Pi * radius * radius / pdf)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
