@@ -3,7 +3,9 @@ static const char *DOC = R"DOC(
 
 Traces paths from the emitters (light tracing) and connects every surface vertex to the sensor,
 splatting the contribution into the pixel it lands on. Emitters seen directly by the camera are
-counted by a separate connection from a point sampled on the emitter to the sensor. Each sample
+counted by a separate connection from a point sampled on the emitter to the sensor; for an
+environment (`constant`, `envmap`) the point is far away in a direction the emitter samples from
+the sensor's position, as in Mitsuba. Each sample
 is one light path (plus one emitter connection); a render takes width x height x spp samples,
 so the spp counts light paths per pixel as in Mitsuba. After `rr_depth` bounces, Russian roulette
 ends paths whose throughput has become small.
@@ -12,9 +14,9 @@ The image does not depend on the thread count: the light paths of each pass are 
 fixed number of work units that splat into their own image buffers, merged in unit order, and
 every path's random numbers are seeded from (seed, path index).
 
-The sensor must support sampling a direction towards it (perspective, thinlens, orthographic);
-every emitter must be able to emit rays (area, point, spot, directional, directionalarea, ...).
-Emitters at infinity seen directly by the camera are not counted.
+The sensor must support sampling a direction towards it (perspective, thinlens, orthographic).
+Every emitter emits rays: environments send them into the scene's bounding sphere from a disk
+facing the sampled direction, so an environment lights the scene as it does for the path tracer.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -88,14 +90,6 @@ public:
         // The importance of the sensors integrates to one over the whole film: every pixel
         // receives spp times its value from width x height x spp paths.
         film.set_splat_scale(1.0 / double(spp));
-
-        for (const auto &e : scene.emitters())
-            if (has_flag(e->flags(), EmitterFlags::Infinite) &&
-                !has_flag(e->flags(), EmitterFlags::DeltaDirection))
-                FACET_THROW("ptracer: the emitter {} is at infinity; the particle tracer supports "
-                            "only emitters that can emit rays (area, point, spot, directional, "
-                            "directionalarea, ...)",
-                            e->to_string());
 
         // A fixed number of work units per pass, whatever the thread count (determinism).
         const uint64_t units_per_pass = std::min<uint64_t>(UnitsPerPass, paths_per_pass);
@@ -247,6 +241,12 @@ private:
                          float n_emitters, Sampler &sampler, ImageBlock &block,
                          const ReconstructionFilter &filter) const {
         const Point2f u_pos = sampler.next_2d(), u_sensor = sampler.next_2d();
+        if (emitter.is_infinite()) {
+            if (!emitter.is_delta())
+                connect_environment(scene, sensor, emitter, n_emitters, u_pos, u_sensor, block,
+                                    filter);
+            return;
+        }
         // Point and spot lights are invisible to a camera; only emitters on shapes are seen.
         const Shape *shape = emitter.shape();
         if (emitter.is_delta() || !shape) return;
@@ -269,6 +269,44 @@ private:
         if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
         Color3f value = L * (cos_theta * n_emitters / ps.pdf) * importance;
         if (value.is_finite()) block.splat(ds.uv, value, filter);
+    }
+
+    /// An environment seen directly: a direction sampled by the emitter from the sensor's
+    /// position gives a far point (on a sphere around that position, facing it, beyond the
+    /// scene's bounding sphere), which is
+    /// connected to the sensor like a point of a surface, with the area density pdf / dist² of
+    /// that sphere and no cosine. The radiance is the environment's along the connection.
+    void connect_environment(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
+                             float n_emitters, const Point2f &u_pos, const Point2f &u_sensor,
+                             ImageBlock &block, const ReconstructionFilter &filter) const {
+        Interaction ref;
+        ref.p = sensor.to_world().apply_point(Point3f(0.f));
+        ref.n = Normal3f(0.f);
+        ref.t = 0.f;
+        auto [eds, eweight] = emitter.sample_direction(ref, u_pos);
+        if (!(eds.pdf > 0.f) || eweight.is_black()) return;
+        // The far point, outside the scene's bounding sphere wherever the sensor is (the
+        // emitter's own point assumes a reference point inside it).
+        const BoundingBox3f &bbox = scene.bbox();
+        const Point3f centre = bbox.valid() ? bbox.center() : Point3f(0.f);
+        const float radius = bbox.valid() ? bbox.bounding_sphere_radius() : 0.f;
+        const float dist = 2.f * std::max(radius, 1.f) + norm(ref.p - centre);
+        const float dist2 = dist * dist;
+        if (!std::isfinite(dist2)) return;
+        SurfaceInteraction si;
+        si.p = ref.p + eds.d * dist;
+        si.n = -eds.d;
+        si.sh_frame = Frame(si.n);
+        si.t = 0.f;
+        auto [ds, importance] = sensor.sample_direction(si, u_sensor);
+        if (importance.is_black() || !(dot(ds.d, si.n) > 0.f)) return;
+        if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
+        // The radiance a camera ray from the sensor point along -ds.d would find.
+        SurfaceInteraction miss;
+        Scene::escaped(Ray(ds.p, -ds.d), miss);
+        const Color3f L = emitter.eval(miss);
+        Color3f value = L * (dist2 * n_emitters / eds.pdf) * importance;
+        if (!value.is_black() && value.is_finite()) block.splat(ds.uv, value, filter);
     }
 
     uint32_t m_max_depth;

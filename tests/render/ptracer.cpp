@@ -1,8 +1,10 @@
 // The particle tracer: the same image for any thread count, and the same picture as the path
 // tracer on a scene with an area light seen directly and a point light (a two-sample test of
 // independent renders of each), plus the directionalarea emitter that only it can render and a
-// directional light.
+// directional light, and environments (constant, envmap) against the path tracer by the peer
+// comparison rule.
 
+#include <facet/compare.h>
 #include <facet/integrator.h>
 #include <facet/render.h>
 #include <facet/scene.h>
@@ -13,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -279,4 +282,138 @@ TEST(ParticleTracer, DirectionalLightOnADiffuseFloor) {
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) mean += img.at(x, y, 1) / 256.0;
     EXPECT_NEAR(mean, 0.5 * 2.0 * 0.5 / Pi, 0.03 * 0.5 * 2.0 * 0.5 / Pi);
+}
+
+namespace {
+
+/// A diffuse sphere on a diffuse floor under an environment, seen against it.
+std::string environment_scene(const std::string &integrator, const std::string &emitter,
+                              bool hide_emitters = false) {
+    return fmt::format(R"(<scene version="3.0.0">
+    <integrator type="{integrator}">
+        <integer name="max_depth" value="3"/>
+        <boolean name="hide_emitters" value="{hide}"/>
+    </integrator>
+    <sensor type="perspective">
+        <float name="fov" value="90"/>
+        <transform name="to_world">
+            <lookat origin="0, 1.2, 2.5" target="0, 0.4, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="24"/><integer name="height" value="24"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="1.5"/><rotate x="1" angle="-90"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.6, 0.6, 0.6"/></bsdf>
+    </shape>
+    <shape type="sphere">
+        <point name="center" value="0, 0.5, 0"/><float name="radius" value="0.5"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.5, 0.3"/></bsdf>
+    </shape>
+    {emitter}
+</scene>)",
+                       fmt::arg("integrator", integrator), fmt::arg("emitter", emitter),
+                       fmt::arg("hide", hide_emitters ? "true" : "false"));
+}
+
+/// K independent renders (seeds 0 .. K-1) at `spp`: their mean (RGB) and the per-sample variance
+/// of each pixel in XYZ (the variance of one render times spp), as facet compare takes them.
+struct MeanAndVariance {
+    Image mean, var_xyz;
+    int spp = 0;
+};
+
+MeanAndVariance independent_means(const Scene &scene, int spp, int k) {
+    const Sensor &sensor = *scene.sensors().at(0);
+    MeanAndVariance out;
+    std::vector<Image> xyz;
+    for (int i = 0; i < k; ++i) {
+        RenderOptions opts;
+        opts.threads = 2;
+        opts.progress = false;
+        opts.spp = spp;
+        opts.seed = uint64_t(i) * 7919u;
+        Image img = render(scene, sensor, opts).image;
+        if (i == 0) {
+            out.mean = Image(img.width, img.height, 3);
+            out.var_xyz = Image(img.width, img.height, 3);
+        }
+        Image x(img.width, img.height, 3);
+        for (int y = 0; y < img.height; ++y)
+            for (int px = 0; px < img.width; ++px) {
+                const Color3f c(img.at(px, y, 0), img.at(px, y, 1), img.at(px, y, 2));
+                const Color3f v = srgb_to_xyz(c);
+                for (int ch = 0; ch < 3; ++ch) {
+                    out.mean.at(px, y, ch) += c[ch] / float(k);
+                    x.at(px, y, ch) = v[ch];
+                }
+            }
+        xyz.push_back(std::move(x));
+    }
+    for (size_t p = 0; p < out.var_xyz.data.size(); ++p) {
+        double sum = 0.0, sum2 = 0.0;
+        for (const Image &x : xyz) {
+            sum += x.data[p];
+            sum2 += double(x.data[p]) * x.data[p];
+        }
+        const double m = sum / k, var = std::max(0.0, (sum2 - k * m * m) / (k - 1));
+        out.var_xyz.data[p] = float(var * spp);
+    }
+    out.spp = spp * k;
+    return out;
+}
+
+/// The particle tracer's image of the environment scene agrees with the path tracer's by the
+/// peer rule (facet compare): z = |ptracer - path| sqrt(N / var) per pixel and XYZ channel with
+/// N the light paths per pixel, where var holds both renders' noise (the path tracer's scaled
+/// to N samples), and 99.75 % of the channels must pass the Sidak-corrected level.
+void expect_agreement(const std::string &emitter) {
+    auto pt = load_temp_scene("env-pt", environment_scene("ptracer", emitter));
+    auto path = load_temp_scene("env-path", environment_scene("path", emitter));
+    // Directly visible environment pixels receive a few of the emitter connections of each
+    // render: enough light paths per render keep those counts away from the small, skewed
+    // Poisson counts that would make the variance estimate of 16 renders too low.
+    MeanAndVariance a = independent_means(*pt, 128, 16);
+    MeanAndVariance b = independent_means(*path, 512, 4);
+    Image var = a.var_xyz;
+    for (size_t p = 0; p < var.data.size(); ++p)
+        var.data[p] += b.var_xyz.data[p] * float(a.spp) / float(b.spp);
+    PeerComparison cmp = compare_with_reference(a.mean, b.mean, var, a.spp);
+    std::printf("ptracer vs path: %.2f %% of the pixel-channels agree, brightness %+.2f %%\n",
+                100.0 * cmp.fraction, 100.0 * cmp.brightness_difference());
+    EXPECT_TRUE(cmp.passed_rule) << "agreement " << 100.0 * cmp.fraction << " %";
+    EXPECT_EQ(cmp.non_finite, 0u);
+    EXPECT_NEAR(cmp.brightness_difference(), 0.0, 0.02);
+    // Sky pixels above the floor see the environment directly: the ptracer counts it there.
+    EXPECT_GT(a.mean.at(12, 0, 1), 0.f);
+}
+
+} // namespace
+
+TEST(ParticleTracer, ConstantEnvironmentAgreesWithThePathTracer) {
+    expect_agreement(R"(<emitter type="constant"><rgb name="radiance" value="0.8, 1, 1.3"/>
+                        </emitter>)");
+}
+
+TEST(ParticleTracer, EnvironmentMapAgreesWithThePathTracer) {
+    expect_agreement(fmt::format(R"(<emitter type="envmap">
+        <string name="filename" value="{}/tests/chi2/envmap_sky.exr"/>
+        <transform name="to_world"><rotate y="1" angle="40"/></transform>
+    </emitter>)",
+                                 FACET_SOURCE_DIR));
+}
+
+TEST(ParticleTracer, HiddenEnvironmentLeavesTheSkyBlack) {
+    // hide_emitters: the sky pixels (the top rows look over the floor) get nothing, the lit
+    // floor and sphere still do.
+    auto scene = load_temp_scene(
+        "env-hidden", environment_scene("ptracer", R"(<emitter type="constant"/>)", true));
+    Image img = render_with(*scene, 2).image;
+    for (int x = 0; x < img.width; ++x)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(img.at(x, 0, c), 0.f) << x;
+    EXPECT_GT(img.at(12, 12, 1), 0.f); // the sphere
+    EXPECT_GT(img.at(3, 16, 1), 0.f);  // the floor
 }
