@@ -116,8 +116,9 @@ TEST(HostileCli, EveryClassEndsInOneLocatedErrorLine) {
     for (const Case &c : cases()) {
         SCOPED_TRACE(c.name);
         std::ofstream(dir / "scene.xml") << c.xml;
-        std::string cmd = "cd '" + dir.string() + "' && '" + FACET + "' render -q -t 2 " +
-                          c.defines + " scene.xml -o out.exr > out.txt 2> err.txt < /dev/null";
+        std::string cmd = "cd '" + dir.string() + "' && '" + FACET +
+                          "' render -q -t 2 -o out.exr scene.xml " + c.defines +
+                          " > out.txt 2> err.txt < /dev/null";
         auto start = std::chrono::steady_clock::now();
         int status = std::system(cmd.c_str());
         double seconds =
