@@ -24,7 +24,8 @@ int colors_main(int argc, char **argv) {
     fmt::print("\nDisplays and their views (* = default):\n");
     for (const auto &d : cfg.displays) {
         fmt::print("  {}{}\n", d.name, d.name == cfg.default_display ? " *" : "");
-        for (const auto &v : d.views) fmt::print("      {}{}\n", v, v == d.default_view ? " *" : "");
+        for (const auto &v : d.views)
+            fmt::print("      {}{}\n", v, v == d.default_view ? " *" : "");
     }
     fmt::print("\nLooks:\n");
     if (cfg.looks.empty()) fmt::print("  (none)\n");

@@ -10,8 +10,7 @@ namespace facet {
 namespace {
 
 /// Solves f = A q + b for the 2×2 matrix A and offset b from three correspondences.
-bool fit_affine_2d(const Point2f (&q)[3], const Point2f (&f)[3], float (&a)[2][2],
-                   float (&b)[2]) {
+bool fit_affine_2d(const Point2f (&q)[3], const Point2f (&f)[3], float (&a)[2][2], float (&b)[2]) {
     const double q1x = q[1].x - q[0].x, q1y = q[1].y - q[0].y;
     const double q2x = q[2].x - q[0].x, q2y = q[2].y - q[0].y;
     const double det = q1x * q2y - q2x * q1y;
@@ -62,28 +61,51 @@ std::optional<Matrix4f> sensor_world_to_ndc(const Sensor &sensor) {
         q[i] = pinhole ? Point2f(dir[i].x / dir[i].z, dir[i].y / dir[i].z)
                        : Point2f(origin[i].x, origin[i].y);
     float a[2][2], b[2];
-    if (!fit_affine_2d({q[0], q[1], q[2]}, {film[0], film[1], film[2]}, a, b))
-        return std::nullopt;
+    if (!fit_affine_2d({q[0], q[1], q[2]}, {film[0], film[1], film[2]}, a, b)) return std::nullopt;
     // The fourth ray must land where the fit says (a fisheye lens would not).
     const float px = a[0][0] * q[3].x + a[0][1] * q[3].y + b[0];
     const float py = a[1][0] * q[3].x + a[1][1] * q[3].y + b[1];
-    if (std::abs(px - film[3].x) > 1e-4f || std::abs(py - film[3].y) > 1e-4f)
-        return std::nullopt;
+    if (std::abs(px - film[3].x) > 1e-4f || std::abs(py - film[3].y) > 1e-4f) return std::nullopt;
 
     Matrix4f p;
     const bool finite_far = std::isfinite(far_z) && far_z > near_z;
     if (pinhole) {
         // x' w = a (x, y) + b z with w = z; z' = far (z - near) / (z (far - near)).
-        const float m[16] = {a[0][0], a[0][1], b[0], 0.f, a[1][0], a[1][1], b[1], 0.f,
-                             0.f,     0.f,     finite_far ? far_z / (far_z - near_z) : 1.f,
+        const float m[16] = {a[0][0],
+                             a[0][1],
+                             b[0],
+                             0.f,
+                             a[1][0],
+                             a[1][1],
+                             b[1],
+                             0.f,
+                             0.f,
+                             0.f,
+                             finite_far ? far_z / (far_z - near_z) : 1.f,
                              finite_far ? -far_z * near_z / (far_z - near_z) : -near_z,
-                             0.f,     0.f,     1.f,  0.f};
+                             0.f,
+                             0.f,
+                             1.f,
+                             0.f};
         p = Matrix4f::from_rows(m);
     } else {
         if (!finite_far) return std::nullopt;
-        const float m[16] = {a[0][0], a[0][1], 0.f, b[0], a[1][0], a[1][1], 0.f, b[1],
-                             0.f, 0.f, 1.f / (far_z - near_z), -near_z / (far_z - near_z),
-                             0.f, 0.f, 0.f, 1.f};
+        const float m[16] = {a[0][0],
+                             a[0][1],
+                             0.f,
+                             b[0],
+                             a[1][0],
+                             a[1][1],
+                             0.f,
+                             b[1],
+                             0.f,
+                             0.f,
+                             1.f / (far_z - near_z),
+                             -near_z / (far_z - near_z),
+                             0.f,
+                             0.f,
+                             0.f,
+                             1.f};
         p = Matrix4f::from_rows(m);
     }
     return p * world_to_camera.matrix;

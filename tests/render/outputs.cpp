@@ -175,12 +175,17 @@ TEST_F(Outputs, FullFilesystemFailsAndKeepsTheOldImage) {
         GTEST_SKIP() << "unshare -rm is not permitted here (no user/mount namespaces); the "
                         "ulimit test above covers the same path";
     const std::string script =
-        "set -u; d='" + path("tmpfs") + "'; mkdir -p \"$d\"; "
+        "set -u; d='" + path("tmpfs") +
+        "'; mkdir -p \"$d\"; "
         "mount -t tmpfs -o size=256k tmpfs \"$d\" || exit 77; "
-        "'" + FACET + "' render scene.xml -q -D res=16 -o \"$d/out.png\" || exit 78; "
+        "'" +
+        FACET +
+        "' render scene.xml -q -D res=16 -o \"$d/out.png\" || exit 78; "
         "cp \"$d/out.png\" before.png; "
         "dd if=/dev/zero of=\"$d/filler\" bs=1k 2> /dev/null; "
-        "'" + FACET + "' render scene.xml -q -D res=256 -o \"$d/out.png\" 2> err.txt; "
+        "'" +
+        FACET +
+        "' render scene.xml -q -D res=256 -o \"$d/out.png\" 2> err.txt; "
         "echo $? > code.txt; cp \"$d/out.png\" after.png; ls -a \"$d\" > listing.txt";
     write_file(m_dir / "full.sh", script);
     Result r;

@@ -60,11 +60,11 @@ TEST(ReadmeImages, EveryReferencedImageIsInTheRepository) {
         return;
     }
     for (const std::string &image : images) {
-        const std::string tracked = command_output("git -C '" + src.string() +
-                                                   "' ls-files -- '" + image + "' 2>/dev/null");
-        const std::string ignored = command_output("git -C '" + src.string() +
-                                                   "' check-ignore -q -- '" + image +
-                                                   "' 2>/dev/null && echo ignored");
+        const std::string tracked =
+            command_output("git -C '" + src.string() + "' ls-files -- '" + image + "' 2>/dev/null");
+        const std::string ignored =
+            command_output("git -C '" + src.string() + "' check-ignore -q -- '" + image +
+                           "' 2>/dev/null && echo ignored");
         EXPECT_TRUE(!tracked.empty() || ignored.empty())
             << image << " is ignored by .gitignore, so a commit would leave it out";
     }
