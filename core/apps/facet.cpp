@@ -92,8 +92,7 @@ int run(int argc, char **argv) {
     const Command commands[] = {
         {"render", render_main},   {"plugins", plugins_main}, {"bench", bench_main},
         {"compare", compare_main}, {"chi2", chi2_main},       {"new-plugin", new_plugin_main},
-        {"merge", merge_main},
-        {"colors", colors_main},
+        {"merge", merge_main},     {"colors", colors_main},
     };
     for (const Command &cmd : commands) {
         if (first == cmd.name) return cmd.run(argc - 1, argv + 1);
