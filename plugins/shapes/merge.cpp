@@ -60,6 +60,7 @@ public:
         // initialize() renormalises the normals; the members' values are kept bit for bit so
         // that the merged scene renders exactly like the separate meshes.
         m_normals = std::move(normals);
+        build_face_table(); // from the members' normals, as each member built its own
     }
 
 private:

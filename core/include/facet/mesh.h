@@ -80,12 +80,13 @@ protected:
     std::vector<uint32_t> m_faces;  ///< 3 per triangle
     bool m_flip_normals = false;
 
-private:
     /// Fills m_face_table when the shading normal is constant over every face (no vertex
     /// normals, or equal ones at the three corners of each face): then the geometric normal and
-    /// the shading frame of each face are computed once here instead of at every hit.
+    /// the shading frame of each face are computed once here instead of at every hit. Called by
+    /// initialize() and recompute_vertex_normals(); again by a shape that edits m_normals after.
     void build_face_table();
 
+private:
     /// Per face when the mesh is flat (else empty): geometric normal, shading normal and the
     /// shading frame's s, 9 floats (the frame's t is cross(ns, s)).
     std::vector<float> m_face_table;
