@@ -214,6 +214,16 @@ std::string transform_problem(const Transform &t, float max_entry, float max_inv
     return {};
 }
 
+bool has_scale(const Transform &t) {
+    const auto &m = t.matrix.m;
+    for (int j = 0; j < 3; ++j) {
+        const double len2 =
+            double(m[0][j]) * m[0][j] + double(m[1][j]) * m[1][j] + double(m[2][j]) * m[2][j];
+        if (!(len2 >= 0.999 && len2 <= 1.001)) return true;
+    }
+    return false;
+}
+
 std::string Transform::to_string() const {
     std::string s = "[";
     for (int i = 0; i < 4; ++i) {

@@ -8,7 +8,7 @@ either, the camera has a 50 mm lens on a 36x24 mm film, measured along the diago
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
-| to_world | transform | identity | Camera-to-world transform (usually a `<lookat>`) |
+| to_world | transform | identity | Camera-to-world transform (usually a `<lookat>`; rigid: no scale, as in Mitsuba) |
 | fov | float | (from focal_length) | Field of view in degrees, 0 < fov < 180, along `fov_axis` |
 | fov_axis | string | x | Axis of `fov`: x, y, diagonal, smaller or larger (read only with `fov`) |
 | focal_length | string | 50mm | 35 mm equivalent focal length ("<f>mm", or a bare number in mm); not with `fov` |
@@ -68,6 +68,12 @@ public:
 
         m_tan_x = float(std::tan(0.5 * m_x_fov * 3.14159265358979323846 / 180.0));
         m_tan_y = float(double(m_tan_x) / aspect);
+        // As in Mitsuba: the importance and the lens density are those of a rigid camera.
+        if (has_scale(m_to_world))
+            FACET_THROW_AT(props.location("to_world"),
+                           "scale factors in the camera-to-world transformation are not allowed "
+                           "(to_world = {})",
+                           m_to_world.to_string());
         m_origin = m_to_world.apply_point(Point3f(0.f));
         m_world_to_local = m_to_world.inverse();
     }

@@ -57,6 +57,12 @@ public:
         if (!(m_near_clip > 0.f) || !(m_far_clip > m_near_clip))
             FACET_THROW_AT(props.location(),
                            "the clipping planes must satisfy 0 < near_clip < far_clip");
+        // As in Mitsuba: the importance and the lens density are those of a rigid camera.
+        if (has_scale(m_to_world))
+            FACET_THROW_AT(props.location("to_world"),
+                           "scale factors in the camera-to-world transformation are not allowed "
+                           "(to_world = {})",
+                           m_to_world.to_string());
         m_world_to_local = m_to_world.inverse();
         m_forward = normalize(m_to_world.apply_vector(Vector3f(0.f, 0.f, 1.f)));
     }

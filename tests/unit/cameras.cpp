@@ -110,3 +110,31 @@ TEST(ThinLens, MissingParametersAreErrors) {
         make_sensor("thinlens", Transform(), {{"aperture_radius", -1.0}, {"focus_distance", 3.0}}),
         std::exception);
 }
+
+TEST(ProjectiveCameras, ScaledToWorldIsRefusedAsInMitsuba) {
+    // The pinhole's and the lens's importance and densities assume a rigid camera frame: a
+    // scaled to_world would mix world and camera distances. Mitsuba refuses it; so does facet.
+    const Transform look = Transform::look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0});
+    const std::vector<std::pair<std::string, double>> lens = {{"aperture_radius", 0.1},
+                                                              {"focus_distance", 3.0}};
+    for (const auto &[type, params] :
+         {std::pair{std::string("perspective"), std::vector<std::pair<std::string, double>>{}},
+          std::pair{std::string("thinlens"), lens}}) {
+        SCOPED_TRACE(type);
+        for (const Vector3f &s : {Vector3f(2, 2, 2), Vector3f(1, 1, 0.5f), Vector3f(1.01f, 1, 1)}) {
+            try {
+                make_sensor(type, look * Transform::scale(s), params);
+                ADD_FAILURE() << "a scaled to_world was accepted";
+            } catch (const std::exception &e) {
+                EXPECT_NE(std::string(e.what()).find("scale factors in the camera-to-world"),
+                          std::string::npos)
+                    << e.what();
+            }
+        }
+        // Rigid frames, mirrored ones included (scale x = -1 flips the image, as in Mitsuba),
+        // and rounding-level deviations are accepted.
+        EXPECT_NO_THROW(make_sensor(type, look, params));
+        EXPECT_NO_THROW(make_sensor(type, look * Transform::scale({-1, 1, 1}), params));
+        EXPECT_NO_THROW(make_sensor(type, look * Transform::scale({1.0004f, 1, 1}), params));
+    }
+}

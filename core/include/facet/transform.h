@@ -64,4 +64,9 @@ constexpr float MaxSceneCoordinate = 1e12f;
 std::string transform_problem(const Transform &t, float max_entry = MaxSceneCoordinate,
                               float max_inverse_entry = MaxSceneCoordinate);
 
+/// True when the linear part of `t` changes lengths: one of the images of the three axes has a
+/// squared length outside [0.999, 1.001] (Mitsuba's test; mirroring, e.g. scale x = -1, is no
+/// scale). Mitsuba's perspective and thin-lens cameras refuse such a to_world.
+bool has_scale(const Transform &t);
+
 } // namespace facet
