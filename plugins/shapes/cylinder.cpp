@@ -87,8 +87,13 @@ public:
         m_length = norm(ez);
         m_area = 2.f * Pi * m_radius * m_length;
         const float det = dot(cross(ex, ey), ez);
-        if (!(m_area > 0.f) || !std::isfinite(m_area) || !(std::abs(det) > 0.f) ||
+        if (!std::isfinite(m_radius) || !std::isfinite(m_length) || !std::isfinite(m_area) ||
             !std::isfinite(det))
+            FACET_THROW_AT(props.has("radius") ? props.location("radius") : props.location(),
+                           "cylinder: too large for single precision (radius {}, length {}, "
+                           "then to_world: its world-space size or area overflows)",
+                           radius, length);
+        if (!(m_area > 0.f) || !(std::abs(det) > 0.f))
             FACET_THROW_AT(props.location("to_world"),
                            "cylinder: to_world collapses the cylinder ({})", to_world.to_string());
         // The tolerances of Mitsuba's check on the polar decomposition, relative here.

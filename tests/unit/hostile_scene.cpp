@@ -115,6 +115,10 @@ TEST(HostileScene, NonFiniteParametersAreRefusedWhereTheyAreWritten) {
     expect_load_error(head + "<shape type=\"sphere\"><float name=\"radius\" value=\"1e300\"/>"
                              "</shape></scene>",
                       "out-of-range", 2);
+    // Finite as a float, but its area and frame overflow: said so, not "collapses".
+    expect_load_error(head + "<shape type=\"cylinder\">\n<float name=\"radius\" value=\"1e30\"/>"
+                             "</shape></scene>",
+                      "cylinder: too large", 3);
     expect_load_error(head + "<shape type=\"sphere\"><point name=\"center\" value=\"0, nan, 0\"/>"
                              "</shape></scene>",
                       "vector \"center\" contains NaN", 2);
