@@ -44,9 +44,8 @@ public:
         const uint64_t v = m_pixel_seed ^ (uint64_t(index) * 0x9e3779b97f4a7c15ull);
         uint32_t lo = uint32_t(v), hi = uint32_t(v >> 32);
         uint32_t base_lo = uint32_t(m_base_seed), base_hi = uint32_t(m_base_seed >> 32);
-        uint64_t state = tea_hash(lo ^ base_hi, base_lo, 8);
-        uint64_t stream = tea_hash(hi, base_lo ^ 0x6a09e667u, 8) ^ v;
-        m_rng.seed(state, stream);
+        auto [state, stream] = tea_hash_pair(lo ^ base_hi, base_lo, hi, base_lo ^ 0x6a09e667u, 8);
+        m_rng.seed(state, stream ^ v);
     }
 
     float next_1d() override {

@@ -1,5 +1,6 @@
 // The independent sampler: determinism per seed, distinct pixel streams, range, clones.
 #include <facet/plugin.h>
+#include <facet/random.h>
 #include <facet/sampler.h>
 
 #include <gtest/gtest.h>
@@ -92,4 +93,20 @@ TEST(IndependentSampler, ValuesInUnitIntervalAndUniform) {
     }
     // Each bin expects 10000 with a standard deviation of ~97: 6 sigma is generous but finite.
     for (int h : hist) EXPECT_NEAR(h, n / bins, 600);
+}
+
+TEST(TeaHash, PairIsTwoHashesBitForBit) {
+    // tea_hash_pair runs both hashes in one SSE register: it must give exactly tea_hash's words,
+    // for any inputs (carries, sign bits) and round counts.
+    PCG32 rng(7, 11);
+    for (int rounds : {1, 4, 8, 16})
+        for (int i = 0; i < 2000; ++i) {
+            uint32_t a0 = rng.next_uint32(), a1 = rng.next_uint32(), b0 = rng.next_uint32(),
+                     b1 = rng.next_uint32();
+            if (i == 0) a0 = a1 = b0 = b1 = 0u;
+            if (i == 1) a0 = a1 = b0 = b1 = 0xffffffffu;
+            auto [a, b] = tea_hash_pair(a0, a1, b0, b1, rounds);
+            ASSERT_EQ(a, tea_hash(a0, a1, rounds)) << "rounds " << rounds << ", case " << i;
+            ASSERT_EQ(b, tea_hash(b0, b1, rounds)) << "rounds " << rounds << ", case " << i;
+        }
 }

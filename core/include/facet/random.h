@@ -1,6 +1,11 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace facet {
 
@@ -58,6 +63,36 @@ inline uint64_t tea_hash(uint32_t v0, uint32_t v1, int rounds = 4) {
         v1 += ((v0 << 4) + 0xad90777d) ^ (v0 + sum) ^ ((v0 >> 5) + 0x7e95761e);
     }
     return (uint64_t(v1) << 32) | v0;
+}
+
+/// Two TEA hashes at once: {tea_hash(a0, a1, rounds), tea_hash(b0, b1, rounds)}, bit for bit.
+/// With SSE2 both run in the lanes of one register (half the instructions of two calls).
+inline std::pair<uint64_t, uint64_t> tea_hash_pair(uint32_t a0, uint32_t a1, uint32_t b0,
+                                                   uint32_t b1, int rounds = 4) {
+#if defined(__SSE2__)
+    __m128i v0 = _mm_set_epi32(0, 0, int(b0), int(a0));
+    __m128i v1 = _mm_set_epi32(0, 0, int(b1), int(a1));
+    const __m128i k0 = _mm_set1_epi32(int(0xa341316cu)), k1 = _mm_set1_epi32(int(0xc8013ea4u)),
+                  k2 = _mm_set1_epi32(int(0xad90777du)), k3 = _mm_set1_epi32(int(0x7e95761eu)),
+                  delta = _mm_set1_epi32(int(0x9e3779b9u));
+    __m128i sum = _mm_setzero_si128();
+    for (int i = 0; i < rounds; ++i) {
+        sum = _mm_add_epi32(sum, delta);
+        v0 = _mm_add_epi32(v0, _mm_xor_si128(_mm_xor_si128(_mm_add_epi32(_mm_slli_epi32(v1, 4), k0),
+                                                           _mm_add_epi32(v1, sum)),
+                                             _mm_add_epi32(_mm_srli_epi32(v1, 5), k1)));
+        v1 = _mm_add_epi32(v1, _mm_xor_si128(_mm_xor_si128(_mm_add_epi32(_mm_slli_epi32(v0, 4), k2),
+                                                           _mm_add_epi32(v0, sum)),
+                                             _mm_add_epi32(_mm_srli_epi32(v0, 5), k3)));
+    }
+    // Lanes 0 and 1 of the interleaved (v0, v1) pairs: a's and b's 64-bit results.
+    const __m128i ab = _mm_unpacklo_epi32(v0, v1); // a0 a1 b0 b1
+    alignas(16) uint64_t out[2];
+    _mm_store_si128(reinterpret_cast<__m128i *>(out), ab);
+    return {out[0], out[1]};
+#else
+    return {tea_hash(a0, a1, rounds), tea_hash(b0, b1, rounds)};
+#endif
 }
 
 } // namespace facet
