@@ -49,7 +49,7 @@ public:
         bs.sampled_component = 0;
         // f·cos θo / pdf = (ρ/π · cos θo) / (cos θo/π) = ρ.
         if (!(bs.pdf > 0.f) || Frame::cos_theta(bs.wo) <= 0.f) return {bs, Color3f(0.f)};
-        return {bs, m_reflectance->eval(si)};
+        return {bs, m_reflectance.eval(si)};
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
@@ -57,7 +57,7 @@ public:
         float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || cos_i <= 0.f || cos_o <= 0.f)
             return Color3f(0.f);
-        return m_reflectance->eval(si) * (InvPi * cos_o);
+        return m_reflectance.eval(si) * (InvPi * cos_o);
     }
 
     float pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
@@ -73,12 +73,12 @@ public:
         float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
         if (!ctx.is_enabled(BSDFFlags::DiffuseReflection) || cos_i <= 0.f || cos_o <= 0.f)
             return {Color3f(0.f), 0.f};
-        return {m_reflectance->eval(si) * (InvPi * cos_o),
+        return {m_reflectance.eval(si) * (InvPi * cos_o),
                 warp::square_to_cosine_hemisphere_pdf(wo)};
     }
 
     Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const override {
-        return m_reflectance->eval(si);
+        return m_reflectance.eval(si);
     }
 
     std::string to_string() const override {
@@ -86,7 +86,7 @@ public:
     }
 
 private:
-    std::shared_ptr<Texture> m_reflectance;
+    BakedTexture m_reflectance; ///< a constant reflectance is evaluated without a virtual call
 };
 
 } // namespace facet

@@ -52,6 +52,33 @@ private:
     Color3f m_value;
 };
 
+/// A texture parameter of a BSDF with its constant value baked in: eval() of a ConstantTexture
+/// (a plain number or rgb, the common case) is a load and a branch, not a virtual call. The
+/// texture itself stays reachable (to_string, mean, gradients).
+class BakedTexture {
+public:
+    BakedTexture() = default;
+    explicit BakedTexture(std::shared_ptr<Texture> texture) { *this = std::move(texture); }
+    BakedTexture &operator=(std::shared_ptr<Texture> texture) {
+        m_texture = std::move(texture);
+        const auto *c = dynamic_cast<const ConstantTexture *>(m_texture.get());
+        m_constant = c != nullptr;
+        if (c) m_value = c->mean();
+        return *this;
+    }
+    Color3f eval(const SurfaceInteraction &si) const {
+        return m_constant ? m_value : m_texture->eval(si);
+    }
+    const std::shared_ptr<Texture> &texture() const { return m_texture; }
+    const Texture *operator->() const { return m_texture.get(); }
+    explicit operator bool() const { return bool(m_texture); }
+
+private:
+    std::shared_ptr<Texture> m_texture;
+    Color3f m_value;
+    bool m_constant = false;
+};
+
 /**
  * A spectrum plugin (`<spectrum type="d65">`, uniform, regular, irregular, srgb, blackbody): a
  * constant whose RGB value depends on what it describes, as in Mitsuba's RGB variants (a
