@@ -306,7 +306,9 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     return true;
 }
 
-bool Scene::ray_test(const Ray &ray) const {
+bool Scene::ray_test(const Ray &ray) const { return occluded(ray); }
+
+inline bool Scene::occluded(const Ray &ray) const {
     count_ray();
     if (!embree_can_trace(ray)) return false;
     RTCIntersectContext context;
@@ -344,31 +346,36 @@ inline float triangle_light_pdf(float inv_area, const DirectionSample &ds) {
 
 std::pair<DirectionSample, Color3f>
 Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility) const {
+    // The result is built in place (one copy of the sample less on every return).
+    std::pair<DirectionSample, Color3f> result{DirectionSample(), Color3f(0.f)};
+    DirectionSample &ds = result.first;
+    Color3f &weight = result.second;
     const size_t count = m_emitter_table.size();
-    if (count == 0) return {DirectionSample(), Color3f(0.f)};
+    if (count == 0) return result;
     // Uniform emitter selection; the sample is stretched back to [0, 1) for the emitter.
     float scaled = u.x * float(count);
     size_t index = std::min(size_t(scaled), count - 1);
     u.x = std::min(scaled - float(index), OneMinusEpsilon);
     const EmitterEntry &entry = m_emitter_table[index];
 
-    DirectionSample ds;
-    Color3f weight;
     if (entry.mesh) {
         // A triangle light: a point uniform in area on the mesh (no virtual call).
         static_cast<PositionSample &>(ds) = entry.mesh->Mesh::sample_position(u);
         ds.d = ds.p - ref.p;
         ds.dist = norm(ds.d);
-        if (!(ds.dist > 0.f)) return {ds, Color3f(0.f)};
+        if (!(ds.dist > 0.f)) return result;
         ds.d /= ds.dist;
         ds.pdf = triangle_light_pdf(entry.inv_area, ds);
-        if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
+        if (!(ds.pdf > 0.f)) return result;
         weight = entry.radiance / ds.pdf;
     } else {
         std::tie(ds, weight) = entry.emitter->sample_direction(ref, u);
     }
     ds.emitter = entry.emitter;
-    if (!(ds.pdf > 0.f) || weight.is_black()) return {ds, Color3f(0.f)};
+    if (!(ds.pdf > 0.f) || weight.is_black()) {
+        weight = Color3f(0.f);
+        return result;
+    }
     // Delta emitters report pdf 1 (not a density): it is left as returned, as in
     // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
     if (!ds.delta) ds.pdf /= float(count);
@@ -376,9 +383,9 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
 
     if (test_visibility) {
         Ray shadow = std::isfinite(ds.dist) ? ref.spawn_ray_to(ds.p) : ref.spawn_ray(ds.d);
-        if (ray_test(shadow)) weight = Color3f(0.f);
+        if (occluded(shadow)) weight = Color3f(0.f);
     }
-    return {ds, weight};
+    return result;
 }
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {

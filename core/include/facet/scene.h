@@ -71,6 +71,9 @@ public:
     std::string to_string() const override;
 
 private:
+    /// ray_test()'s body, inlined into the shadow ray of sample_emitter_direction().
+    bool occluded(const Ray &ray) const;
+
     std::vector<std::shared_ptr<Shape>> m_shapes;
     std::vector<std::shared_ptr<Emitter>> m_emitters;
     std::vector<std::shared_ptr<Emitter>> m_environment;
