@@ -20,10 +20,13 @@ namespace facet {
 
 class BoxFilter final : public ReconstructionFilter {
 public:
-    explicit BoxFilter(const Properties &) { m_radius = 0.5f; }
+    explicit BoxFilter(const Properties &) {
+        m_radius = 0.5f;
+        m_is_box = true; // image blocks evaluate it inline
+    }
 
     /// Half-open [-0.5, 0.5): a sample on a pixel boundary belongs to exactly one pixel.
-    float eval(float x) const override { return (x >= -0.5f && x < 0.5f) ? 1.f : 0.f; }
+    float eval(float x) const override { return box_eval(x); }
 
     std::string to_string() const override { return "BoxFilter[radius=0.5]"; }
 };
