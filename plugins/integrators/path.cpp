@@ -92,7 +92,7 @@ public:
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
             if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), true);
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.draw_2d(), true);
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);
                     auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
@@ -104,8 +104,8 @@ public:
             }
 
             // ---- BSDF sampling: the next segment of the path ----
-            float sample1 = sampler.next_1d();
-            Point2f sample2 = sampler.next_2d();
+            float sample1 = sampler.draw_1d();
+            Point2f sample2 = sampler.draw_2d();
             auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);
             if (bsdf_weight.is_black()) break;
 
@@ -122,7 +122,7 @@ public:
             if (!(throughput_max > 0.f) || !std::isfinite(throughput_max)) break;
             if (depth >= m_rr_depth) {
                 float q = std::min(throughput_max * eta * eta, 0.95f);
-                if (!(sampler.next_1d() < q)) break;
+                if (!(sampler.draw_1d() < q)) break;
                 throughput /= q;
             }
         }

@@ -26,7 +26,7 @@ namespace facet {
 
 class Independent final : public Sampler {
 public:
-    explicit Independent(const Properties &props) : Sampler(props) {}
+    explicit Independent(const Properties &props) : Sampler(props) { m_stream = &m_rng; }
 
     std::unique_ptr<Sampler> clone() const override {
         return std::unique_ptr<Sampler>(new Independent(*this));
@@ -48,6 +48,7 @@ public:
         m_rng.seed(state, stream ^ v);
     }
 
+    // Sampler::draw_1d() and draw_2d() draw from m_rng directly, as these do.
     float next_1d() override {
         ++m_dimension;
         return m_rng.next_float();
@@ -65,7 +66,11 @@ public:
     }
 
 private:
-    Independent(const Independent &) = default;
+    Independent(const Independent &other)
+        : Sampler(other), m_rng(other.m_rng), m_pixel_seed(other.m_pixel_seed) {
+        m_stream = &m_rng; // not the original's generator
+    }
+    Independent &operator=(const Independent &) = delete;
     PCG32 m_rng;
     uint64_t m_pixel_seed = 0;
 };

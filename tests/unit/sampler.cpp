@@ -110,3 +110,28 @@ TEST(TeaHash, PairIsTwoHashesBitForBit) {
             ASSERT_EQ(b, tea_hash(b0, b1, rounds)) << "rounds " << rounds << ", case " << i;
         }
 }
+
+TEST(IndependentSampler, DrawsEqualTheVirtualCallsAndClonesOwnTheirStream) {
+    // draw_1d()/draw_2d() take the sampler's PCG32 directly: the values must be next_1d()'s and
+    // next_2d()'s, and a clone must draw from its own generator, not the original's.
+    auto proto = independent(16, 3);
+    std::unique_ptr<Sampler> a = proto->clone(), b = proto->clone();
+    a->seed(12345);
+    b->seed(12345);
+    for (uint32_t s = 0; s < 16; ++s) {
+        a->set_sample_index(s);
+        b->set_sample_index(s);
+        for (int i = 0; i < 5; ++i) {
+            ASSERT_EQ(a->draw_1d(), b->next_1d());
+            Point2f pa = a->draw_2d(), pb = b->next_2d();
+            ASSERT_EQ(pa.x, pb.x);
+            ASSERT_EQ(pa.y, pb.y);
+        }
+    }
+    // Drawing from a clone leaves the prototype's stream where it was.
+    proto->seed(7);
+    std::unique_ptr<Sampler> c = proto->clone();
+    float first = c->draw_1d();
+    for (int i = 0; i < 10; ++i) c->draw_2d();
+    EXPECT_EQ(proto->draw_1d(), first);
+}

@@ -2,6 +2,7 @@
 
 #include <facet/object.h>
 #include <facet/properties.h>
+#include <facet/random.h>
 #include <facet/vector.h>
 
 #include <memory>
@@ -34,6 +35,21 @@ public:
     uint32_t sample_index() const { return m_sample_index; }
     virtual float next_1d() = 0;
     virtual Point2f next_2d() = 0;
+    /// next_1d() and next_2d() for the hot paths (the render loop, the integrators): the same
+    /// values, without a virtual call when the sampler is one PCG32 stream per sample (it then
+    /// points m_stream at it, and its next_1d() and next_2d() must be these).
+    float draw_1d() {
+        if (!m_stream) return next_1d();
+        ++m_dimension;
+        return m_stream->next_float();
+    }
+    Point2f draw_2d() {
+        if (!m_stream) return next_2d();
+        m_dimension += 2;
+        float x = m_stream->next_float();
+        float y = m_stream->next_float();
+        return {x, y};
+    }
 
     uint32_t sample_count() const { return m_sample_count; }
     void set_sample_count(uint32_t spp) { m_sample_count = spp; }
@@ -46,6 +62,9 @@ protected:
     uint64_t m_base_seed = 0;
     uint32_t m_sample_index = 0;
     uint32_t m_dimension = 0;
+    /// The sampler's own generator when its values are plain PCG32 draws (set by the sampler;
+    /// a copy must point it at the copy's generator), else nullptr.
+    PCG32 *m_stream = nullptr;
 };
 
 } // namespace facet
