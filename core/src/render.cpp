@@ -519,10 +519,10 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                             }
                         }
                         sampler->set_sample_index(s);
-                        const Point2f u = sampler->next_2d();
+                        const Point2f u = sampler->draw_2d();
                         const Point2f pos(float(x) + u.x, float(y) + u.y);
                         const Point2f aperture =
-                            needs_aperture ? sampler->next_2d() : Point2f(0.5f, 0.5f);
+                            needs_aperture ? sampler->draw_2d() : Point2f(0.5f, 0.5f);
                         auto [ray, weight] = sensor.sample_ray(0.f, pos * inv_film_size, aperture);
                         // Integrators need not write every AOV for every sample (e.g. on a miss).
                         std::fill(aovs->begin(), aovs->end(), 0.f);
