@@ -2,7 +2,6 @@
 
 #include <facet/logger.h>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -52,29 +51,17 @@ Part read_part(const std::string &path) {
     if (!fs::is_regular_file(path, ec))
         FACET_THROW("cannot read part \"{}\": {}", path,
                     fs::exists(path, ec) ? "not a regular file" : "no such file");
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) FACET_THROW("cannot read part \"{}\": {}", path, OIIO::geterror());
-    const OIIO::ImageSpec &spec = in->spec();
+    ImageFile file = read_image_file(path);
     Part part;
     part.name = path;
-    part.full_width = spec.full_width;
-    part.full_height = spec.full_height;
-    part.x = spec.x - spec.full_x;
-    part.y = spec.y - spec.full_y;
-    part.half = spec.format == OIIO::TypeDesc::HALF;
-    for (const auto &f : spec.channelformats)
-        if (f != OIIO::TypeDesc::HALF) part.half = false;
-    part.image = Image(spec.width, spec.height, spec.nchannels);
-    part.image.channel_names.assign(spec.channelnames.begin(), spec.channelnames.end());
-    for (const OIIO::ParamValue &p : spec.extra_attribs) {
-        std::string name = p.name().string();
-        if (name.rfind("facet:", 0) == 0) part.metadata[name] = p.get_string();
-    }
-    bool ok =
-        in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, part.image.data.data());
-    std::string err = ok ? "" : in->geterror();
-    in->close();
-    if (!ok) FACET_THROW("cannot read part \"{}\": {}", path, err);
+    part.full_width = file.image.full_width;
+    part.full_height = file.image.full_height;
+    part.x = file.image.x;
+    part.y = file.image.y;
+    part.half = file.half;
+    part.image = std::move(file.image);
+    for (auto &[name, value] : file.attributes)
+        if (name.rfind("facet:", 0) == 0) part.metadata[name] = value;
     return part;
 }
 

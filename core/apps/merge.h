@@ -40,7 +40,7 @@ struct Part {
     std::map<std::string, std::string> metadata; ///< the facet:* string attributes
 };
 
-/// Reads a part with OpenImageIO (display and data windows, channels, facet:* attributes).
+/// Reads a part (display and data windows, channels, facet:* attributes).
 Part read_part(const std::string &path);
 
 struct Merged {

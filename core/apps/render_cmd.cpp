@@ -248,6 +248,7 @@ int render_main(int argc, char **argv) {
     cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
                                   film.crop_size().x, film.crop_size().y, range.count));
     RenderResult result;
+    preload_image_library(); // meanwhile, for the write
     try {
         result = render(*scene, sensor, ropts);
         result.load_seconds = load_seconds;

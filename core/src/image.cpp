@@ -1,3 +1,5 @@
+#include "image_library.h"
+
 #include <facet/checked.h>
 #include <facet/image.h>
 #include <facet/logger.h>
@@ -653,3 +655,39 @@ std::string ocio_config_path(const std::string &explicit_path) {
 }
 
 } // namespace facet
+
+// libfacet_image: libfacet loads this file's library on first use (image_api.cpp) and calls it
+// through this table, the one symbol the library exports (image_library.h).
+
+namespace facet {
+
+ImageFile read_image_file(const std::string &path) {
+    ImageFile file;
+    file.image = read_image(path);
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) FACET_THROW("cannot read image \"{}\": {}", path, OIIO::geterror());
+    const OIIO::ImageSpec &spec = in->spec();
+    file.half = spec.format == OIIO::TypeDesc::HALF;
+    for (const auto &f : spec.channelformats)
+        if (f != OIIO::TypeDesc::HALF) file.half = false;
+    for (const OIIO::ParamValue &p : spec.extra_attribs)
+        file.attributes[p.name().string()] = p.get_string();
+    in->close();
+    return file;
+}
+
+} // namespace facet
+
+extern "C" __attribute__((visibility("default"))) const facet::detail::ImageLibrary *
+facet_image_library() {
+    static const std::string versions =
+        fmt::format("OpenImageIO {}, OpenColorIO {}", OIIO_VERSION_STRING, OCIO::GetVersion());
+    static const facet::detail::ImageLibrary table = {
+        FACET_IMAGE_LIBRARY_VERSION, &facet::write_image,
+        &facet::check_image_path,    &facet::check_image_output,
+        &facet::ocio_displays,       &facet::resolve_display_view,
+        &facet::read_image,          &facet::read_image_file,
+        &facet::ocio_config_path,    [] { return versions.c_str(); },
+    };
+    return &table;
+}

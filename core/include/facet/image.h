@@ -89,6 +89,30 @@ DisplayView resolve_display_view(const ImageWriteOptions &opts);
 
 /// Reads any format OpenImageIO knows; 8-bit images are returned as stored (no decoding).
 Image read_image(const std::string &path);
+
+/// An image file with what read_image() leaves out: how it stores its channels and its
+/// attributes (as `facet merge` reads the parts of a split render).
+struct ImageFile {
+    Image image;
+    bool half = false;                             ///< every channel is stored as float16
+    std::map<std::string, std::string> attributes; ///< every attribute, as text
+};
+/// read_image(), and the storage and attributes of the file.
+ImageFile read_image_file(const std::string &path);
+
+/// The image and colour libraries (OpenImageIO, OpenColorIO) live in libfacet_image, which
+/// libfacet loads the first time an image is read or written or a display transform resolved
+/// (they are some 260 shared libraries a render needs only to write its result). The path of
+/// that library (installed next to libfacet; $FACET_IMAGE_LIBRARY overrides it).
+std::string image_library_path();
+/// Whether libfacet_image is loaded in this process (nothing loads it but the functions above
+/// and preload_image_library()).
+bool image_library_loaded();
+/// Starts loading libfacet_image on a background thread (once; errors are left to the first
+/// real use). `facet render` calls it as the render starts: the ~0.5 CPU-s of loading overlap
+/// the render instead of delaying the first sample, and an interrupted render writes its image
+/// without waiting for the libraries.
+void preload_image_library();
 /// Path of the OCIO config facet uses: `explicit_path`, else $OCIO, else the installed one.
 std::string ocio_config_path(const std::string &explicit_path = "");
 
