@@ -174,6 +174,21 @@ public:
     }
 
     bool is_ascii() const { return m_format == PlyFormat::Ascii; }
+    /// Binary in this machine's byte order: values can be copied as they are stored.
+    bool is_native_binary() const {
+        const uint16_t one = 1;
+        unsigned char low;
+        std::memcpy(&low, &one, 1);
+        return m_format == (low ? PlyFormat::BinaryLittle : PlyFormat::BinaryBig);
+    }
+    /// The next `size` bytes of a binary file (checked to be there), skipped over.
+    const char *take(size_t size, const char *what) {
+        if (size_t(m_end - m_cur) < size)
+            FACET_THROW("{}: the file ends early, while reading {}", m_name, what);
+        const char *p = m_cur;
+        m_cur += size;
+        return p;
+    }
     size_t remaining() const { return size_t(m_end - m_cur); }
 
     std::string where() const {
@@ -536,13 +551,31 @@ private:
         for (AttributeGroup &g : groups) g.data.reserve(g.props.size() * n);
         std::vector<double> values(el.props.size(), 0.0);
         double sv[8] = {};
+        // The common binary layout, floats only in the machine's byte order, is copied a
+        // vertex at a time (the general reader below decodes value by value).
+        const bool raw_floats =
+            reader.is_native_binary() &&
+            std::all_of(el.props.begin(), el.props.end(), [](const PlyProperty &p) {
+                return !p.is_list && p.type == PlyType::Float32;
+            });
+        const size_t stride = el.props.size() * sizeof(float);
         for (size_t v = 0; v < n; ++v) {
-            for (size_t i = 0; i < el.props.size(); ++i) {
-                if (el.props[i].is_list)
-                    skip(el.props[i], reader);
-                else
-                    values[i] = reader.read(el.props[i].type, el.props[i].name.c_str());
-                if (slot[i] >= 0) sv[slot[i]] = values[i];
+            if (raw_floats) {
+                const char *row = reader.take(stride, "a vertex");
+                for (size_t i = 0; i < el.props.size(); ++i) {
+                    float f;
+                    std::memcpy(&f, row + i * sizeof(float), sizeof(float));
+                    values[i] = f;
+                    if (slot[i] >= 0) sv[slot[i]] = f;
+                }
+            } else {
+                for (size_t i = 0; i < el.props.size(); ++i) {
+                    if (el.props[i].is_list)
+                        skip(el.props[i], reader);
+                    else
+                        values[i] = reader.read(el.props[i].type, el.props[i].name.c_str());
+                    if (slot[i] >= 0) sv[slot[i]] = values[i];
+                }
             }
             reader.end_element();
             for (int k = 0; k < 3; ++k) m_positions[3 * v + k] = float(sv[k]);
@@ -580,8 +613,33 @@ private:
                         sizeof(uint32_t));
         std::vector<uint32_t> polygon;
         std::vector<double> values(el.props.size(), 0.0);
+        // The common binary layout, only a uchar count and 32-bit indices in the machine's byte
+        // order, is copied a face at a time (the general reader below decodes value by value).
+        const PlyType index_type = el.props[size_t(list)].type;
+        const bool raw_indices = reader.is_native_binary() && el.props.size() == 1 &&
+                                 el.props[0].count_type == PlyType::UInt8 &&
+                                 (index_type == PlyType::Int32 || index_type == PlyType::UInt32);
         for (size_t f = 0; f < el.count; ++f) {
-            for (size_t i = 0; i < el.props.size(); ++i) {
+            if (raw_indices) {
+                const size_t count = size_t(uint8_t(*reader.take(1, "a face's vertex count")));
+                if (count < 3)
+                    FACET_THROW("{}: face {} has {} vertices (at least 3 needed)", reader.where(),
+                                f, count);
+                const char *idx = reader.take(count * sizeof(uint32_t), "a vertex index");
+                polygon.resize(count);
+                std::memcpy(polygon.data(), idx, count * sizeof(uint32_t));
+                // A negative int32 index reads as a huge uint32: out of range below.
+                if (index_type == PlyType::Int32)
+                    for (size_t k = 0; k < count; ++k)
+                        if (int32_t(polygon[k]) < 0)
+                            FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f,
+                                        int32_t(polygon[k]));
+                for (size_t k = 0; k < count; ++k)
+                    if (polygon[k] == 4294967295u)
+                        FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f,
+                                    polygon[k]);
+            }
+            for (size_t i = 0; !raw_indices && i < el.props.size(); ++i) {
                 const auto &prop = el.props[i];
                 if (int(i) != list) {
                     if (prop.is_list)
