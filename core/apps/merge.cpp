@@ -193,7 +193,9 @@ Merged merge_parts(const std::vector<Part> &parts) {
         }
 
     // Metadata: what all parts agree on, the total sample count and the summed render time.
-    for (const auto &[key, value] : first.metadata) {
+    for (const auto &entry : first.metadata) {
+        // Not a structured binding: C++17 lambdas cannot capture those (clang rejects it).
+        const std::string &key = entry.first, &value = entry.second;
         if (key == attr::pass || key == attr::passes || key == attr::crop || key == attr::spp ||
             key == attr::render_time || key == attr::sample_offset)
             continue;
