@@ -29,13 +29,23 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
     if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return false;
     const float radius = filter.radius();
     const Point2i s = storage_size();
-    // Continuous position in the block's storage, with pixel centres at integers.
-    const float px = pos.x - 0.5f - float(m_offset.x - m_border);
-    const float py = pos.y - 0.5f - float(m_offset.y - m_border);
-    fp.x0 = std::max(0, int(std::ceil(px - radius)));
-    fp.y0 = std::max(0, int(std::ceil(py - radius)));
-    const int x1 = std::min(s.x - 1, int(std::floor(px + radius)));
-    const int y1 = std::min(s.y - 1, int(std::floor(py + radius)));
+    // Continuous position in film pixels, with pixel centres at integers, and the film pixel of
+    // storage pixel (0, 0): the filter weights do not depend on where the block lies, so the
+    // blocks of a crop window (or a light tracer's block of it) weigh a sample exactly as those
+    // of the whole film do.
+    const float px = pos.x - 0.5f, py = pos.y - 0.5f;
+    fp.ox = m_offset.x - m_border;
+    fp.oy = m_offset.y - m_border;
+    fp.px = px;
+    fp.py = py;
+    fp.ux0 = int(std::ceil(px - radius)) - fp.ox;
+    fp.uy0 = int(std::ceil(py - radius)) - fp.oy;
+    fp.ux1 = int(std::floor(px + radius)) - fp.ox;
+    fp.uy1 = int(std::floor(py + radius)) - fp.oy;
+    fp.x0 = std::max(0, fp.ux0);
+    fp.y0 = std::max(0, fp.uy0);
+    const int x1 = std::min(s.x - 1, fp.ux1);
+    const int y1 = std::min(s.y - 1, fp.uy1);
     if (fp.x0 > x1 || fp.y0 > y1) return false;
     fp.nx = size_t(x1 - fp.x0 + 1);
     fp.ny = size_t(y1 - fp.y0 + 1);
@@ -56,9 +66,9 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
         return true;
     }
     for (size_t i = 0; i < fp.nx; ++i)
-        fp.sum_x += (m_wx[i] = filter.eval(px - float(fp.x0 + int(i))));
+        fp.sum_x += (m_wx[i] = filter.eval(px - float(fp.ox + fp.x0 + int(i))));
     for (size_t j = 0; j < fp.ny; ++j)
-        fp.sum_y += (m_wy[j] = filter.eval(py - float(fp.y0 + int(j))));
+        fp.sum_y += (m_wy[j] = filter.eval(py - float(fp.oy + fp.y0 + int(j))));
     return true;
 }
 
@@ -94,9 +104,20 @@ void ImageBlock::splat(const Point2f &pos, const Color3f &L, const Reconstructio
     const Point2i s = storage_size();
     const size_t nx = fp.nx, ny = fp.ny;
     const int x0 = fp.x0, y0 = fp.y0;
-    const float sx = fp.sum_x, sy = fp.sum_y;
-    // A footprint cut by the block edge keeps its unnormalised share: only the whole-footprint
-    // sum is known to be the filter's integral over the pixels it covers.
+    // A footprint cut by the block edge keeps its share of the whole footprint's weights (the
+    // pixels beyond the edge belong to another block, or to none): the sums run over the whole
+    // footprint, in the same order as when nothing is cut, so a crop window's pixels receive
+    // the same splats as in a render of the whole film.
+    auto whole_sum = [&filter](float p, int o, int u0, int u1, int c0, size_t n, float clipped,
+                               const std::vector<float> &w) {
+        if (u0 == c0 && u1 == c0 + int(n) - 1) return clipped;
+        float sum = 0.f;
+        for (int i = u0; i <= u1; ++i)
+            sum += i >= c0 && i < c0 + int(n) ? w[size_t(i - c0)] : filter.eval(p - float(o + i));
+        return sum;
+    };
+    const float sx = whole_sum(fp.px, fp.ox, fp.ux0, fp.ux1, x0, nx, fp.sum_x, m_wx);
+    const float sy = whole_sum(fp.py, fp.oy, fp.uy0, fp.uy1, y0, ny, fp.sum_y, m_wy);
     const float norm = sx * sy;
     if (!(norm != 0.f) || !std::isfinite(norm)) return;
     const float inv = 1.f / norm;

@@ -59,6 +59,11 @@ private:
         int x0 = 0, y0 = 0;
         size_t nx = 0, ny = 0;
         float sum_x = 0.f, sum_y = 0.f;
+        /// The continuous position in film pixels, the film pixel of storage pixel (0, 0), and
+        /// the whole footprint's first and last storage pixels before the clipping.
+        float px = 0.f, py = 0.f;
+        int ox = 0, oy = 0;
+        int ux0 = 0, ux1 = 0, uy0 = 0, uy1 = 0;
     };
     /// False when the sample (non-finite, or outside the block) reaches no pixel.
     bool footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp);
