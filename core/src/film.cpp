@@ -270,42 +270,99 @@ void Film::put_block(const ImageBlock &block) {
     }
 }
 
+void develop_pixel(const double *storage, int aov_count, const double *splat, double splat_scale,
+                   bool alpha, float *dst) {
+    const bool splatted = splat && (splat[0] != 0.0 || splat[1] != 0.0 || splat[2] != 0.0);
+    int o = 0;
+    if (!storage) {
+        for (int c = 0; c < 3; ++c) dst[o++] = splat ? float(splat[c] * splat_scale) : 0.f;
+        if (alpha) dst[o++] = splatted ? 1.f : 0.f;
+        for (int k = 0; k < aov_count; ++k) dst[o++] = 0.f;
+        return;
+    }
+    const double w = storage[3 + aov_count];
+    // Filters with negative lobes can give a negative sum: divide by it all the same (as
+    // Mitsuba does); only a pixel without any weight stays 0.
+    const double inv = w != 0.0 ? 1.0 / w : 0.0;
+    for (int c = 0; c < 3; ++c)
+        dst[o++] = float(storage[c] * inv + (splat ? splat[c] * splat_scale : 0.0));
+    if (alpha) dst[o++] = w > 0.0 || splatted ? 1.f : 0.f;
+    for (int k = 0; k < aov_count; ++k) dst[o++] = float(storage[3 + k] * inv);
+}
+
+namespace {
+
+/// The developed image of a crop window, channels named, pixels zero.
+Image developed_image(const Point2i &crop_offset, const Point2i &crop_size, const Point2i &size,
+                      bool alpha, const std::vector<std::string> &aov_names) {
+    const int out_c = 3 + (alpha ? 1 : 0) + int(aov_names.size());
+    Image img(crop_size.x, crop_size.y, out_c);
+    img.x = crop_offset.x;
+    img.y = crop_offset.y;
+    img.full_width = size.x;
+    img.full_height = size.y;
+    img.channel_names = {"R", "G", "B"};
+    if (alpha) img.channel_names.push_back("A");
+    for (const auto &n : aov_names) img.channel_names.push_back(n);
+    return img;
+}
+
+} // namespace
+
 Image Film::develop() const {
     const int naov = int(m_aov_names.size());
     const int nc = 4 + naov;
-    const int out_c = 3 + (m_alpha ? 1 : 0) + naov;
-    Image img(m_crop_size.x, m_crop_size.y, out_c);
-    img.x = m_crop_offset.x;
-    img.y = m_crop_offset.y;
-    img.full_width = m_size.x;
-    img.full_height = m_size.y;
-    img.channel_names = {"R", "G", "B"};
-    if (m_alpha) img.channel_names.push_back("A");
-    for (const auto &n : m_aov_names) img.channel_names.push_back(n);
+    Image img = developed_image(m_crop_offset, m_crop_size, m_size, m_alpha, m_aov_names);
     if (m_storage.empty() && m_splats.empty()) return img;
+    for (size_t i = 0, n = size_t(m_crop_size.x) * m_crop_size.y; i < n; ++i)
+        develop_pixel(m_storage.empty() ? nullptr : m_storage.data() + i * nc, naov,
+                      m_splats.empty() ? nullptr : m_splats.data() + i * 3, m_splat_scale, m_alpha,
+                      img.data.data() + i * size_t(img.channels));
+    return img;
+}
 
-    for (size_t i = 0, n = size_t(m_crop_size.x) * m_crop_size.y; i < n; ++i) {
-        float *dst = img.data.data() + i * out_c;
-        const double *splat = m_splats.empty() ? nullptr : m_splats.data() + i * 3;
-        const bool splatted = splat && (splat[0] != 0.0 || splat[1] != 0.0 || splat[2] != 0.0);
-        if (m_storage.empty()) {
-            int o = 0;
-            for (int c = 0; c < 3; ++c) dst[o++] = float(splat[c] * m_splat_scale);
-            if (m_alpha) dst[o++] = splatted ? 1.f : 0.f;
-            for (int k = 0; k < naov; ++k) dst[o++] = 0.f;
-            continue;
-        }
-        const double *src = m_storage.data() + i * nc;
-        const double w = src[nc - 1];
-        // Filters with negative lobes can give a negative sum: divide by it all the same (as
-        // Mitsuba does); only a pixel without any weight stays 0.
-        const double inv = w != 0.0 ? 1.0 / w : 0.0;
-        int o = 0;
-        for (int c = 0; c < 3; ++c)
-            dst[o++] = float(src[c] * inv + (splat ? splat[c] * m_splat_scale : 0.0));
-        if (m_alpha) dst[o++] = w > 0.0 || splatted ? 1.f : 0.f;
-        for (int k = 0; k < naov; ++k) dst[o++] = float(src[3 + k] * inv);
+void Film::prepare_splats() {
+    m_splats.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * 3, 0.0);
+}
+
+std::vector<std::string> Film::raw_channel_names() const {
+    std::vector<std::string> names;
+    const std::string p = RawChannelPrefix;
+    if (!m_storage.empty()) {
+        for (const char *c : {"R", "G", "B"}) names.push_back(p + "sum." + c);
+        for (const auto &n : m_aov_names) names.push_back(p + "sum." + n);
+        names.push_back(p + "weight");
     }
+    if (!m_splats.empty())
+        for (const char *c : {"R", "G", "B"}) names.push_back(p + "splat." + c);
+    return names;
+}
+
+std::vector<float> Film::raw_sums() const {
+    const size_t pixels = size_t(m_crop_size.x) * size_t(m_crop_size.y);
+    const size_t nc = m_storage.empty() ? 0 : 4 + m_aov_names.size();
+    const size_t ns = m_splats.empty() ? 0 : 3, n = nc + ns;
+    std::vector<float> out(pixels * n);
+    for (size_t i = 0; i < pixels; ++i) {
+        for (size_t c = 0; c < nc; ++c) out[i * n + c] = float(m_storage[i * nc + c]);
+        for (size_t c = 0; c < ns; ++c) out[i * n + nc + c] = float(m_splats[i * 3 + c]);
+    }
+    return out;
+}
+
+Image Film::develop_sums(const std::vector<double> &sums, double splat_scale) const {
+    const size_t pixels = size_t(m_crop_size.x) * size_t(m_crop_size.y);
+    const int naov = int(m_aov_names.size());
+    const size_t nc = m_storage.empty() ? 0 : size_t(4 + naov);
+    const size_t ns = m_splats.empty() ? 0 : 3, n = nc + ns;
+    if (sums.size() != pixels * n)
+        FACET_THROW("develop_sums: {} values for {} pixels of {} raw channels", sums.size(), pixels,
+                    n);
+    Image img = developed_image(m_crop_offset, m_crop_size, m_size, m_alpha, m_aov_names);
+    for (size_t i = 0; i < pixels; ++i)
+        develop_pixel(nc ? sums.data() + i * n : nullptr, naov,
+                      ns ? sums.data() + i * n + nc : nullptr, splat_scale, m_alpha,
+                      img.data.data() + i * size_t(img.channels));
     return img;
 }
 

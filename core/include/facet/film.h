@@ -110,13 +110,32 @@ public:
     /// and hands the blocks in strictly in unit order (BlockMerger in render.h): the same seed and
     /// sample count give the same image for any number of threads.
     void put_splats(const ImageBlock &block);
+    /// Gives the film a (zero) splat buffer, so a light tracer's image has one even before its
+    /// first splat (its raw channels do not depend on how far it got).
+    void prepare_splats();
     /// Factor applied to the splat buffer by develop() (1 / light paths per pixel).
     void set_splat_scale(double scale) { m_splat_scale = scale; }
+    double splat_scale() const { return m_splat_scale; }
     /// Normalised linear RGB (plus alpha when the pixel format asks) of the crop window, followed
     /// by the AOV channels. Pixels without any sample weight are 0 (and alpha 0). The image's
     /// window (Image::x, y, full_width, full_height) is the crop window inside the film, so an
     /// EXR of a crop has the crop as data window and the whole film as display window.
     virtual Image develop() const;
+
+    /// Raw channels: the sums the crop window is developed from, named "facet.sum.R",
+    /// "facet.sum.G", "facet.sum.B", "facet.sum.<aov>" (Σ w·value over the samples that reach
+    /// the pixel through the filter), "facet.weight" (Σ w), then "facet.splat.R/G/B" when the
+    /// film has a splat buffer. A part of a render split into passes carries them (rounded to
+    /// float) after its developed channels, so that passes merge exactly: their sums are added
+    /// in pass order and developed once (develop_pixel), whatever the filter.
+    std::vector<std::string> raw_channel_names() const;
+    /// The raw channels of every crop pixel, rounded to float (raw_channel_names() per pixel).
+    std::vector<float> raw_sums() const;
+    /// Develops the crop window from `sums` (raw_channel_names() doubles per pixel) and
+    /// `splat_scale` instead of the film's own: the render of several passes in one process.
+    /// The channels are the base class's (R, G, B, A, AOVs): a film that develops into other
+    /// colour channels (hdrfilm's xyz, luminance) is not converted.
+    Image develop_sums(const std::vector<double> &sums, double splat_scale) const;
     /// Extension the film writes by default (".exr").
     virtual std::string default_extension() const { return ".exr"; }
     /// Writes `image` to `path` through image I/O (atomically), float16 or float32 as configured.
@@ -138,5 +157,14 @@ protected:
     bool m_half = true;   ///< component_format float16
     bool m_alpha = false; ///< pixel_format rgba
 };
+
+/// Prefix of the raw channels (Film::raw_channel_names).
+inline constexpr const char *RawChannelPrefix = "facet.";
+
+/// One developed pixel, as Film::develop computes it: `storage` holds Σ w·R, G, B, the
+/// `aov_count` AOV sums and Σ w (null: no weighted samples), `splat` the splatted r, g, b (null:
+/// none), added times `splat_scale`. Writes R, G, B, A (with `alpha`) and the AOVs to `dst`.
+void develop_pixel(const double *storage, int aov_count, const double *splat, double splat_scale,
+                   bool alpha, float *dst);
 
 } // namespace facet
