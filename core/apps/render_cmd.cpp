@@ -149,7 +149,9 @@ int render_main(int argc, char **argv) {
                    "Render part I (0-based) of the --passes N independent parts of one render "
                    "of N x spp samples per pixel (for merging later)")
         ->type_name("I");
-    app.add_option("--passes", pass_count, "Number of parts for --pass (default 1)")
+    app.add_option("--passes", pass_count,
+                   "Number of parts for --pass (default 1); without --pass, every part one after "
+                   "the other, combined as `facet merge` combines them")
         ->type_name("N");
     app.add_option("--ocio-config", ocio_config,
                    "OpenColorIO config for 8-bit outputs (default: $OCIO, else facet's own)");
@@ -197,9 +199,12 @@ int render_main(int argc, char **argv) {
         ropts.crop = {{crop[0], crop[1], crop[2], crop[3]}};
     }
     if (pass_count != 0 || pass_index >= 0) {
-        if (pass_count < 1 || pass_index < 0 || pass_index >= pass_count)
-            FACET_THROW("--pass I --passes N: expected both, with N >= 1 and 0 <= I < N, got "
-                        "--pass {} --passes {}",
+        // --passes N alone: all N parts in this process (pass index -1).
+        if (pass_count >= 1 && app.count("--pass") == 0) pass_index = -1;
+        if (pass_count < 1 || pass_index < -1 || pass_index >= pass_count ||
+            (pass_index == -1 && app.count("--pass") > 0))
+            FACET_THROW("--pass I --passes N: expected N >= 1 and 0 <= I < N (or --passes N "
+                        "alone for all the parts), got --pass {} --passes {}",
                         pass_index < 0 ? std::string("(none)") : std::to_string(pass_index),
                         pass_count == 0 ? std::string("(none)") : std::to_string(pass_count));
         ropts.pass_index = pass_index;
@@ -232,17 +237,19 @@ int render_main(int argc, char **argv) {
     if (!opts.quiet) {
         const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
         const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
-        fmt::print("Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", opts.scene, w, h,
-                   crop.empty() ? ""
-                                : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1],
-                                              crop[2], crop[3], film.size().x, film.size().y),
-                   range.count, rounding,
-                   ropts.pass_count > 1
-                       ? fmt::format(" (part {} of {}: samples {}..{} of {})", ropts.pass_index,
-                                     ropts.pass_count, range.first, range.first + range.count - 1,
-                                     range.total)
-                       : "",
-                   threads, threads == 1 ? "" : "s");
+        fmt::print(
+            "Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", opts.scene, w, h,
+            crop.empty() ? ""
+                         : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1], crop[2],
+                                       crop[3], film.size().x, film.size().y),
+            range.count, rounding,
+            ropts.pass_count > 1 && ropts.pass_index < 0
+                ? fmt::format(" (in {} parts, combined as a merge of them)", ropts.pass_count)
+            : ropts.pass_count > 1 ? fmt::format(" (part {} of {}: samples {}..{} of {})",
+                                                 ropts.pass_index, ropts.pass_count, range.first,
+                                                 range.first + range.count - 1, range.total)
+                                   : "",
+            threads, threads == 1 ? "" : "s");
         std::fflush(stdout);
     }
     cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,

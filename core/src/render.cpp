@@ -172,23 +172,23 @@ int render_thread_count(const RenderOptions &opts) {
     return arena.max_concurrency();
 }
 
-namespace {
+bool StopCondition::timed_out() const { return timeout > 0.0 && seconds_since(start) >= timeout; }
 
-/// When a render stops early: the cancel flag is set, or `timeout` seconds (if > 0) have passed
-/// since `start`. Cheap enough to ask every few samples.
-struct StopCondition {
-    const std::atomic<bool> *cancel = nullptr;
-    double timeout = -1.0;
-    Clock::time_point start;
-    bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
-    bool timed_out() const { return timeout > 0.0 && seconds_since(start) >= timeout; }
-    bool operator()() const { return cancelled() || timed_out(); }
-};
+std::vector<uint32_t> progressive_schedule(uint32_t spp, uint32_t samples_per_pass, uint32_t cap) {
+    cap = std::max(cap, 1u);
+    std::vector<uint32_t> pass_start; // pass p takes samples [pass_start[p], pass_start[p + 1])
+    uint32_t next = 0, size = 1;
+    while (next < spp) {
+        pass_start.push_back(next);
+        const uint32_t take =
+            samples_per_pass > 0 ? std::min(samples_per_pass, spp) : std::min(size, cap);
+        next += std::min(take, spp - next);
+        if (next > 1) size = std::min(cap, size * 2);
+    }
+    pass_start.push_back(spp);
+    return pass_start;
+}
 
-/// Runs units 0..count-1 like run_work_units(); a unit may return early (without its result)
-/// when `stop` says so. The progress line shows work_done / work_total, redrawn by a monitor
-/// thread (so it moves while long units run), which also says "stopping" at the first
-/// cancellation.
 WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondition &stop,
                        const std::atomic<uint64_t> &work_done, uint64_t work_total,
                        const std::function<std::function<void(size_t)>()> &make_worker) {
@@ -271,62 +271,6 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
     return run;
 }
 
-} // namespace
-
-WorkUnitsRun run_work_units(size_t count, const RenderOptions &opts, double timeout,
-                            const std::function<std::function<size_t(size_t)>()> &make_worker) {
-    if (opts.threads < 0)
-        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
-    const auto start = Clock::now();
-    // More threads than cores is allowed (TBB otherwise caps its workers at the core count).
-    std::unique_ptr<tbb::global_control> allow;
-    if (opts.threads > 0)
-        allow = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      size_t(opts.threads));
-    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
-    const int workers = arena.max_concurrency();
-
-    ProgressLine progress(opts.progress);
-    std::atomic<size_t> next_unit{0}, done_units{0};
-    std::atomic<bool> cancelled{false}, timed_out{false};
-    std::mutex progress_mutex;
-
-    // Each worker takes the next unit until none is left; the caller's merge order, not who took
-    // which unit, decides the image.
-    auto worker = [&](int) {
-        ScopedFlushToZero ftz;
-        std::function<size_t(size_t)> run = make_worker();
-        for (;;) {
-            if (opts.cancel && opts.cancel->load(std::memory_order_relaxed)) {
-                cancelled = true;
-                return;
-            }
-            if (timeout > 0.0 && seconds_since(start) >= timeout) {
-                timed_out = true;
-                return;
-            }
-            const size_t index = next_unit.fetch_add(1);
-            if (index >= count) return;
-            const size_t done = run(index);
-            done_units = std::max(done_units.load(), done);
-            if (progress.enabled()) {
-                std::lock_guard<std::mutex> lock(progress_mutex);
-                progress.update(done, count, seconds_since(start));
-            }
-        }
-    };
-    arena.execute([&] { tbb::parallel_for(0, workers, worker, tbb::simple_partitioner()); });
-
-    WorkUnitsRun run;
-    run.seconds = seconds_since(start);
-    const size_t taken = std::min(next_unit.load(), count);
-    run.cancelled = cancelled && taken < count;
-    run.timed_out = timed_out && taken < count;
-    progress.update(done_units.load(), count, run.seconds, true);
-    progress.finish();
-    return run;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The sampling integrators' render loop
 
@@ -377,9 +321,10 @@ SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts)
     if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
     if (opts.pass_count < 1)
         FACET_THROW("the pass count must be at least 1, got {}", opts.pass_count);
-    if (opts.pass_index < 0 || opts.pass_index >= opts.pass_count)
-        FACET_THROW("the pass index must lie in 0..{} (pass_count {}), got {}", opts.pass_count - 1,
-                    opts.pass_count, opts.pass_index);
+    if (opts.pass_index < -1 || opts.pass_index >= opts.pass_count)
+        FACET_THROW("the pass index must lie in 0..{} (pass_count {}), or be -1 for all of them, "
+                    "got {}",
+                    opts.pass_count - 1, opts.pass_count, opts.pass_index);
     // Samplers may round the count (stratified ones to a square); seeding once lets them do so
     // before the count is read back.
     std::unique_ptr<Sampler> sampler = sensor.sampler().clone();
@@ -392,6 +337,10 @@ SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts)
     sampler->seed(0);
     SampleRange range;
     range.total = std::max(sampler->sample_count(), 1u);
+    if (opts.pass_index < 0) { // all the passes
+        range.count = range.total;
+        return range;
+    }
     const uint64_t n = uint64_t(opts.pass_count), i = uint64_t(opts.pass_index);
     range.first = uint32_t(uint64_t(range.total) * i / n);
     range.count = uint32_t(uint64_t(range.total) * (i + 1) / n) - range.first;
@@ -440,20 +389,9 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
     // about 2^18 samples over the film each (a power of two): early stops keep a useful image
     // and a stop throws away at most one pass. The schedule depends only on the film size and
     // the part's samples, never on the crop or the thread count.
-    std::vector<uint32_t> pass_start; // pass p takes samples [pass_start[p], pass_start[p + 1])
-    {
-        uint32_t cap = 1;
-        while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
-        uint32_t next = 0, size = 1;
-        while (next < spp) {
-            pass_start.push_back(next);
-            const uint32_t take =
-                m_samples_per_pass > 0 ? std::min(m_samples_per_pass, spp) : std::min(size, cap);
-            next += std::min(take, spp - next);
-            if (next > 1) size = std::min(cap, size * 2);
-        }
-        pass_start.push_back(spp);
-    }
+    uint32_t cap = 1;
+    while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
+    const std::vector<uint32_t> pass_start = progressive_schedule(spp, m_samples_per_pass, cap);
     const size_t passes = pass_start.size() - 1;
 
     const int border = ImageBlock::border_for(film.rfilter());
@@ -589,6 +527,83 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
     return result;
 }
 
+namespace {
+
+/// A part's raw channels (Film::raw_channel_names) after its developed ones.
+void append_raw_channels(Image &image, const Film &film) {
+    const std::vector<std::string> names = film.raw_channel_names();
+    const std::vector<float> raw = film.raw_sums();
+    const size_t pixels = size_t(image.width) * size_t(image.height), nr = names.size();
+    const size_t nd = size_t(image.channels), n = nd + nr;
+    if (raw.size() != pixels * nr)
+        FACET_THROW("the film's raw sums ({} values) do not match its {}x{} image", raw.size(),
+                    image.width, image.height);
+    std::vector<float> data(pixels * n);
+    for (size_t i = 0; i < pixels; ++i) {
+        std::copy_n(image.data.data() + i * nd, nd, data.data() + i * n);
+        std::copy_n(raw.data() + i * nr, nr, data.data() + i * n + nd);
+    }
+    image.data = std::move(data);
+    image.channels = int(n);
+    image.channel_names.insert(image.channel_names.end(), names.begin(), names.end());
+}
+
+} // namespace
+
+/// Every pass of opts.pass_count, one after the other, combined as a merge of the parts combines
+/// them: the raw sums of each pass rounded to float (what a part's file holds), added in pass
+/// order in double and developed once. The result is bit-identical to the merge of the parts.
+static RenderResult render_all_passes(const Scene &scene, const Sensor &sensor,
+                                      const RenderOptions &opts) {
+    const auto start = Clock::now();
+    Film &film = sensor.film();
+    RenderResult all;
+    std::vector<double> sums;
+    std::vector<std::string> raw_names;
+    for (int i = 0; i < opts.pass_count; ++i) {
+        RenderOptions part = opts;
+        part.pass_index = i;
+        RenderResult r = render(scene, sensor, part);
+        const std::vector<std::string> &names = r.image.channel_names;
+        if (names.size() < 3 || names[0] != "R" || names[1] != "G" || names[2] != "B")
+            FACET_THROW("a render of {} passes in one process develops R, G, B: the film {} "
+                        "develops into {} (use the pixel format rgb or rgba, or render the passes "
+                        "apart)",
+                        opts.pass_count, film.to_string(), names.empty() ? "nothing" : names[0]);
+        const std::vector<float> raw = film.raw_sums();
+        if (i == 0) {
+            raw_names = film.raw_channel_names();
+            sums.assign(raw.size(), 0.0);
+            all = r;
+        } else {
+            if (film.raw_channel_names() != raw_names || raw.size() != sums.size())
+                FACET_THROW("pass {} of {} has other raw channels than pass 0", i, opts.pass_count);
+            all.blocks_done += r.blocks_done;
+            all.blocks_total += r.blocks_total;
+            all.samples += r.samples;
+            all.spp += r.spp;
+            all.sampling_seconds += r.sampling_seconds;
+            all.develop_seconds += r.develop_seconds;
+        }
+        for (size_t k = 0; k < sums.size(); ++k) sums[k] += double(raw[k]);
+        if (r.cancelled) {
+            all.cancelled = true;
+            all.timed_out = r.timed_out;
+            break;
+        }
+    }
+    const SampleRange range = render_sample_range(sensor, opts);
+    // As a merge: splats are divided by the light paths per pixel of all the passes.
+    all.image = film.develop_sums(sums, all.spp > 0 ? 1.0 / double(all.spp) : 1.0);
+    all.spp_target = range.total;
+    all.spp_total = range.total;
+    all.sample_offset = 0;
+    all.pass_index = 0;
+    all.pass_count = 1;
+    all.seconds = seconds_since(start);
+    return all;
+}
+
 RenderResult Integrator::render(const Scene &, const Sensor &, const RenderOptions &) const {
     FACET_THROW("the integrator {} cannot render images", to_string());
 }
@@ -607,15 +622,15 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
                         c[0], c[1], c[2], c[3]);
         film.set_crop_window(Point2i(c[0], c[1]), Point2i(c[2] - c[0], c[3] - c[1]));
     }
-    const bool sampling = dynamic_cast<const SamplingIntegrator *>(&integrator) != nullptr;
-    if (opts.pass_count != 1 && !sampling)
-        FACET_THROW("the integrator {} renders in one part only (a pass count of {} needs a "
-                    "sampling integrator such as path)",
-                    integrator.to_string(), opts.pass_count);
     const SampleRange range = render_sample_range(sensor, opts); // validates the options
+    if (opts.pass_count > 1 && opts.pass_index < 0) return render_all_passes(scene, sensor, opts);
     RenderResult result = integrator.render(scene, sensor, opts);
     if (result.spp_total == 0) {
-        // An integrator that does not fill these in (a light tracer) renders one whole part.
+        // An integrator that does not fill these in renders one whole part.
+        if (opts.pass_count != 1)
+            FACET_THROW("the integrator {} renders in one part only (it cannot render part {} of "
+                        "{})",
+                        integrator.to_string(), opts.pass_index, opts.pass_count);
         result.spp_target = range.count;
         result.spp = range.count;
         result.sample_offset = range.first;
@@ -629,6 +644,7 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     result.film_height = film.size().y;
     result.accel_seconds = scene.accel_build_seconds();
     if (result.sampling_seconds == 0.0) result.sampling_seconds = result.seconds;
+    if (opts.pass_count > 1) append_raw_channels(result.image, film);
     return result;
 }
 

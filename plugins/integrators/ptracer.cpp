@@ -10,9 +10,12 @@ is one light path (plus one emitter connection); a render takes width x height x
 so the spp counts light paths per pixel as in Mitsuba. After `rr_depth` bounces, Russian roulette
 ends paths whose throughput has become small.
 
-The image does not depend on the thread count: the light paths of each pass are split into a
-fixed number of work units that splat into their own image buffers, merged in unit order, and
-every path's random numbers are seeded from (seed, path index).
+The image does not depend on the thread count: the light paths are traced in progressive passes
+(1, 1, 2, 4, ... paths per pixel, or `samples_per_pass`), each split into a fixed number of work
+units that splat into their own image buffers, merged in unit order, and every path's random
+numbers are seeded from (seed, path index). The film holds whole passes only: a render stopped
+early (Ctrl-C, `timeout`) develops the light paths per pixel it reached. A render split into
+parts (`--pass I --passes N`) traces the light paths of its samples.
 
 The sensor must support sampling a direction towards it (perspective, thinlens, orthographic).
 Every emitter emits rays: environments send them into the scene's bounding sphere from a disk
@@ -23,7 +26,7 @@ facing the sampled direction, so an environment lights the scene as it does for 
 | max_depth | integer | -1 | Longest path, in segments: -1 is unbounded, 1 shows only directly visible emitters, 2 adds direct illumination, ... |
 | rr_depth | integer | 5 | Depth from which Russian roulette may end a path (at least 1) |
 | hide_emitters | boolean | false | Do not count emitters seen directly by the camera |
-| samples_per_pass | integer | (all) | Split the light paths into passes of this many per pixel (must divide the sample count) |
+| samples_per_pass | integer | (progressive) | Trace the light paths in passes of this many per pixel (must divide the sample count) |
 | timeout | float | -1 | Stop after this many seconds and develop what is done; <= 0: no limit |
 
 ```xml
@@ -65,84 +68,119 @@ public:
     RenderResult render(const Scene &scene, const Sensor &sensor,
                         const RenderOptions &opts) const override {
         const auto start = std::chrono::steady_clock::now();
-        if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
         if (!sensor.supports_direction_sampling())
             FACET_THROW("ptracer: the sensor {} cannot be connected to (it does not support "
                         "sampling a direction towards it)",
                         sensor.to_string());
         Film &film = sensor.film();
+        // Sample s of the whole render (of range.total samples per pixel) is the light paths
+        // [s·P, (s + 1)·P) for a P-pixel film; a part takes the samples of its range.
+        const SampleRange range = render_sample_range(sensor, opts);
+        if (range.count == 0)
+            FACET_THROW("pass {} of {} has no samples: the {} light paths per pixel of the whole "
+                        "render cannot be split into {} parts",
+                        opts.pass_index, opts.pass_count, range.total, opts.pass_count);
         std::unique_ptr<Sampler> base_sampler = sensor.sampler().clone();
-        if (opts.spp > 0) base_sampler->set_sample_count(uint32_t(opts.spp));
+        base_sampler->set_sample_count(range.total);
         base_sampler->seed(0);
-        const uint32_t spp = std::max(base_sampler->sample_count(), 1u);
-        const uint32_t spp_per_pass =
-            m_samples_per_pass > 0 ? std::min(m_samples_per_pass, spp) : spp;
-        if (spp % spp_per_pass != 0)
+        const uint32_t spp = range.count;
+        if (m_samples_per_pass > 0 && spp % std::min(m_samples_per_pass, spp) != 0)
             FACET_THROW("ptracer: the sample count ({}) must be a multiple of samples_per_pass "
                         "({})",
-                        spp, spp_per_pass);
-        const uint32_t passes = spp / spp_per_pass;
+                        spp, m_samples_per_pass);
         const uint64_t seed = opts.seed + sensor.sampler().base_seed();
         const Point2i film_size = film.size();
-        const uint64_t paths_per_pass =
-            uint64_t(film_size.x) * uint64_t(film_size.y) * uint64_t(spp_per_pass);
+        const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
         film.prepare({});
-        // The importance of the sensors integrates to one over the whole film: every pixel
-        // receives spp times its value from width x height x spp paths.
-        film.set_splat_scale(1.0 / double(spp));
+        film.prepare_splats();
 
-        // A fixed number of work units per pass, whatever the thread count (determinism).
-        const uint64_t units_per_pass = std::min<uint64_t>(UnitsPerPass, paths_per_pass);
+        // Progressive passes of 1, 1, 2, 4, ... light paths per pixel (or samples_per_pass),
+        // each split into a fixed number of work units whatever the thread count
+        // (determinism); the film only ever holds whole passes, so a stopped render's image is
+        // that of the light paths per pixel it reached. Each unit splats into a block of the
+        // whole crop window, so the passes double without a cap: few units for any spp.
+        const std::vector<uint32_t> pass_start =
+            progressive_schedule(spp, m_samples_per_pass, 1u << 30);
+        const size_t passes = pass_start.size() - 1;
+        const uint64_t units_per_pass = std::min<uint64_t>(UnitsPerPass, film_pixels);
         const size_t total = size_t(units_per_pass) * passes;
         const int border = ImageBlock::border_for(film.rfilter());
         const ReconstructionFilter &filter = film.rfilter();
-        FACET_LOG(Info, "Starting particle tracing ({}x{}, {} light paths per pixel{}, {} threads)",
-                  film.crop_size().x, film.crop_size().y, spp,
-                  passes > 1 ? fmt::format(" in {} passes", passes) : "",
+        FACET_LOG(Info,
+                  "Starting particle tracing ({}x{}, {} light paths per pixel in {} pass{}{}, {} "
+                  "threads)",
+                  film.crop_size().x, film.crop_size().y, spp, passes, passes == 1 ? "" : "es",
+                  opts.pass_count > 1
+                      ? fmt::format(", part {} of {}", opts.pass_index, opts.pass_count)
+                      : "",
                   render_thread_count(opts));
+        if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
 
-        BlockMerger merger(film, /*splat=*/true);
+        StopCondition stop{opts.cancel, m_timeout, start};
+        BlockMerger merger(film, /*splat=*/true, size_t(units_per_pass));
         std::atomic<uint64_t> paths_done{0};
         const bool have_emitters = !scene.emitters().empty();
-        auto make_worker = [&]() -> std::function<size_t(size_t)> {
+        auto make_worker = [&]() -> std::function<void(size_t)> {
             auto sampler = std::shared_ptr<Sampler>(base_sampler->clone());
-            return [&, sampler](size_t index) -> size_t {
-                const uint64_t pass = index / units_per_pass, unit = index % units_per_pass;
-                const uint64_t begin = paths_per_pass * unit / units_per_pass,
-                               end = paths_per_pass * (unit + 1) / units_per_pass;
+            return [&, sampler](size_t index) {
+                const size_t pass = index / units_per_pass;
+                const uint64_t unit = index % units_per_pass;
+                // The pass's light paths, numbered over the whole render.
+                const uint64_t first = uint64_t(range.first + pass_start[pass]) * film_pixels,
+                               count =
+                                   uint64_t(pass_start[pass + 1] - pass_start[pass]) * film_pixels;
+                const uint64_t begin = first + count * unit / units_per_pass,
+                               end = first + count * (unit + 1) / units_per_pass;
                 std::unique_ptr<ImageBlock> block = merger.acquire();
                 block->reset(film.crop_offset(), film.crop_size(), border);
                 if (have_emitters)
                     for (uint64_t i = begin; i < end; ++i) {
-                        sampler->seed(sample_stream_seed(seed, pass * paths_per_pass + i));
+                        // A stop abandons the unit (its pass is incomplete and is dropped).
+                        if ((i - begin) % 64 == 63 && stop()) {
+                            merger.release(std::move(block));
+                            return;
+                        }
+                        sampler->seed(sample_stream_seed(seed, i));
                         trace(scene, sensor, *sampler, *block, filter);
                     }
-                paths_done += end - begin;
-                return merger.submit(index, std::move(block));
+                paths_done.fetch_add(end - begin, std::memory_order_relaxed);
+                merger.submit(index, std::move(block));
             };
         };
-        WorkUnitsRun run = run_work_units(total, opts, m_timeout, make_worker);
+        WorkUnitsRun run = run_units(total, opts, stop, paths_done, film_pixels * spp, make_worker);
         merger.flush();
 
         RenderResult result;
+        const size_t passes_done = merger.merged() / size_t(units_per_pass);
         result.blocks_total = total;
-        result.blocks_done = merger.finished();
-        result.cancelled = (run.cancelled || run.timed_out) && result.blocks_done < total;
-        result.timed_out = run.timed_out && result.blocks_done < total;
-        result.samples = paths_done.load();
-        // A partial render develops what was traced: the scale follows the paths done.
-        if (result.cancelled && result.samples > 0)
-            film.set_splat_scale(double(film_size.x) * double(film_size.y) /
-                                 double(result.samples));
-        if (result.timed_out)
-            FACET_LOG(Warn, "Timeout of {:.2f}s reached after {} of {} work units", m_timeout,
-                      result.blocks_done, total);
-        else if (result.cancelled)
-            FACET_LOG(Warn, "Rendering cancelled after {} of {} work units", result.blocks_done,
-                      total);
-        result.seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        result.blocks_done = merger.merged();
+        result.cancelled = passes_done < passes;
+        result.timed_out = result.cancelled && run.timed_out;
+        result.spp_target = spp;
+        result.spp = pass_start[passes_done];
+        result.samples = film_pixels * result.spp;
+        result.sample_offset = range.first;
+        result.spp_total = range.total;
+        // The importance of the sensor integrates to one over the whole film: every pixel
+        // receives spp times its value from width x height x spp paths.
+        film.set_splat_scale(result.spp > 0 ? 1.0 / double(result.spp) : 1.0);
+        if (result.cancelled) {
+            const std::string what =
+                fmt::format("after {} of {} passes: the image has {} of {} light paths per "
+                            "pixel{}",
+                            passes_done, passes, result.spp, spp,
+                            result.spp == 0 ? " (no pass was finished: it is black)" : "");
+            if (result.timed_out)
+                FACET_LOG(Warn, "Timeout of {:.2f}s reached {}", m_timeout, what);
+            else
+                FACET_LOG(Warn, "Rendering stopped {}", what);
+        }
+        result.sampling_seconds = run.seconds;
+        const auto develop_start = std::chrono::steady_clock::now();
         result.image = film.develop();
+        const auto now = std::chrono::steady_clock::now();
+        result.develop_seconds = std::chrono::duration<double>(now - develop_start).count();
+        result.seconds = std::chrono::duration<double>(now - start).count();
         return result;
     }
 

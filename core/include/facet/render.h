@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -36,8 +37,11 @@ struct RenderOptions {
     /// Part `pass_index` (0-based) of `pass_count` independent parts of one render of
     /// pass_count x spp samples per pixel: the part takes the samples
     /// [pass_index·T/pass_count, (pass_index+1)·T/pass_count) of every pixel, T being that total
-    /// after the sampler's rounding (T = pass_count·spp for the independent sampler). The parts,
-    /// averaged with their spp as weights, are the same estimator as the whole render.
+    /// after the sampler's rounding (T = pass_count·spp for the independent sampler). A part's
+    /// image carries the raw sums of its pixels (Film::raw_channel_names) after its developed
+    /// channels: the parts merge exactly (sums added in pass order, developed once), whatever
+    /// the filter. pass_index -1: every part, one after the other in this process, combined as
+    /// their merge combines them (bit-identical to it; a merge of crops of parts too).
     int pass_index = 0;
     int pass_count = 1;
 };
@@ -141,20 +145,40 @@ private:
     size_t m_next = 0, m_finished = 0;
 };
 
-/// What run_work_units() did.
+/// When a render stops early: the cancel flag is set, or `timeout` seconds (if > 0) have passed
+/// since `start`. Cheap enough to ask every few samples.
+struct StopCondition {
+    const std::atomic<bool> *cancel = nullptr;
+    double timeout = -1.0;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+    bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+    bool timed_out() const;
+    bool operator()() const { return cancelled() || timed_out(); }
+};
+
+/// The passes of a progressive render of `spp` samples per pixel: pass p takes the samples
+/// [s[p], s[p + 1]) of every pixel (s[0] = 0, the last is spp). With `samples_per_pass` > 0
+/// passes of that many; else 1, 1, 2, 4, ... samples, at most `cap` per pass. The render's film
+/// holds whole passes only (BlockMerger groups), so a stopped render has every pixel at the same
+/// spp, s[passes done].
+std::vector<uint32_t> progressive_schedule(uint32_t spp, uint32_t samples_per_pass, uint32_t cap);
+
+/// What run_units() did.
 struct WorkUnitsRun {
     bool cancelled = false; ///< stopped by the cancel flag before every unit was taken
     bool timed_out = false; ///< stopped by the timeout before every unit was taken
     double seconds = 0.0;
 };
 
-/// Runs work units 0..count-1 on opts.threads threads (a TBB arena; every thread sets
-/// flush-to-zero). `make_worker` is called once per thread and returns the function that runs one
-/// unit; each thread takes the next unit index until none is left, the cancel flag is set or
-/// `timeout` seconds (if > 0) have passed since `start`. Units in flight are finished. The
-/// progress line counts finished units (the unit function returns the count done so far).
-WorkUnitsRun run_work_units(size_t count, const RenderOptions &opts, double timeout,
-                            const std::function<std::function<size_t(size_t)>()> &make_worker);
+/// The render loop of every integrator: runs work units 0..count-1 on opts.threads threads (a
+/// TBB arena; every thread sets flush-to-zero). `make_worker` is called once per thread and
+/// returns the function that runs one unit; each thread takes the next unit index until none is
+/// left or `stop` says so; a unit may itself return early (without handing in its result) when
+/// `stop` says so. The progress line shows work_done / work_total, redrawn by a monitor thread
+/// (so it moves while long units run), which also says "stopping" at the first cancellation.
+WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondition &stop,
+                       const std::atomic<uint64_t> &work_done, uint64_t work_total,
+                       const std::function<std::function<void(size_t)>()> &make_worker);
 
 /// Number of threads a render with `opts` uses.
 int render_thread_count(const RenderOptions &opts);
