@@ -16,3 +16,9 @@ if(TARGET facet_cli AND FACET_IDIFF)
 elseif(TARGET facet_cli)
     message(WARNING "idiff (openimageio-tools) not found: the merge tests are not registered")
 endif()
+
+# The C++ part tests merge in memory with the code of `facet merge`.
+if(TARGET render_parts)
+    target_sources(render_parts PRIVATE ${PROJECT_SOURCE_DIR}/core/apps/merge.cpp)
+    target_include_directories(render_parts PRIVATE ${PROJECT_SOURCE_DIR}/core/apps)
+endif()

@@ -1,5 +1,6 @@
 #include "merge.h"
 
+#include <facet/film.h>
 #include <facet/logger.h>
 
 #include <fmt/format.h>
@@ -44,6 +45,82 @@ std::string join(const std::vector<std::string> &v) {
     return s;
 }
 
+/// Where a part's developed and raw channels (Film::raw_channel_names) are. Found by name: an EXR
+/// file may list its channels in another order than they were written in.
+struct RawLayout {
+    std::vector<int> developed; ///< R, G, B, A?, AOVs (in the part's order)
+    int aovs = 0;               ///< AOV channels among them
+    bool alpha = false;         ///< developed[3] is A
+    bool sums = false, splats = false;
+    /// The raw channels in develop_pixel's order: Σ w·R, G, B, Σ w·AOVs, Σ w, then the splats.
+    std::vector<int> raw;
+    std::vector<std::string> raw_names;
+};
+
+/// Index of every channel of `names` in the part `p` (the parts' channel sets agree).
+std::vector<int> channel_indices(const Part &p, const std::vector<std::string> &names) {
+    std::vector<int> out;
+    const std::vector<std::string> &have = p.image.channel_names;
+    for (const std::string &n : names) {
+        auto it = std::find(have.begin(), have.end(), n);
+        if (it == have.end()) FACET_THROW("{} has no channel {}", p.name, n);
+        out.push_back(int(it - have.begin()));
+    }
+    return out;
+}
+
+RawLayout raw_layout(const Part &p) {
+    const std::vector<std::string> &names = p.image.channel_names;
+    const std::string prefix = RawChannelPrefix;
+    RawLayout l;
+    size_t prefixed = 0;
+    for (size_t c = 0; c < names.size(); ++c) {
+        if (names[c].rfind(prefix, 0) == 0)
+            ++prefixed;
+        else
+            l.developed.push_back(int(c));
+    }
+    auto name_of = [&](int c) { return names[size_t(c)]; };
+    std::vector<std::string> developed_names;
+    for (int c : l.developed) developed_names.push_back(name_of(c));
+    if (prefixed == 0)
+        FACET_THROW("{} has no raw channels ({}sum.R ..., {}weight): passes merge by their "
+                    "sums; render the parts with --pass/--passes of this facet",
+                    p.name, prefix, prefix);
+    if (developed_names.size() < 3 || developed_names[0] != "R" || developed_names[1] != "G" ||
+        developed_names[2] != "B")
+        FACET_THROW("{} has the colour channels {}: passes merge into R, G, B only (render them "
+                    "with the pixel format rgb or rgba)",
+                    p.name, join(developed_names));
+    l.alpha = developed_names.size() > 3 && developed_names[3] == "A";
+    l.aovs = int(developed_names.size()) - 3 - (l.alpha ? 1 : 0);
+    auto find = [&](const std::string &name) {
+        auto it = std::find(names.begin(), names.end(), name);
+        return it == names.end() ? -1 : int(it - names.begin());
+    };
+    l.sums = find(prefix + "weight") >= 0;
+    l.splats = find(prefix + "splat.R") >= 0;
+    std::vector<std::string> expect;
+    if (l.sums) {
+        for (const char *c : {"R", "G", "B"}) expect.push_back(prefix + "sum." + c);
+        for (int a = 0; a < l.aovs; ++a)
+            expect.push_back(prefix + "sum." + developed_names[size_t(3 + (l.alpha ? 1 : 0) + a)]);
+        expect.push_back(prefix + "weight");
+    }
+    if (l.splats)
+        for (const char *c : {"R", "G", "B"}) expect.push_back(prefix + "splat." + c);
+    for (const std::string &e : expect) l.raw.push_back(find(e));
+    l.raw_names = expect;
+    if (expect.size() != prefixed || std::count(l.raw.begin(), l.raw.end(), -1) > 0) {
+        std::vector<std::string> have;
+        for (const std::string &n : names)
+            if (n.rfind(prefix, 0) == 0) have.push_back(n);
+        FACET_THROW("{}: the raw channels {} are not the {} its developed channels need", p.name,
+                    join(have), join(expect));
+    }
+    return l;
+}
+
 } // namespace
 
 Part read_part(const std::string &path) {
@@ -79,13 +156,17 @@ Merged merge_parts(const std::vector<Part> &parts) {
             FACET_THROW("{} is a part of a {}x{} image, {} of a {}x{} image: parts of different "
                         "renders",
                         p.name, p.full_width, p.full_height, first.name, W, H);
-        if (p.image.channel_names != first.image.channel_names)
-            FACET_THROW("{} has the channels {}, {} has {}: parts of different renders", p.name,
-                        join(p.image.channel_names), first.name, join(first.image.channel_names));
         long long n = get_int(p, attr::passes, 1);
         if (n != passes)
             FACET_THROW("{} is a part of a render in {} pass{}, {} of one in {}", p.name, n,
                         n == 1 ? "" : "es", first.name, passes);
+        // The same channels, in any order (EXR files list them in their own order).
+        std::vector<std::string> a = p.image.channel_names, b = first.image.channel_names;
+        std::sort(a.begin(), a.end());
+        std::sort(b.begin(), b.end());
+        if (a != b)
+            FACET_THROW("{} has the channels {}, {} has {}: parts of different renders", p.name,
+                        join(p.image.channel_names), first.name, join(first.image.channel_names));
         for (const char *key : {attr::scene_hash, attr::seed, attr::spp_total}) {
             auto a = first.metadata.find(key), b = p.metadata.find(key);
             bool has_a = a != first.metadata.end(), has_b = b != p.metadata.end();
@@ -111,17 +192,29 @@ Merged merge_parts(const std::vector<Part> &parts) {
                         p.name, attr::spp);
     }
 
+    // Passes merge by their raw sums (the parts' channels agree, so one layout fits all).
+    const RawLayout raw = passes > 1 ? raw_layout(first) : RawLayout{};
+    const int out_channels = passes > 1 ? int(raw.developed.size()) : C;
+    const int nraw = int(raw.raw.size());
+
     Merged out;
     out.passes = int(passes);
-    out.image = Image(W, H, C);
-    out.image.channel_names = first.image.channel_names;
+    out.image = Image(W, H, out_channels);
+    if (passes > 1)
+        for (int c : raw.developed)
+            out.image.channel_names.push_back(first.image.channel_names[size_t(c)]);
+    else
+        out.image.channel_names = first.image.channel_names;
+    // Where each part keeps the channels the merge reads: the output's (one pass) or the raw ones.
+    auto channels_read = [&](const Part &p) {
+        return channel_indices(p, passes > 1 ? raw.raw_names : out.image.channel_names);
+    };
     out.half = std::all_of(parts.begin(), parts.end(), [](const Part &p) { return p.half; });
 
-    std::vector<double> sum, weight;
-    if (passes > 1) {
-        sum.assign(size_t(W) * H * C, 0.0);
-        weight.assign(size_t(W) * H, 0.0);
-    }
+    // Σ of every raw channel over the passes, in pass order (the order a render of all the
+    // passes in one process adds them in).
+    std::vector<double> sum;
+    if (passes > 1) sum.assign(size_t(W) * H * size_t(nraw), 0.0);
     long long total_spp = 0;
     bool uniform_spp = true;
     for (long long pass = 0; pass < passes; ++pass) {
@@ -169,28 +262,38 @@ Merged merge_parts(const std::vector<Part> &parts) {
         for (const Part *p : in_pass) {
             const long long spp = get_int(*p, attr::spp, 0);
             if (spp != pass_spp) uniform_spp = false;
+            const std::vector<int> index = channels_read(*p);
             for (int y = 0; y < p->image.height; ++y) {
                 const float *src = p->image.data.data() + size_t(y) * p->image.width * C;
                 const size_t row = size_t(p->y + y) * W + p->x;
-                if (passes == 1) {
-                    std::memcpy(out.image.data.data() + row * C, src,
-                                size_t(p->image.width) * C * sizeof(float));
-                    continue;
-                }
                 for (int x = 0; x < p->image.width; ++x) {
-                    for (int c = 0; c < C; ++c)
-                        sum[(row + x) * C + c] += double(spp) * double(src[size_t(x) * C + c]);
-                    weight[row + x] += double(spp);
+                    const float *px = src + size_t(x) * C;
+                    if (passes == 1) {
+                        float *dst = out.image.data.data() + (row + x) * size_t(C);
+                        for (int c = 0; c < C; ++c) dst[c] = px[index[size_t(c)]];
+                        continue;
+                    }
+                    for (int c = 0; c < nraw; ++c)
+                        sum[(row + x) * size_t(nraw) + c] += double(px[index[size_t(c)]]);
                 }
             }
         }
         total_spp += pass_spp;
     }
-    if (passes > 1)
+    if (passes > 1) {
+        if (!uniform_spp)
+            FACET_THROW("the parts of one pass have different sample counts: parts of different "
+                        "renders");
+        // Developed as the film develops: Σ w·value / Σ w, splats over the light paths per
+        // pixel of all the passes.
+        const double splat_scale = total_spp > 0 ? 1.0 / double(total_spp) : 1.0;
         for (size_t i = 0; i < size_t(W) * H; ++i) {
-            const double inv = weight[i] > 0.0 ? 1.0 / weight[i] : 0.0;
-            for (int c = 0; c < C; ++c) out.image.data[i * C + c] = float(sum[i * C + c] * inv);
+            const double *s = sum.data() + i * size_t(nraw);
+            develop_pixel(raw.sums ? s : nullptr, raw.aovs,
+                          raw.splats ? s + (raw.sums ? 4 + raw.aovs : 0) : nullptr, splat_scale,
+                          raw.alpha, out.image.data.data() + i * size_t(out_channels));
         }
+    }
 
     // Metadata: what all parts agree on, the total sample count and the summed render time.
     for (const auto &entry : first.metadata) {

@@ -5,8 +5,12 @@
 //
 // A part is an image of a rectangle of the full image (its data window inside the display
 // window) from one pass of a render split into passes. Parts of one pass must cover the full
-// image exactly once; pixels are averaged over the passes with the passes' sample counts as
-// weights. With one pass the merged pixels are the parts' pixels, unchanged.
+// image exactly once. With one pass the merged pixels are the parts' pixels, unchanged. With
+// several, every part carries the raw sums of its pixels after its developed channels
+// (Film::raw_channel_names: Σ w·value, Σ w, splats): they are added over the passes in pass order
+// and developed once (facet::develop_pixel), so the merge is Σ w·L / Σ w over all the samples
+// whatever the filter, bit-identical to the render of all the passes in one process
+// (RenderOptions::pass_index -1, `facet render --passes N` without --pass).
 
 #include <facet/image.h>
 
@@ -36,7 +40,7 @@ struct Part {
     int full_width = 0, full_height = 0;         ///< display window
     int x = 0, y = 0;                            ///< data window origin inside the display window
     Image image;                                 ///< the data window's pixels
-    bool half = false;                           ///< stored as float16
+    bool half = false;                           ///< colour stored as float16
     std::map<std::string, std::string> metadata; ///< the facet:* string attributes
 };
 

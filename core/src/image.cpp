@@ -667,9 +667,9 @@ ImageFile read_image_file(const std::string &path) {
     auto in = OIIO::ImageInput::open(path);
     if (!in) FACET_THROW("cannot read image \"{}\": {}", path, OIIO::geterror());
     const OIIO::ImageSpec &spec = in->spec();
-    file.half = spec.format == OIIO::TypeDesc::HALF;
-    for (const auto &f : spec.channelformats)
-        if (f != OIIO::TypeDesc::HALF) file.half = false;
+    // The film's colour comes first; AOVs and raw sums after it may be float32.
+    file.half = (spec.channelformats.empty() ? spec.format : spec.channelformats[0]) ==
+                OIIO::TypeDesc::HALF;
     for (const OIIO::ParamValue &p : spec.extra_attribs)
         file.attributes[p.name().string()] = p.get_string();
     in->close();

@@ -34,6 +34,9 @@ run_array 8 TILES_X=2 TILES_Y=2 PASSES=2 OUT=parts2
 "$FACET" render "$SCENE" "${D[@]}" -q --pass 1 --passes 2 -o pass1.exr
 "$FACET" merge pass0.exr pass1.exr -o passes.exr
 same passes.exr merged2.exr
+# ... which is the render of the two passes in one process.
+"$FACET" render "$SCENE" "${D[@]}" -q --passes 2 -o single_passes.exr
+same single_passes.exr merged2.exr
 
 # A task id past the parts fails.
 if env TILES_X=2 TILES_Y=2 PASSES=2 OUT=parts2 SLURM_ARRAY_TASK_ID=8 SCENE="$SCENE" WIDTH=40 \

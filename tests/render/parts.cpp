@@ -1,6 +1,10 @@
 // Parts of one render: crop windows (bit-identical to the same pixels of the whole film, EXR data
 // window inside the display window) and independent sample passes (--pass I --passes N) that
-// merge, weighted by their sample counts, into the render of all their samples.
+// merge by their raw sums (Σ w·L, Σ w) into the render of all their samples, bit-identical to
+// the render of all the passes in one process for every reconstruction filter, crop split and
+// integrator (path, aov, ptracer).
+#include "merge.h"
+
 #include <facet/film.h>
 #include <facet/image.h>
 #include <facet/render.h>
@@ -11,6 +15,7 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -35,10 +40,13 @@ std::shared_ptr<Scene> load_temp_scene(const std::string &xml) {
 }
 
 /// A sphere on a plane under a sky and a point light; `film_extra` goes inside the film.
-std::string scene_xml(const std::string &sampler, int spp, const std::string &film_extra,
-                      int width = 29, int height = 21) {
+std::string
+scene_xml(const std::string &sampler, int spp, const std::string &film_extra, int width = 29,
+          int height = 21,
+          const std::string &integrator =
+              R"(<integrator type="path"><integer name="max_depth" value="5"/></integrator>)") {
     return fmt::format(R"(<scene version="3.0.0">
-    <integrator type="path"><integer name="max_depth" value="5"/></integrator>
+    {integrator}
     <sensor type="perspective">
         <float name="fov" value="40"/>
         <transform name="to_world">
@@ -69,9 +77,9 @@ std::string scene_xml(const std::string &sampler, int spp, const std::string &fi
         <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
     </shape>
 </scene>)",
-                       fmt::arg("sampler", sampler), fmt::arg("spp", spp),
-                       fmt::arg("film_extra", film_extra), fmt::arg("w", width),
-                       fmt::arg("h", height));
+                       fmt::arg("integrator", integrator), fmt::arg("sampler", sampler),
+                       fmt::arg("spp", spp), fmt::arg("film_extra", film_extra),
+                       fmt::arg("w", width), fmt::arg("h", height));
 }
 
 RenderOptions options(int threads = 2) {
@@ -112,12 +120,16 @@ void expect_parts_merge_to_whole(const std::string &sampler, int spp, int parts)
     whole_opts.spp = int(total);
     RenderResult whole = render(*scene, sensor, whole_opts);
     EXPECT_EQ(whole.spp, total);
-    ASSERT_EQ(whole.image.data.size(), results[0].image.data.size());
+    // The parts carry their raw sums after the developed channels.
+    const size_t nc = size_t(whole.image.channels), np = size_t(results[0].image.channels);
+    ASSERT_EQ(whole.image.data.size() / nc, results[0].image.data.size() / np);
+    ASSERT_GT(np, nc);
     size_t differing = 0;
     double max_rel = 0.0;
     for (size_t k = 0; k < whole.image.data.size(); ++k) {
         double sum = 0.0;
-        for (const RenderResult &r : results) sum += double(r.image.data[k]) * double(r.spp);
+        for (const RenderResult &r : results)
+            sum += double(r.image.data[k / nc * np + k % nc]) * double(r.spp);
         const double merged = sum / double(total), ref = whole.image.data[k];
         const double rel = std::abs(merged - ref) / std::max(std::abs(ref), 1e-3);
         max_rel = std::max(max_rel, rel);
@@ -147,7 +159,199 @@ bool same_pixels(const Image &crop, const Image &full, int x0, int y0) {
     return true;
 }
 
+/// A part as `facet render` writes it: the image and the attributes a merge checks.
+merge::Part part_of(const RenderResult &r, const std::string &name) {
+    merge::Part p;
+    p.name = name;
+    p.full_width = r.image.full_width;
+    p.full_height = r.image.full_height;
+    p.x = r.image.x;
+    p.y = r.image.y;
+    p.image = r.image;
+    p.metadata = render_metadata(r);
+    p.metadata["facet:scene_hash"] = "0123456789abcdef";
+    p.metadata["facet:seed"] = "0";
+    return p;
+}
+
+/// Values (pixel-channels) whose bits differ; the images must have the same shape.
+size_t differing_values(const Image &a, const Image &b) {
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    EXPECT_EQ(a.channel_names, b.channel_names);
+    if (a.data.size() != b.data.size()) return std::max(a.data.size(), b.data.size());
+    size_t n = 0;
+    for (size_t k = 0; k < a.data.size(); ++k)
+        n += std::memcmp(&a.data[k], &b.data[k], sizeof(float)) != 0;
+    return n;
+}
+
+/// The crop windows pass i of a 29x21 film is split into: the whole film, two rows, four tiles
+/// (none aligned to the 8-pixel blocks; every filter reaches across their edges).
+std::vector<std::array<int, 4>> split_of_pass(int i) {
+    switch (i % 3) {
+    case 0:
+        return {{{0, 0, 29, 21}}};
+    case 1:
+        return {{{0, 0, 29, 9}}, {{0, 9, 29, 21}}};
+    default:
+        return {{{0, 0, 11, 13}}, {{11, 0, 29, 13}}, {{0, 13, 17, 21}}, {{17, 13, 29, 21}}};
+    }
+}
+
+/// Renders `passes` parts of `xml`, each pass cut into the crops of split_of_pass(), merges them
+/// and checks the merge is bit-identical to the render of all the passes in one process. Prints
+/// how far the earlier merge (the parts' developed pixels averaged with their spp as weights) was
+/// from it, and how far both are from one render of all the samples (other float rounding).
+void expect_exact_pass_merge(const std::string &what, const std::string &xml, int passes) {
+    SCOPED_TRACE(what);
+    auto scene = load_temp_scene(xml);
+    const Sensor &sensor = *scene->sensors().at(0);
+    std::vector<merge::Part> parts;
+    std::vector<RenderResult> whole_passes;
+    for (int i = 0; i < passes; ++i) {
+        for (const auto &crop : split_of_pass(i)) {
+            RenderOptions opts = options(2);
+            opts.pass_index = i;
+            opts.pass_count = passes;
+            opts.crop = crop;
+            RenderResult r = render(*scene, sensor, opts);
+            ASSERT_FALSE(r.cancelled);
+            parts.push_back(part_of(r, fmt::format("pass {} crop {} {}", i, crop[0], crop[1])));
+        }
+        RenderOptions opts = options(1);
+        opts.pass_index = i;
+        opts.pass_count = passes;
+        whole_passes.push_back(render(*scene, sensor, opts));
+    }
+    const merge::Merged merged = merge::merge_parts(parts);
+
+    RenderOptions all = options(3);
+    all.pass_index = -1;
+    all.pass_count = passes;
+    const RenderResult single = render(*scene, sensor, all);
+    EXPECT_EQ(single.spp, single.spp_total);
+    EXPECT_EQ(merged.metadata.at("facet:spp"), std::to_string(single.spp));
+    ASSERT_EQ(merged.image.channels, single.image.channels);
+    const size_t exact = differing_values(merged.image, single.image);
+    EXPECT_EQ(exact, 0u) << "values of the merge that differ from the render of all the passes";
+
+    // The spp-weighted mean of the developed passes (what merges took before the raw sums).
+    Image mean = single.image;
+    const size_t values = mean.data.size();
+    for (size_t k = 0; k < values; ++k) {
+        const int c = int(k % size_t(mean.channels));
+        const size_t pixel = k / size_t(mean.channels);
+        double sum = 0.0, weight = 0.0;
+        for (const RenderResult &r : whole_passes) {
+            sum += double(r.spp) * double(r.image.data[pixel * size_t(r.image.channels) + c]);
+            weight += double(r.spp);
+        }
+        mean.data[k] = float(sum / weight);
+    }
+    RenderOptions one = options(2);
+    one.spp = int(single.spp);
+    const RenderResult plain = render(*scene, sensor, one);
+    std::printf(
+        "%s: %d passes, %u spp: the raw-sum merge differs from the one-process render of "
+        "the passes in %zu of %zu values; the spp-weighted mean of the passes in %zu (max "
+        "relative difference %.3g); the one render of %u spp: the merge in %zu values\n",
+        what.c_str(), passes, single.spp, exact, values, differing_values(mean, single.image),
+        [&] {
+            double m = 0.0;
+            for (size_t k = 0; k < values; ++k)
+                m = std::max(m, std::abs(double(mean.data[k]) - single.image.data[k]) /
+                                    std::max(1e-3, std::abs(double(single.image.data[k]))));
+            return m;
+        }(),
+        plain.spp, differing_values(merged.image, plain.image));
+}
+
 } // namespace
+
+TEST(RenderParts, PassesMergeExactlyWithEveryFilter) {
+    for (const char *filter : {"", "<rfilter type=\"gaussian\"/>", "<rfilter type=\"box\"/>",
+                               "<rfilter type=\"tent\"/>", "<rfilter type=\"lanczos\"/>",
+                               "<rfilter type=\"mitchell\"/>", "<rfilter type=\"catmullrom\"/>"}) {
+        expect_exact_pass_merge(*filter ? filter : "default filter (gaussian)",
+                                scene_xml("independent", 3, filter), 3);
+    }
+}
+
+TEST(RenderParts, PassesMergeExactlyWithOtherSamplersAndAovs) {
+    expect_exact_pass_merge("stratified", scene_xml("stratified", 4, ""), 3);
+    expect_exact_pass_merge("ldsampler", scene_xml("ldsampler", 2, ""), 4);
+    // AOV channels and alpha: their sums merge like the colour's.
+    expect_exact_pass_merge(
+        "aov + rgba",
+        scene_xml("independent", 2, R"(<string name="pixel_format" value="rgba"/>)", 29, 21,
+                  R"(<integrator type="aov"><string name="aovs" value="dd:depth, nn:sh_normal"/>
+                     <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+                     </integrator>)"),
+        2);
+}
+
+TEST(RenderParts, LightTracerPassesMergeExactly) {
+    expect_exact_pass_merge(
+        "ptracer",
+        scene_xml(
+            "independent", 2, "", 29, 21,
+            R"(<integrator type="ptracer"><integer name="max_depth" value="4"/></integrator>)"),
+        3);
+}
+
+TEST(RenderParts, PartFilesMergeExactly) {
+    // Through EXR files (float16 colour, float32 raw sums): the merge is developed from the raw
+    // sums, so it is still the one-process render of the passes, bit for bit.
+    auto scene = load_temp_scene(scene_xml("independent", 2, ""));
+    const Sensor &sensor = *scene->sensors().at(0);
+    std::vector<merge::Part> parts;
+    for (int i = 0; i < 2; ++i)
+        for (const auto &crop : split_of_pass(i + 1)) {
+            RenderOptions opts = options();
+            opts.pass_index = i;
+            opts.pass_count = 2;
+            opts.crop = crop;
+            RenderResult r = render(*scene, sensor, opts);
+            const std::string path =
+                (temp_dir() / fmt::format("part-{}-{}-{}.exr", i, crop[0], crop[1])).string();
+            ImageWriteOptions w;
+            w.metadata = part_of(r, path).metadata;
+            sensor.film().write(r.image, path, w);
+            parts.push_back(merge::read_part(path));
+            EXPECT_TRUE(parts.back().half);
+        }
+    const std::vector<std::string> &names = parts[0].image.channel_names;
+    // The raw sums, in the order the EXR file lists them.
+    ASSERT_EQ(names.size(), 7u);
+    std::vector<std::string> sorted = names;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, (std::vector<std::string>{"B", "G", "R", "facet.sum.B", "facet.sum.G",
+                                                "facet.sum.R", "facet.weight"}));
+    const merge::Merged merged = merge::merge_parts(parts);
+    RenderOptions all = options();
+    all.pass_index = -1;
+    all.pass_count = 2;
+    EXPECT_EQ(differing_values(merged.image, render(*scene, sensor, all).image), 0u);
+    EXPECT_TRUE(merged.half);
+
+    // Parts without raw sums (developed images only) cannot be merged as passes.
+    for (merge::Part &p : parts) {
+        std::vector<float> rgb;
+        for (size_t k = 0; k < p.image.data.size(); k += 7)
+            rgb.insert(rgb.end(), p.image.data.begin() + std::ptrdiff_t(k),
+                       p.image.data.begin() + std::ptrdiff_t(k + 3));
+        p.image.data = rgb;
+        p.image.channels = 3;
+        p.image.channel_names.resize(3);
+    }
+    try {
+        merge::merge_parts(parts);
+        ADD_FAILURE() << "a part without raw sums was merged";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find("no raw channels"), std::string::npos) << e.what();
+    }
+}
 
 TEST(RenderParts, IndependentPassesMergeToTheWholeRender) {
     expect_parts_merge_to_whole("independent", 3, 4);
@@ -176,7 +380,7 @@ TEST(RenderParts, SampleRangeOfAPart) {
     EXPECT_EQ(r.count, 6u);
     opts.pass_index = 3;
     EXPECT_THROW(render_sample_range(sensor, opts), Error);
-    opts.pass_index = -1;
+    opts.pass_index = -2; // -1 is every pass
     EXPECT_THROW(render(*scene, sensor, opts), Error);
     opts.pass_index = 0;
     opts.pass_count = 0;

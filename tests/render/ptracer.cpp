@@ -14,11 +14,14 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 #include <unistd.h>
 
 using namespace facet;
@@ -103,6 +106,14 @@ RenderResult render_with(const Scene &scene, int threads) {
     return render(scene, *scene.sensors().at(0), opts);
 }
 
+RenderResult render_with_spp(const Scene &scene, int threads, int spp) {
+    RenderOptions opts;
+    opts.threads = threads;
+    opts.spp = spp;
+    opts.progress = false;
+    return render(scene, *scene.sensors().at(0), opts);
+}
+
 bool identical(const Image &a, const Image &b) {
     return a.data.size() == b.data.size() &&
            std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(float)) == 0;
@@ -162,6 +173,35 @@ TEST(ParticleTracer, BitIdenticalForAnyThreadCount) {
     auto other =
         load_temp_scene("seed", box_scene(PTRACER, 24, 8, 6, "<rfilter type=\"gaussian\"/>"));
     EXPECT_FALSE(identical(one.image, render_with(*other, 2).image));
+}
+
+TEST(ParticleTracer, StoppedRenderKeepsTheLightPathsPerPixelItReached) {
+    // Far too many light paths to finish: a stop keeps the progressive passes done, says how
+    // many paths per pixel they hold, and the image is the render of exactly that many.
+    auto scene =
+        load_temp_scene("stop", box_scene(PTRACER, 24, 1 << 22, 5, "<rfilter type=\"gaussian\"/>"));
+    std::atomic<bool> cancel{false};
+    RenderOptions opts;
+    opts.threads = 2;
+    opts.progress = false;
+    opts.cancel = &cancel;
+    std::thread stopper([&cancel] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        cancel = true;
+    });
+    RenderResult stopped = render(*scene, *scene->sensors().at(0), opts);
+    stopper.join();
+    EXPECT_TRUE(stopped.cancelled);
+    EXPECT_FALSE(stopped.timed_out);
+    EXPECT_EQ(stopped.spp_target, 1u << 22);
+    ASSERT_GE(stopped.spp, 1u);
+    EXPECT_LT(stopped.spp, 1u << 22);
+    EXPECT_EQ(stopped.samples, 24u * 24u * stopped.spp);
+    EXPECT_LT(stopped.blocks_done, stopped.blocks_total);
+    auto again = render_with_spp(*scene, 1, int(stopped.spp));
+    EXPECT_FALSE(again.cancelled);
+    EXPECT_TRUE(identical(stopped.image, again.image))
+        << "the stopped render is not the render of " << stopped.spp << " light paths per pixel";
 }
 
 TEST(ParticleTracer, AgreesWithThePathTracer) {

@@ -94,7 +94,7 @@ Image read_image(const std::string &path);
 /// attributes (as `facet merge` reads the parts of a split render).
 struct ImageFile {
     Image image;
-    bool half = false;                             ///< every channel is stored as float16
+    bool half = false; ///< the first channel (a film's colour) is stored as float16
     std::map<std::string, std::string> attributes; ///< every attribute, as text
 };
 /// read_image(), and the storage and attributes of the file.
