@@ -108,7 +108,7 @@ class Image(tuple):
         return f"<facet.Image {w}x{h} {self[1]}>"
 
 
-def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_index=0, passes=1):
+def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_index=None, passes=1):
     """Renders ``sensor`` of ``scene`` with its integrator and returns an ``Image``: a NumPy
     float32 array of shape (height, width, channels) and the channel names (R, G, B, then A and
     the AOVs when the scene asks for them). ``spp`` overrides the sampler's sample_count, ``seed``
@@ -117,8 +117,12 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
 
     ``crop=(x0, y0, x1, y1)`` renders only film pixels [x0, x1) x [y0, y1) (the same pixels as
     in a render of the whole film); ``pass_index=i, passes=n`` renders part i of n of a render
-    of n x spp samples per pixel (``--pass``/``--passes`` of the CLI). ``facet.merge`` puts such
-    parts back together."""
+    of n x spp samples per pixel (``--pass``/``--passes`` of the CLI), with the raw sums of its
+    pixels as extra ``facet.*`` channels. ``facet.merge`` puts such parts back together.
+    ``passes=n`` without ``pass_index`` renders all n parts here, combined as their merge
+    combines them (bit-identical to it)."""
+    if pass_index is None:
+        pass_index = -1 if int(passes) > 1 else 0
     pixels, channels, metadata, half, window = _facet.render(
         scene, spp, int(seed), int(sensor), threads,
         None if crop is None else [int(v) for v in crop], int(pass_index), int(passes))
@@ -127,8 +131,8 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
 
 def merge(parts, output=None):
     """Merges the parts of a split render as ``facet merge`` does: crop windows placed where they
-    belong, passes averaged by their sample counts; with one pass the pixels are the parts'
-    pixels. ``parts`` are file names or rendered ``Image``s (mixed as you like). Raises
+    belong, passes combined by their raw sums (Σ w·L / Σ w over all their samples, whatever the
+    filter); with one pass the pixels are the parts' pixels. ``parts`` are file names or rendered ``Image``s (mixed as you like). Raises
     ``facet.Error`` naming the parts that overlap, leave holes or belong to different renders.
     Returns the whole image (and writes it to ``output`` when given)."""
     items = []

@@ -10,11 +10,11 @@
 The film is cut into ``tiles`` crop windows (columns, rows) and each window into ``passes`` parts
 of ``spp`` samples per pixel; every (window, pass) is one task that loads the scene on its worker
 (once per worker process and scene) and renders that part. The parts come back as arrays and are
-merged as ``facet merge`` merges files: windows placed where they belong, passes averaged by their
-sample counts. With one pass the result is bit-identical to ``facet.render`` of the whole film;
-with several it is the same estimator as one render of passes x spp samples per pixel (and
-bit-identical to the same parts rendered anywhere else). The workers must see the scene file and
-its assets at the same path (a shared folder, or the same machine).
+merged as ``facet merge`` merges files: windows placed where they belong, passes combined by their
+raw sums (Σ w·L / Σ w over all their samples, whatever the filter). The result is bit-identical to
+``facet.render(scene, passes=passes)`` of the whole film in one process (with one pass: to
+``facet.render(scene)``), the same estimator as one render of passes x spp samples per pixel.
+The workers must see the scene file and its assets at the same path (a shared folder, or the same machine).
 """
 
 import os
