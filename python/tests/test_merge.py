@@ -65,9 +65,11 @@ def test_merged_passes_are_the_render_of_all_passes(scene):
              for i in range(3) for c in ([(0, 0, 40, 40)] if i == 1 else
                                          [(0, 0, 40, 17), (0, 17, 23, 40), (23, 17, 40, 40)])]
     assert np.array_equal(facet.merge(tiles[::-1]).pixels, single.pixels)
-    # The spp-weighted mean of the developed passes is close, but not the same estimator.
+    # The spp-weighted mean of the developed passes (what merges took before) is another
+    # estimator: pixels differ by far more than rounding, the image's brightness only a little.
     mean = sum(x.pixels[..., :3].astype(np.float64) for x in p) / 3.0
-    np.testing.assert_allclose(merged.pixels, mean, rtol=1e-3, atol=1e-6)
+    assert not np.allclose(merged.pixels, mean, rtol=1e-3)
+    assert abs(merged.pixels.mean() / mean.mean() - 1.0) < 0.02
     # The passes are independent: no two are the same image.
     assert not np.array_equal(p[0].pixels, p[1].pixels)
     # And their merge estimates the 12-spp render: close on the mean brightness.
