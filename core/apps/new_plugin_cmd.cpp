@@ -1,5 +1,6 @@
-// `facet new-plugin bsdf <name> [dir]`: writes an out-of-tree plugin project that builds
-// against the installed facet package and loads with -a.
+// `facet new-plugin bsdf|emitter|texture|integrator <name> [dir]`: writes an out-of-tree plugin
+// project (CMakeLists.txt, the plugin's .cpp, a scene.xml using it) that builds against the
+// installed facet package and loads with -a.
 
 #include "commands.h"
 
@@ -16,21 +17,76 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const char *CMAKE_TEMPLATE = R"(# The @NAME@ plugin for facet, built out of tree:
+const char *CMAKE_TEMPLATE = R"CMAKE(# The @NAME@ plugin (@KIND@) for facet, built out of tree:
 #   cmake -S . -B build -DCMAKE_PREFIX_PATH=<facet's install prefix>
 #   cmake --build build
 #   facet plugins @NAME@ -a build            # its parameter table
-#   facet chi2 bsdf @NAME@ -a build          # checks its sampling against its pdf
-#   facet render scene.xml -a build          # or: export FACET_PLUGIN_PATH=$PWD/build
+@CHECK_LINE@#   facet render scene.xml -a build          # or: export FACET_PLUGIN_PATH=$PWD/build
 cmake_minimum_required(VERSION 3.20)
 project(@NAME@ LANGUAGES CXX)
 
+# A plugin built without optimisation renders many times slower: Release unless asked otherwise.
+if(NOT CMAKE_BUILD_TYPE AND NOT CMAKE_CONFIGURATION_TYPES)
+    set(CMAKE_BUILD_TYPE Release CACHE STRING "Build type (Debug, Release, RelWithDebInfo)" FORCE)
+endif()
+
 find_package(facet REQUIRED)
 facet_add_plugin(@NAME@ @NAME@.cpp)
-)";
+)CMAKE";
 
-// The plugin: a Lambertian BSDF, complete and correct, to be turned into something else. The
-// doc block is what `facet plugins @NAME@` prints; keep its table in step with the constructor.
+// The scene every template comes with: the plugin in use, rendered by
+// `facet render scene.xml -a build`. @OBJECTS@ is the template's part.
+const char *SCENE_TEMPLATE =
+    R"XML(<!-- A small scene that uses the @NAME@ plugin: facet render scene.xml -a build -->
+<scene version="3.0.0">
+    <default name="spp" value="16"/>
+    <default name="res" value="64"/>
+
+@INTEGRATOR@
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world">
+            <lookat origin="0, 1.5, 4" target="0, 0.5, 0" up="0, 1, 0"/>
+        </transform>
+        <sampler type="independent">
+            <integer name="sample_count" value="$spp"/>
+        </sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="$res"/>
+            <integer name="height" value="$res"/>
+        </film>
+    </sensor>
+
+    <shape type="sphere">
+        <point name="center" x="0" y="0.6" z="0"/>
+        <float name="radius" value="0.6"/>
+@SPHERE_BSDF@
+    </shape>
+
+    <shape type="rectangle">
+        <transform name="to_world">
+            <rotate x="1" angle="-90"/>
+            <scale value="5"/>
+        </transform>
+@FLOOR_BSDF@
+    </shape>
+
+@EMITTER@
+</scene>
+)XML";
+
+const char *PATH_INTEGRATOR = R"(    <integrator type="path">
+        <integer name="max_depth" value="4"/>
+    </integrator>
+)";
+const char *DIFFUSE_BSDF = R"(        <bsdf type="diffuse"/>)";
+const char *SKY = R"(    <emitter type="constant">
+        <rgb name="radiance" value="0.8, 0.85, 1.0"/>
+    </emitter>)";
+
+// The plugins: each complete and correct, to be turned into something else. The doc block is
+// what `facet plugins @NAME@` prints; keep its table in step with the constructor (every name the
+// constructor reads must be a row of the table).
 const char *BSDF_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
 # @NAME@: a BSDF plugin (so far a Lambertian reflector)
 
@@ -121,6 +177,339 @@ private:
 FACET_EXPORT_PLUGIN(facet::@CLASS@, BSDF, "@NAME@", "A BSDF plugin (so far a Lambertian reflector)", DOC)
 )CPP";
 
+const char *EMITTER_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: an emitter plugin (so far a two-colour sky)
+
+Describe the light here. Until you change it this is an environment that surrounds the scene and
+sends radiance blended linearly from `bottom` (light travelling upwards, from straight below) to
+`top` (from straight above) with the height of the direction it comes from; +y is up, as in most
+Mitsuba scenes. Directions are sampled uniformly over the sphere (pdf 1/4π): correct for any
+radiance, and the first thing to improve (sample the brighter half more often) once the model is
+right. With `top` = `bottom` it is the `constant` emitter.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| top | spectrum | 1 | Radiance arriving from straight above (+y) |
+| bottom | spectrum | 0.25 | Radiance arriving from straight below (-y) |
+
+```xml
+<emitter type="@NAME@">
+    <rgb name="top" value="0.6, 0.7, 1.0"/>
+    <rgb name="bottom" value="0.2, 0.15, 0.1"/>
+</emitter>
+```
+)DOC";
+
+// Conventions (facet/emitter.h): sample_direction() picks a point of the emitter seen from
+// ref.p and returns the record (unit direction towards it, distance, solid-angle pdf) and the
+// weight radiance/pdf, without testing visibility; pdf_direction() is the density of exactly
+// what sample_direction() does; eval() is the radiance along a ray that reached the emitter (for
+// an environment: a miss record whose si.wi = -ray.d in world space). sample_ray() is what the
+// light tracer (ptracer) draws. `facet chi2 emitter @NAME@ -a <build dir>` checks the sampling
+// against the pdf statistically.
+
+#include <facet/emitter.h>
+#include <facet/frame.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/scene.h>
+#include <facet/warp.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace facet {
+
+class @CLASS@ final : public Emitter {
+public:
+    explicit @CLASS@(const Properties &props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        m_top = props.get_color("top", Color3f(1.f), SpectrumKind::Emission);
+        m_bottom = props.get_color("bottom", Color3f(0.25f), SpectrumKind::Emission);
+        m_flags = EmitterFlags::Infinite;
+    }
+
+    /// The environment surrounds the scene: remember its bounding sphere.
+    void set_scene(const Scene &scene) override {
+        const BoundingBox3f &bbox = scene.bbox();
+        float radius = bbox.bounding_sphere_radius();
+        if (bbox.valid() && std::isfinite(radius) && radius > 0.f) {
+            m_center = bbox.center();
+            m_radius = radius * (1.f + RayEpsilon); // the sampled points lie outside it
+        }
+    }
+
+    std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
+                                                         const Point2f &u) const override {
+        DirectionSample ds;
+        ds.d = warp::square_to_uniform_sphere(u);
+        // A point beyond the bounding sphere for every reference point inside it.
+        ds.dist = 2.f * m_radius;
+        ds.p = ref.p + ds.d * ds.dist;
+        ds.n = -ds.d;
+        ds.uv = u;
+        ds.pdf = InvFourPi;
+        ds.delta = false;
+        ds.emitter = this;
+        return {ds, radiance_from(ds.d) / ds.pdf};
+    }
+
+    float pdf_direction(const Interaction &, const DirectionSample &) const override {
+        return InvFourPi;
+    }
+
+    Color3f eval(const SurfaceInteraction &si) const override { return radiance_from(-si.wi); }
+
+    /// A ray entering the bounding sphere: direction w uniform over the sphere (pdf 1/4π), origin
+    /// uniform on the disk of radius r facing it (pdf 1/(π r²)); weight = radiance / both pdfs.
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+        const Vector3f w = warp::square_to_uniform_sphere(u_dir);
+        const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
+        const Frame frame(w);
+        const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y - w) * m_radius;
+        return {Ray(o, w), radiance_from(-w) * (4.f * Pi * Pi * m_radius * m_radius)};
+    }
+
+    std::string to_string() const override {
+        return fmt::format("@CLASS@[top = ({}, {}, {}), bottom = ({}, {}, {})]", m_top.r, m_top.g,
+                           m_top.b, m_bottom.r, m_bottom.g, m_bottom.b);
+    }
+
+private:
+    /// Radiance arriving from the unit world direction d (pointing away from the scene).
+    Color3f radiance_from(const Vector3f &d) const {
+        float t = std::clamp(0.5f * (d.y + 1.f), 0.f, 1.f);
+        return lerp(t, m_bottom, m_top);
+    }
+
+    Color3f m_top, m_bottom;
+    Point3f m_center{0.f, 0.f, 0.f};
+    float m_radius = 1.f;
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Emitter, "@NAME@", "An emitter plugin (so far a two-colour sky)", DOC)
+)CPP";
+
+const char *TEXTURE_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: a texture plugin (so far a colour ramp)
+
+Describe the pattern here. Until you change it this is a linear ramp along the surface's u
+coordinate from `color0` (at u = 0) to `color1` (at u = 1), repeated `scale` times over the unit
+square of texture coordinates.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| color0 | spectrum | 0 | Colour at the start of each ramp |
+| color1 | spectrum | 1 | Colour at the end of each ramp |
+| scale | float | 1 | Number of ramps over u ∈ [0, 1] (> 0) |
+
+```xml
+<bsdf type="diffuse">
+    <texture type="@NAME@" name="reflectance">
+        <rgb name="color0" value="0.1, 0.1, 0.4"/>
+        <rgb name="color1" value="0.9, 0.8, 0.2"/>
+        <float name="scale" value="4"/>
+    </texture>
+</bsdf>
+```
+)DOC";
+
+// Conventions (facet/texture.h): eval() is the colour at a surface point (si.uv are its texture
+// coordinates), eval_1() its scalar value (for roughness, blend weights: by default the mean of
+// the channels), eval_1_grad() the gradient of eval_1 over (u, v) (for bump mapping), mean() the
+// average over the texture's domain and max() an upper bound of eval_1 over all points.
+
+#include <facet/logger.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/texture.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace facet {
+
+class @CLASS@ final : public Texture {
+public:
+    explicit @CLASS@(const Properties &props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        m_color0 = props.get_color("color0", Color3f(0.f));
+        m_color1 = props.get_color("color1", Color3f(1.f));
+        m_scale = float(props.get_float("scale", 1.0));
+        if (!(m_scale > 0.f) || !std::isfinite(m_scale))
+            FACET_THROW_AT(props.location("scale"), "@NAME@: scale must be positive, got {}",
+                           m_scale);
+    }
+
+    Color3f eval(const SurfaceInteraction &si) const override {
+        return lerp(ramp(si), m_color0, m_color1);
+    }
+
+    /// d/du of the mean of the channels along the ramp (the steps between ramps have none).
+    Vector2f eval_1_grad(const SurfaceInteraction &) const override {
+        return Vector2f((m_color1.mean() - m_color0.mean()) * m_scale, 0.f);
+    }
+
+    /// A linear ramp averages to the middle of its ends.
+    Color3f mean() const override { return (m_color0 + m_color1) * 0.5f; }
+    float max() const override { return std::max(m_color0.max(), m_color1.max()); }
+
+    std::string to_string() const override {
+        return fmt::format("@CLASS@[color0 = ({}, {}, {}), color1 = ({}, {}, {}), scale = {}]",
+                           m_color0.r, m_color0.g, m_color0.b, m_color1.r, m_color1.g, m_color1.b,
+                           m_scale);
+    }
+
+private:
+    /// Position in [0, 1) along the ramp the point lies on.
+    float ramp(const SurfaceInteraction &si) const {
+        float x = si.uv.x * m_scale;
+        return x - std::floor(x);
+    }
+
+    Color3f m_color0, m_color1;
+    float m_scale = 1.f;
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Texture, "@NAME@", "A texture plugin (so far a colour ramp)", DOC)
+)CPP";
+
+const char *INTEGRATOR_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: an integrator plugin (so far ambient occlusion)
+
+Describe the estimator here. Until you change it this is ambient occlusion: at the first surface
+a camera ray hits, the fraction of the hemisphere around the shading normal (on the side the ray
+came from), weighted by the cosine, that is not blocked within `max_distance`. It takes
+`shading_samples` cosine-distributed directions per camera sample, so each counts 0 or 1 and
+their mean is the estimate. Rays that hit nothing give 0. The value goes to all three channels.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| shading_samples | integer | 1 | Occlusion rays per camera sample (≥ 1) |
+| max_distance | float | -1 | Occluders further away than this are ignored; ≤ 0: no limit |
+| timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
+| samples_per_pass | integer | (all) | Render in passes over the image of this many samples per pixel (must divide the sample count) |
+| block_size | integer | 0 | Side of the square image blocks, in pixels; 0 chooses 32 |
+
+```xml
+<integrator type="@NAME@">
+    <integer name="shading_samples" value="4"/>
+    <float name="max_distance" value="0.5"/>
+</integrator>
+```
+)DOC";
+
+// Conventions (facet/integrator.h): a SamplingIntegrator estimates the radiance along one camera
+// ray in sample(); facet renders the image in blocks and passes on all threads around it. The
+// estimate may use only the sampler for randomness (so the image is the same for any number of
+// threads), and sample() runs on many threads at once: it must not modify the integrator.
+// The base class reads timeout, samples_per_pass and block_size (rows of the table above).
+
+#include <facet/frame.h>
+#include <facet/integrator.h>
+#include <facet/logger.h>
+#include <facet/plugin.h>
+#include <facet/properties.h>
+#include <facet/sampler.h>
+#include <facet/scene.h>
+#include <facet/warp.h>
+
+#include <fmt/format.h>
+
+namespace facet {
+
+class @CLASS@ final : public SamplingIntegrator {
+public:
+    explicit @CLASS@(const Properties &props) : SamplingIntegrator(props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        int64_t samples = props.get_int("shading_samples", 1);
+        if (samples < 1 || samples > 0xffff)
+            FACET_THROW_AT(props.location("shading_samples"),
+                           "@NAME@: shading_samples must be in [1, 65535], got {}", samples);
+        m_samples = uint32_t(samples);
+        m_max_distance = float(props.get_float("max_distance", -1.0));
+    }
+
+    Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray,
+                   float * /*aovs*/) const override {
+        SurfaceInteraction si;
+        if (!scene.ray_intersect(ray, si)) return Color3f(0.f);
+        // The hemisphere on the side the camera ray arrived from (si.wi is in the local frame).
+        float side = Frame::cos_theta(si.wi) < 0.f ? -1.f : 1.f;
+        uint32_t unoccluded = 0;
+        for (uint32_t i = 0; i < m_samples; ++i) {
+            Vector3f local = warp::square_to_cosine_hemisphere(sampler.next_2d());
+            local.z *= side;
+            Ray shadow = si.spawn_ray(si.to_world(local));
+            if (m_max_distance > 0.f) shadow.maxt = m_max_distance;
+            if (!scene.ray_test(shadow)) ++unoccluded;
+        }
+        return Color3f(float(unoccluded) / float(m_samples));
+    }
+
+    std::string to_string() const override {
+        return fmt::format("@CLASS@[shading_samples = {}, max_distance = {}]", m_samples,
+                           m_max_distance);
+    }
+
+private:
+    uint32_t m_samples = 1;
+    float m_max_distance = -1.f;
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Integrator, "@NAME@", "An integrator plugin (so far ambient occlusion)", DOC)
+)CPP";
+
+/// One kind of plugin `facet new-plugin` can write.
+struct Template {
+    const char *kind;
+    const char *source;
+    const char *check; ///< the CMakeLists line of the chi2 command, if the kind has one
+    // The scene's parts: the integrator, the sphere's and the floor's BSDF, the emitters.
+    const char *integrator, *sphere_bsdf, *floor_bsdf, *emitter;
+};
+
+const Template TEMPLATES[] = {
+    {"bsdf", BSDF_TEMPLATE,
+     "#   facet chi2 bsdf @NAME@ -a build          # checks its sampling against its pdf\n",
+     PATH_INTEGRATOR, R"(        <bsdf type="@NAME@">
+            <rgb name="reflectance" value="0.6, 0.4, 0.2"/>
+        </bsdf>)",
+     DIFFUSE_BSDF, SKY},
+    {"emitter", EMITTER_TEMPLATE,
+     "#   facet chi2 emitter @NAME@ -a build       # checks its sampling against its pdf\n",
+     PATH_INTEGRATOR, DIFFUSE_BSDF, DIFFUSE_BSDF, R"(    <emitter type="@NAME@">
+        <rgb name="top" value="0.6, 0.7, 1.0"/>
+        <rgb name="bottom" value="0.2, 0.15, 0.1"/>
+    </emitter>)"},
+    {"texture", TEXTURE_TEMPLATE, "", PATH_INTEGRATOR, R"(        <bsdf type="diffuse">
+            <texture type="@NAME@" name="reflectance">
+                <rgb name="color0" value="0.1, 0.1, 0.4"/>
+                <rgb name="color1" value="0.9, 0.8, 0.2"/>
+                <float name="scale" value="4"/>
+            </texture>
+        </bsdf>)",
+     DIFFUSE_BSDF, SKY},
+    {"integrator", INTEGRATOR_TEMPLATE, "", R"(    <integrator type="@NAME@">
+        <integer name="shading_samples" value="4"/>
+    </integrator>
+)",
+     DIFFUSE_BSDF, DIFFUSE_BSDF, SKY},
+};
+
 std::string substitute(std::string text, const std::string &key, const std::string &value) {
     for (size_t at = text.find(key); at != std::string::npos;
          at = text.find(key, at + value.size()))
@@ -154,17 +543,24 @@ void write_file(const fs::path &path, const std::string &text) {
 int new_plugin_main(int argc, char **argv) {
     std::string kind, name, dir;
     bool force = false;
+    std::string kinds;
+    for (const Template &t : TEMPLATES) kinds += std::string(kinds.empty() ? "" : ", ") + t.kind;
     CLI::App app("Write a new plugin project that builds out of tree against the installed facet "
-                 "(CMakeLists.txt and one .cpp with a working plugin to start from)",
+                 "(CMakeLists.txt, one .cpp with a working plugin to start from and a scene.xml "
+                 "that uses it)",
                  "facet new-plugin");
-    app.add_option("kind", kind, "Kind of plugin (bsdf)")->required();
+    app.add_option("kind", kind, "Kind of plugin (" + kinds + ")")->required();
     app.add_option("name", name, "Plugin name: the XML type and the library file name")->required();
     app.add_option("dir", dir, "Folder to write (default: ./<name>)");
     app.add_flag("-f,--force", force, "Overwrite the files if they exist");
     if (int code = facet::cli::parse(app, argc, argv); code >= 0) return code;
 
-    if (kind != "bsdf")
-        FACET_THROW("facet new-plugin: no template for \"{}\" plugins (templates: bsdf)", kind);
+    const Template *tpl = nullptr;
+    for (const Template &t : TEMPLATES)
+        if (kind == t.kind) tpl = &t;
+    if (!tpl)
+        FACET_THROW("facet new-plugin: no template for \"{}\" plugins (templates: {})", kind,
+                    kinds);
     bool valid = !name.empty() && std::islower((unsigned char)name[0]);
     for (char c : name)
         valid =
@@ -175,23 +571,36 @@ int new_plugin_main(int argc, char **argv) {
                     name);
 
     fs::path folder = dir.empty() ? fs::path(name) : fs::path(dir);
-    fs::path cmake_file = folder / "CMakeLists.txt", source_file = folder / (name + ".cpp");
-    for (const fs::path &p : {cmake_file, source_file})
+    fs::path cmake_file = folder / "CMakeLists.txt", source_file = folder / (name + ".cpp"),
+             scene_file = folder / "scene.xml";
+    for (const fs::path &p : {cmake_file, source_file, scene_file})
         if (fs::exists(p) && !force)
             FACET_THROW("\"{}\" exists (use --force to overwrite it)", p.string());
     fs::create_directories(folder);
 
-    std::string cmake = substitute(CMAKE_TEMPLATE, "@NAME@", name);
+    std::string cmake = substitute(CMAKE_TEMPLATE, "@CHECK_LINE@", tpl->check);
+    cmake = substitute(substitute(cmake, "@KIND@", tpl->kind), "@NAME@", name);
     std::string source =
-        substitute(substitute(BSDF_TEMPLATE, "@NAME@", name), "@CLASS@", class_name(name));
+        substitute(substitute(tpl->source, "@NAME@", name), "@CLASS@", class_name(name));
+    std::string scene = SCENE_TEMPLATE;
+    scene = substitute(scene, "@INTEGRATOR@", tpl->integrator);
+    scene = substitute(scene, "@SPHERE_BSDF@", tpl->sphere_bsdf);
+    scene = substitute(scene, "@FLOOR_BSDF@", tpl->floor_bsdf);
+    scene = substitute(scene, "@EMITTER@", tpl->emitter);
+    scene = substitute(scene, "@NAME@", name);
     write_file(cmake_file, cmake);
     write_file(source_file, source);
+    write_file(scene_file, scene);
 
-    fmt::print("Wrote {} and {}. Build and test it with:\n"
+    fmt::print("Wrote {}, {} and {}. Build and try it with:\n"
                "  cmake -S {} -B {}/build -DCMAKE_PREFIX_PATH=<facet's install prefix>\n"
                "  cmake --build {}/build\n"
-               "  facet chi2 bsdf {} -a {}/build\n",
-               cmake_file.string(), source_file.string(), folder.string(), folder.string(),
-               folder.string(), name, folder.string());
+               "  facet plugins {} -a {}/build\n"
+               "  facet render {} -a {}/build\n",
+               cmake_file.string(), source_file.string(), scene_file.string(), folder.string(),
+               folder.string(), folder.string(), name, folder.string(), scene_file.string(),
+               folder.string());
+    if (std::string(tpl->kind) == "bsdf" || std::string(tpl->kind) == "emitter")
+        fmt::print("  facet chi2 {} {} -a {}/build\n", tpl->kind, name, folder.string());
     return 0;
 }

@@ -26,14 +26,15 @@ function(step what)
     set(STEP_OUTPUT "${out}" PARENT_SCOPE)
 endfunction()
 
-# Configure and build one out-of-tree project against the installed package.
+# Configure and build one out-of-tree project against the installed package (ARGN: more
+# configure arguments).
 function(build_project src bin)
-    set(extra "")
+    set(extra ${ARGN})
     if(LAUNCHER)
         list(APPEND extra -DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER})
     endif()
     step("configure ${src}" ${CMAKE_COMMAND} -S ${src} -B ${bin} -DCMAKE_PREFIX_PATH=${PREFIX}
-         -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=${CXX} ${extra})
+         -DCMAKE_CXX_COMPILER=${CXX} ${extra})
     step("build ${src}" ${CMAKE_COMMAND} --build ${bin})
 endfunction()
 
@@ -48,7 +49,7 @@ foreach(f bin/facet include/facet/bsdf.h include/facet/plugin.h include/facet/ch
 endforeach()
 
 # 2. A BSDF that facet does not ship (modified Phong), built out of tree.
-build_project(${SOURCE_DIR}/tests/sdk/phong ${WORK}/phong-build)
+build_project(${SOURCE_DIR}/tests/sdk/phong ${WORK}/phong-build -DCMAKE_BUILD_TYPE=Release)
 if(NOT EXISTS ${WORK}/phong-build/phong.so)
     message(FATAL_ERROR "the out-of-tree build made no phong.so")
 endif()
@@ -73,7 +74,61 @@ endif()
 step("render through FACET_PLUGIN_PATH" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PATH=${WORK}/phong-build
      ${FACET} render ${SOURCE_DIR}/tests/sdk/phong/scene.xml -o ${WORK}/phong2.exr -q -D spp=1)
 
-# 3. The template: `facet new-plugin` writes a project that builds, loads and passes chi2.
-step("new-plugin" ${FACET} new-plugin bsdf myplug ${WORK}/myplug)
-build_project(${WORK}/myplug ${WORK}/myplug-build)
-step("chi2 of the template" ${FACET} chi2 bsdf myplug -a ${WORK}/myplug-build)
+# 3. The templates: `facet new-plugin <kind>` writes a project that builds (optimised without
+# being asked), lists its parameter table, renders the scene it comes with and, for the kinds
+# facet's chi2 tests, passes chi2.
+set(_template_dirs "")
+foreach(kind bsdf emitter texture integrator)
+    set(name my${kind})
+    set(project ${WORK}/${name})
+    set(bin ${WORK}/${name}-build)
+    step("new-plugin ${kind}" ${FACET} new-plugin ${kind} ${name} ${project})
+    build_project(${project} ${bin}) # no CMAKE_BUILD_TYPE: the template picks Release
+    file(STRINGS ${bin}/CMakeCache.txt _type REGEX "^CMAKE_BUILD_TYPE:")
+    if(NOT _type MATCHES "=Release$")
+        message(FATAL_ERROR "the ${kind} template builds as \"${_type}\", not Release")
+    endif()
+    if(NOT EXISTS ${bin}/${name}.so)
+        message(FATAL_ERROR "the ${kind} template's build made no ${name}.so")
+    endif()
+    step("parameter table of the ${kind} template" ${FACET} plugins ${name} -a ${bin})
+    set(_row_bsdf "\\| reflectance \\| spectrum or texture \\| 0.5 \\|")
+    set(_row_emitter "\\| bottom \\| spectrum \\| 0.25 \\|")
+    set(_row_texture "\\| scale \\| float \\| 1 \\|")
+    set(_row_integrator "\\| max_distance \\| float \\| -1 \\|")
+    if(NOT STEP_OUTPUT MATCHES "${_row_${kind}}")
+        message(FATAL_ERROR "`facet plugins ${name}` does not show the template's table")
+    endif()
+    file(REMOVE ${WORK}/${name}.exr)
+    step("render the ${kind} template's scene" ${FACET} render ${project}/scene.xml -a ${bin}
+         -o ${WORK}/${name}.exr -q -D spp=4)
+    if(NOT EXISTS ${WORK}/${name}.exr)
+        message(FATAL_ERROR "the render of the ${kind} template's scene wrote no image")
+    endif()
+    if(kind STREQUAL "bsdf")
+        step("chi2 of the bsdf template" ${FACET} chi2 bsdf ${name} -a ${bin})
+        step("chi2 of the bsdf template, grazing" ${FACET} chi2 bsdf ${name} -a ${bin} --theta 80
+             --tests 2)
+    elseif(kind STREQUAL "emitter")
+        step("chi2 of the emitter template" ${FACET} chi2 emitter ${name} -a ${bin} --tests 2)
+        step("chi2 of the emitter template, another point" ${FACET} chi2 emitter ${name}
+             top=2,1,0.5 bottom=0 --ref 3,-1,0.2 -a ${bin} --tests 2)
+    endif()
+    list(APPEND _template_dirs ${bin})
+endforeach()
+# Every parameter each template's constructor reads is a row of its table: facet's own check of
+# its plugins (PluginDocs), run with the templates on the plugin path.
+if(DOCS_TEST)
+    string(REPLACE ";" ":" _path "${_template_dirs}")
+    step("plugins on the path of the check" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PATH=${_path}
+         ${FACET} plugins)
+    foreach(kind bsdf emitter texture integrator)
+        if(NOT STEP_OUTPUT MATCHES "my${kind}")
+            message(FATAL_ERROR "my${kind} is not on the plugin path of the check")
+        endif()
+    endforeach()
+    step("parameter tables of the templates" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PATH=${_path}
+         ${DOCS_TEST} --gtest_filter=PluginDocs.*)
+else()
+    message(FATAL_ERROR "run_sdk_test.cmake: DOCS_TEST (the unit_plugin_docs executable) is not set")
+endif()
