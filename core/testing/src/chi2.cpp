@@ -549,6 +549,7 @@ Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts_in) {
     Chi2Options opts = opts_in;
     Chi2Result res;
     res.description = adapter.to_string();
+    res.phi_center = adapter.plot_phi_center();
     if (opts.res < 2) FACET_THROW("chi2: res must be at least 2 (got {})", opts.res);
     if (opts.samples == 0 || opts.samples > uint64_t(0xffffffffu))
         FACET_THROW("chi2: the sample count must be in [1, 2^32) (got {})", opts.samples);
@@ -595,66 +596,7 @@ std::string Chi2Result::summary() const {
     return s;
 }
 
-// -- Pictures and tables ----------------------------------------------------------------------
-
-namespace {
-
-/// A blue-white-red diverging map for t in [-1, 1].
-Color3f diverging(double t) {
-    t = std::clamp(t, -1.0, 1.0);
-    if (t < 0) return lerp(float(-t), Color3f(1.f), Color3f(0.1f, 0.25f, 0.9f));
-    return lerp(float(t), Color3f(1.f), Color3f(0.9f, 0.1f, 0.1f));
-}
-
-/// A dark-to-bright sequential map for t in [0, 1] (black, purple, orange, yellow-white).
-Color3f sequential(double t) {
-    t = std::clamp(t, 0.0, 1.0);
-    const Color3f stops[] = {
-        {0.f, 0.f, 0.02f}, {0.35f, 0.05f, 0.45f}, {0.9f, 0.35f, 0.1f}, {1.f, 0.95f, 0.6f}};
-    double x = t * 3.0;
-    int i = std::min(2, int(x));
-    return lerp(float(x - i), stops[i], stops[i + 1]);
-}
-
-} // namespace
-
-void write_chi2_heatmap(const std::string &path, const Chi2Result &r) {
-    if (r.observed.empty()) FACET_THROW("write_chi2_heatmap: the result holds no tables");
-    // Each cell becomes scale × scale pixels; panels are about 512 pixels wide.
-    int scale = std::max(1, 512 / r.phi_res);
-    int pw = r.phi_res * scale, ph = r.cos_res * scale, gap = 8;
-    Image img(3 * pw + 2 * gap, ph, 3);
-    img.channel_names = {"R", "G", "B"};
-    std::fill(img.data.begin(), img.data.end(), 0.25f);
-    double peak = 0.0;
-    for (size_t k = 0; k < r.observed.size(); ++k)
-        peak = std::max({peak, r.observed[k], r.expected[k]});
-    if (peak <= 0.0) peak = 1.0;
-    for (int jc = 0; jc < r.cos_res; ++jc) {
-        for (int ip = 0; ip < r.phi_res; ++ip) {
-            size_t k = size_t(jc) * r.phi_res + ip;
-            double o = r.observed[k], e = r.expected[k];
-            // Logarithmic, so that faint lobes next to a peak stay visible.
-            Color3f panels[3] = {sequential(std::log1p(o) / std::log1p(peak)),
-                                 sequential(std::log1p(e) / std::log1p(peak)), Color3f(0.12f)};
-            if (e > 0.0)
-                panels[2] = diverging((o - e) / std::sqrt(e) / 5.0);
-            else if (o > 0.0)
-                panels[2] = Color3f(0.1f, 0.9f, 0.1f);
-            // cos θ = +1 (the normal) at the top.
-            int y0 = (r.cos_res - 1 - jc) * scale;
-            for (int p = 0; p < 3; ++p) {
-                int x0 = p * (pw + gap) + ip * scale;
-                for (int y = y0; y < y0 + scale; ++y)
-                    for (int x = x0; x < x0 + scale; ++x)
-                        for (int c = 0; c < 3; ++c) img.at(x, y, c) = panels[p][c];
-            }
-        }
-    }
-    ImageWriteOptions wo;
-    wo.view = "Raw"; // the colours above are display values already
-    write_image(path, img, wo);
-}
+// -- Tables (the pictures are in chi2_plot.cpp) ----------------------------------------------
 
 void write_chi2_tables(const std::string &path, const Chi2Result &r) {
     std::ofstream out(path);

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
@@ -214,6 +215,10 @@ Chi2Sample BSDFAdapter::sample(const float *u) const {
 }
 
 double BSDFAdapter::pdf(const Vector3f &d) const { return m_bsdf->pdf(m_ctx, m_si, d); }
+
+double BSDFAdapter::plot_phi_center() const {
+    return std::atan2(double(m_si.wi.y), double(m_si.wi.x)) + 3.14159265358979323846;
+}
 
 std::string BSDFAdapter::to_string() const {
     std::string comp =
@@ -577,6 +582,10 @@ Chi2Sample MicrofacetAdapter::sample(const float *u) const {
 }
 
 double MicrofacetAdapter::pdf(const Vector3f &d) const { return m_impl->distr.pdf(m_impl->wi, d); }
+
+double MicrofacetAdapter::plot_phi_center() const {
+    return std::atan2(double(m_impl->wi.y), double(m_impl->wi.x));
+}
 
 std::string MicrofacetAdapter::to_string() const {
     return fmt::format("{}, wi = {}", m_impl->distr.to_string(), vec_str(m_impl->wi));

@@ -69,6 +69,9 @@ public:
     virtual double pdf(const Vector3f &d) const = 0;
     /// True when the mean of the weights may not exceed one (BSDFs: energy conservation).
     virtual bool bounded_weights() const { return false; }
+    /// Azimuth (radians) the heat map puts at the centre of its panels, for display only (the
+    /// statistics never depend on it): 0 by default, so the panels span φ = -π .. π.
+    virtual double plot_phi_center() const { return 0.0; }
     virtual std::string to_string() const = 0;
 };
 
@@ -113,6 +116,7 @@ struct Chi2Result {
     uint64_t weight_mismatches = 0, pdf_mismatches = 0;
     double max_weight_error = 0.0, max_pdf_error = 0.0; ///< largest relative differences seen
     std::string description;                            ///< the adapter's to_string()
+    double phi_center = 0.0; ///< the adapter's plot_phi_center(), for the heat map only
 
     /// Several lines: what was tested, the statistic, dof, p-value and the verdict.
     std::string summary() const;
@@ -121,11 +125,29 @@ struct Chi2Result {
 /// Runs the whole test.
 Chi2Result run_chi2(const Chi2Adapter &adapter, const Chi2Options &opts = {});
 
-/// Writes observed | expected | difference side by side as a PNG: φ from -π to π left to right,
-/// cos θ from 1 (top) to -1. Counts on a logarithmic scale; difference = (o - e)/√e, red above
-/// and blue below expectation (full colour at 5), dark grey where both are zero, green where
-/// samples fell into a cell expecting none.
+/// Writes observed | expected | difference side by side as a PNG, under a title (what was tested,
+/// the statistic, dof, p-value and verdict), with axes (φ in degrees below the panels, θ in
+/// degrees on the left and cos θ on the right: rows are uniform in cos θ, 1 at the top) and a
+/// colour scale with values under each panel. The panels span 2π of φ centred on
+/// result.phi_center (rounded to a cell edge; for BSDFs the mirror azimuth φ_i + π, so that a
+/// reflection lobe is not split across the edges): a rotation of the columns for display only.
+/// Counts on a logarithmic scale; difference = (o - e)/√e, red above and blue below expectation
+/// (full colour at 5), near black where both are zero, green where samples fell into a cell
+/// expecting none. Text uses a built-in bitmap font (ASCII; other characters show as '?').
 void write_chi2_heatmap(const std::string &path, const Chi2Result &result);
+
+/// Where write_chi2_heatmap() puts the panels, in pixels (for tests and for tools that crop).
+struct Chi2HeatmapLayout {
+    int width = 0, height = 0;
+    int panel_x[3] = {0, 0, 0}; ///< left edges of the observed, expected, difference panels
+    int panel_y = 0, panel_width = 0, panel_height = 0;
+    int cell = 0; ///< pixels per side of one histogram cell
+    /// Display column c of a panel shows histogram column (c + column_shift) mod phi_res.
+    int column_shift = 0;
+    int title_lines = 0; ///< lines of text above the panel captions
+    int bar_y = 0;       ///< top of the colour scales
+};
+Chi2HeatmapLayout chi2_heatmap_layout(const Chi2Result &result);
 /// Writes the observed and expected tables as text (one line per cell).
 void write_chi2_tables(const std::string &path, const Chi2Result &result);
 
@@ -177,6 +199,8 @@ public:
     Chi2Sample sample(const float *u) const override;
     double pdf(const Vector3f &d) const override;
     bool bounded_weights() const override { return true; }
+    /// The mirror azimuth φ_i + π, where reflection lobes peak.
+    double plot_phi_center() const override;
     std::string to_string() const override;
     const BSDF &bsdf() const { return *m_bsdf; }
 
@@ -299,6 +323,8 @@ public:
     int sample_dim() const override { return 2; }
     Chi2Sample sample(const float *u) const override;
     double pdf(const Vector3f &d) const override;
+    /// φ_i: visible normals lean towards the incident direction.
+    double plot_phi_center() const override;
     std::string to_string() const override;
 
 private:
