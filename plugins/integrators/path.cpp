@@ -22,8 +22,10 @@ bounces, Russian roulette ends paths whose throughput has become small.
 ```
 )DOC";
 
+#include <facet/assert.h>
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
+#include <facet/frame.h>
 #include <facet/integrator.h>
 #include <facet/mis.h>
 #include <facet/plugin.h>
@@ -93,9 +95,12 @@ public:
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
             if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
                 auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.draw_2d(), true);
+                FACET_ASSERT(ds.pdf >= 0.f && em_weight.is_finite());
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);
+                    FACET_ASSERT(Frame::is_unit(wo) && Frame::is_unit(si.wi));
                     auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
+                    FACET_ASSERT(bsdf_pdf >= 0.f && f.is_finite());
                     if (!f.is_black()) {
                         float w = ds.delta ? 1.f : mis_weight(ds.pdf, bsdf_pdf);
                         result += throughput * f * em_weight * w;
@@ -106,8 +111,11 @@ public:
             // ---- BSDF sampling: the next segment of the path ----
             float sample1 = sampler.draw_1d();
             Point2f sample2 = sampler.draw_2d();
+            FACET_ASSERT(Frame::is_unit(si.wi));
             auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);
+            FACET_ASSERT(bsdf_weight.is_finite());
             if (bsdf_weight.is_black()) break;
+            FACET_ASSERT(bs.pdf >= 0.f && Frame::is_unit(bs.wo));
 
             throughput *= bsdf_weight;
             eta *= bs.eta;
