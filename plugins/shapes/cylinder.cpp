@@ -161,8 +161,8 @@ public:
         si.dp_du = m_to_world.apply_vector(Vector3f(-s, c, 0.f) * (2.f * Pi));
         si.dp_dv = m_to_world.apply_vector(Vector3f(0.f, 0.f, 1.f));
         Vector3f tangent = si.dp_du - si.n * dot(si.n, si.dp_du);
-        si.sh_frame = Frame(normalize(tangent), Vector3f(0.f), si.n);
-        si.sh_frame.t = cross(si.n, si.sh_frame.s);
+        const Vector3f ts = normalize(tangent);
+        si.sh_frame = Frame(ts, cross(si.n, ts), si.n);
         si.wi = si.to_local(-ray.d);
     }
 
