@@ -1,6 +1,8 @@
 // The `facet` command as a user runs it: outputs, naming, -D, one-line errors, plugin listing,
 // determinism across thread counts, Ctrl-C and atomic writes.
 
+#include "test_util.h"
+
 #include <facet/image.h>
 
 #include <OpenImageIO/imageio.h>
@@ -28,7 +30,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string FACET = FACET_BINARY_DIR "/bin/facet";
+using facet::test::FACET;
 
 /// A small scene: a diffuse sphere under a constant sky, seen by a perspective camera.
 const char *TINY_SCENE = R"(<scene version="3.0.0">
@@ -62,59 +64,14 @@ const char *TINY_SCENE = R"(<scene version="3.0.0">
 </scene>
 )";
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
+using Result = facet::test::CommandResult;
+using facet::test::lines;
+using facet::test::read_file;
+using facet::test::write_file;
 
-std::string read_file(const fs::path &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-void write_file(const fs::path &path, const std::string &text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
-
-std::vector<std::string> lines(const std::string &text) {
-    std::vector<std::string> result;
-    std::stringstream ss(text);
-    for (std::string line; std::getline(ss, line);)
-        if (!line.empty()) result.push_back(line);
-    return result;
-}
-
-class CliTest : public ::testing::Test {
+class CliTest : public facet::test::ScratchFolderTest {
 protected:
-    void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_dir = fs::temp_directory_path() /
-                (std::string("facet_cli_") + info->name() + "_" + std::to_string(getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-        write_file(m_dir / "scene.xml", TINY_SCENE);
-    }
-    void TearDown() override {
-        if (!HasFailure()) fs::remove_all(m_dir);
-    }
-
-    /// Runs `facet <args>` in the test folder; stdout and stderr are captured.
-    Result run(const std::string &args) {
-        fs::path out = m_dir / "stdout.txt", err = m_dir / "stderr.txt";
-        std::string cmd = "cd '" + m_dir.string() + "' && '" + FACET + "' " + args + " > '" +
-                          out.string() + "' 2> '" + err.string() + "' < /dev/null";
-        int status = std::system(cmd.c_str());
-        Result r;
-        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = read_file(out);
-        r.err = read_file(err);
-        fs::remove(out);
-        fs::remove(err);
-        return r;
-    }
+    CliTest() : ScratchFolderTest("cli", TINY_SCENE) {}
 
     /// Expects a failure reported as exactly one "facet: error: ..." line; returns that line.
     std::string expect_one_line_error(const std::string &args) {
@@ -126,16 +83,6 @@ protected:
         EXPECT_EQ(err[0].rfind("facet: error: ", 0), 0u) << err[0];
         return err[0];
     }
-
-    /// Every file in the test folder (temporary files of interrupted writes would show here).
-    std::set<std::string> files() const {
-        std::set<std::string> names;
-        for (const auto &e : fs::directory_iterator(m_dir))
-            names.insert(e.path().filename().string());
-        return names;
-    }
-
-    fs::path m_dir;
 };
 
 std::string attribute(const std::string &path, const std::string &name) {

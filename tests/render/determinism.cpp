@@ -1,5 +1,7 @@
 // The render loop: bit-identical images for any thread count, seeds that matter, cancellation,
 // dropped NaN samples and AOV channels.
+#include "test_util.h"
+
 #include <facet/integrator.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
@@ -20,20 +22,11 @@
 #include <unistd.h>
 
 using namespace facet;
+using test::identical;
+using test::load_temp_scene;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Writes `xml` to a scene file in a temporary folder and loads it with the XML loader.
-std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::string &xml) {
-    fs::path dir = fs::temp_directory_path() / fmt::format("facet-determinism-{}", ::getpid());
-    fs::create_directories(dir);
-    fs::path file = dir / (name + ".xml");
-    std::ofstream(file) << xml;
-    auto scene = load_scene(file.string());
-    fs::remove_all(dir);
-    return scene;
-}
 
 std::string scene_xml(const std::string &integrator, int size, int spp,
                       const std::string &rfilter) {
@@ -84,19 +77,9 @@ std::string scene_xml(const std::string &integrator, int size, int spp,
 
 const char *PATH = R"(<integrator type="path"><integer name="max_depth" value="6"/></integrator>)";
 
+/// The render loop in blocks of 8 pixels unless told otherwise.
 RenderResult render_with(const Scene &scene, int threads, uint64_t seed = 0, int block_size = 8) {
-    RenderOptions opts;
-    opts.threads = threads;
-    opts.seed = seed;
-    opts.block_size = block_size;
-    opts.progress = false;
-    return render(scene, *scene.sensors().at(0), opts);
-}
-
-bool identical(const Image &a, const Image &b) {
-    return a.width == b.width && a.height == b.height && a.channels == b.channels &&
-           a.data.size() == b.data.size() &&
-           std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(float)) == 0;
+    return test::render_quiet(scene, threads, seed, block_size);
 }
 
 /// Test integrator: radiance 1 for most samples and NaN or infinity for the others (decided by

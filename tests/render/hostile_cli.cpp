@@ -2,6 +2,8 @@
 // "facet: error: scene.xml:line:col: ..." line, quickly and without large allocations (it used
 // to be a segfault, an Embree abort, gigabytes of memory or an unexplained std::bad_alloc).
 
+#include "test_util.h"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -18,7 +20,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string FACET = FACET_BINARY_DIR "/bin/facet";
+using facet::test::FACET;
+using facet::test::read_file;
 
 struct Case {
     const char *name;
@@ -99,13 +102,6 @@ std::vector<Case> cases() {
                "value=\"$r\"/></bsdf></shape>"),
          "contains NaN", 5, "-D r=nan"},
     };
-}
-
-std::string read_file(const fs::path &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
 }
 
 } // namespace

@@ -3,6 +3,8 @@
 // the aov integrator (depth and normals, no randomness beyond the shared pixel jitter), shading
 // through the image means of a path-traced render.
 
+#include "test_util.h"
+
 #include <facet/image.h>
 #include <facet/render.h>
 #include <facet/scene.h>
@@ -14,6 +16,8 @@
 #include <cmath>
 
 using namespace facet;
+using test::channel;
+using test::render_xml;
 
 namespace {
 
@@ -73,19 +77,6 @@ std::string copied_scene(const std::string &integrator) {
             <bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.7, 0.3"/></bsdf></shape>)";
     }
     return xml + "</scene>";
-}
-
-Image render_xml(const std::string &xml) {
-    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
-    RenderOptions opts;
-    opts.progress = false;
-    return render(*scene, *scene->sensors().at(0), opts).image;
-}
-
-int channel(const Image &img, const std::string &name) {
-    for (size_t i = 0; i < img.channel_names.size(); ++i)
-        if (img.channel_names[i] == name) return int(i);
-    return -1;
 }
 
 } // namespace

@@ -2,6 +2,8 @@
 // and E[x²] - E[x]² is the per-sample variance, checked against the scatter of independent
 // renders.
 
+#include "test_util.h"
+
 #include <facet/integrator.h>
 #include <facet/render.h>
 #include <facet/scene.h>
@@ -17,19 +19,10 @@
 #include <unistd.h>
 
 using namespace facet;
+using test::load_temp_scene;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::string &xml) {
-    fs::path dir = fs::temp_directory_path() / fmt::format("facet-moment-{}", ::getpid());
-    fs::create_directories(dir);
-    fs::path file = dir / (name + ".xml");
-    std::ofstream(file) << xml;
-    auto scene = load_scene(file.string());
-    fs::remove_all(dir);
-    return scene;
-}
 
 std::string scene_xml(const std::string &integrator, int spp, uint64_t seed) {
     return fmt::format(R"(<scene version="3.0.0">
@@ -69,12 +62,7 @@ const char *MOMENT = R"(<integrator type="moment">
     <integrator type="path"><integer name="max_depth" value="4"/></integrator>
 </integrator>)";
 
-Image render_image(const Scene &scene) {
-    RenderOptions opts;
-    opts.progress = false;
-    opts.threads = 2;
-    return render(scene, *scene.sensors().at(0), opts).image;
-}
+Image render_image(const Scene &scene) { return test::render_quiet(scene, 2).image; }
 
 } // namespace
 

@@ -2,6 +2,8 @@
 // writes that never replace a good file by a broken one, typed EXR metadata, and the
 // OpenColorIO display, view and look of 8-bit outputs.
 
+#include "test_util.h"
+
 #include <facet/image.h>
 
 #include <OpenImageIO/imageio.h>
@@ -24,7 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string FACET = FACET_BINARY_DIR "/bin/facet";
+using facet::test::FACET;
 
 /// A diffuse sphere under a constant sky; `$format` is the film's file_format.
 const char *SCENE = R"(<scene version="3.0.0">
@@ -59,64 +61,13 @@ const char *SCENE = R"(<scene version="3.0.0">
 </scene>
 )";
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
+using Result = facet::test::CommandResult;
+using facet::test::read_file;
+using facet::test::write_file;
 
-std::string read_file(const fs::path &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-void write_file(const fs::path &path, const std::string &text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
-
-class Outputs : public ::testing::Test {
+class Outputs : public facet::test::ScratchFolderTest {
 protected:
-    void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_dir = fs::temp_directory_path() /
-                (std::string("facet_outputs_") + info->name() + "_" + std::to_string(getpid()));
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-        write_file(m_dir / "scene.xml", SCENE);
-    }
-    void TearDown() override {
-        if (!HasFailure()) fs::remove_all(m_dir);
-    }
-
-    /// Runs `<prefix> facet <args>` through the shell in the test folder (prefix: environment
-    /// variables, ulimit, ...); stdout and stderr are captured.
-    Result run(const std::string &args, const std::string &prefix = "") {
-        fs::path out = m_dir / ".stdout", err = m_dir / ".stderr";
-        std::string cmd = "cd '" + m_dir.string() + "' && " + prefix + " '" + FACET + "' " + args +
-                          " > '" + out.string() + "' 2> '" + err.string() + "' < /dev/null";
-        int status = std::system(cmd.c_str());
-        Result r;
-        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = read_file(out);
-        r.err = read_file(err);
-        fs::remove(out);
-        fs::remove(err);
-        return r;
-    }
-
-    /// Every file in the test folder (temporary files of failed writes would show here).
-    std::set<std::string> files() const {
-        std::set<std::string> names;
-        for (const auto &e : fs::directory_iterator(m_dir))
-            names.insert(e.path().filename().string());
-        return names;
-    }
-
-    std::string path(const std::string &name) const { return (m_dir / name).string(); }
-
-    fs::path m_dir;
+    Outputs() : ScratchFolderTest("outputs", SCENE) {}
 };
 
 TEST_F(Outputs, PfmFromTheOptionAndFromTheFilm) {

@@ -4,6 +4,8 @@
 // directional light, and environments (constant, envmap) against the path tracer by the peer
 // comparison rule.
 
+#include "test_util.h"
+
 #include <facet/compare.h>
 #include <facet/integrator.h>
 #include <facet/render.h>
@@ -25,19 +27,11 @@
 #include <unistd.h>
 
 using namespace facet;
+using test::identical;
+using test::load_temp_scene;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::string &xml) {
-    fs::path dir = fs::temp_directory_path() / fmt::format("facet-ptracer-{}", ::getpid());
-    fs::create_directories(dir);
-    fs::path file = dir / (name + ".xml");
-    std::ofstream(file) << xml;
-    auto scene = load_scene(file.string());
-    fs::remove_all(dir);
-    return scene;
-}
 
 /// Diffuse floor, back wall, cube and sphere lit by an area light (seen edge-on from the camera,
 /// its front face visible from below) and a point light.
@@ -99,24 +93,12 @@ const char *PTRACER =
     R"(<integrator type="ptracer"><integer name="max_depth" value="4"/></integrator>)";
 const char *PATH = R"(<integrator type="path"><integer name="max_depth" value="4"/></integrator>)";
 
-RenderResult render_with(const Scene &scene, int threads) {
-    RenderOptions opts;
-    opts.threads = threads;
-    opts.progress = false;
-    return render(scene, *scene.sensors().at(0), opts);
-}
-
 RenderResult render_with_spp(const Scene &scene, int threads, int spp) {
     RenderOptions opts;
     opts.threads = threads;
     opts.spp = spp;
     opts.progress = false;
     return render(scene, *scene.sensors().at(0), opts);
-}
-
-bool identical(const Image &a, const Image &b) {
-    return a.data.size() == b.data.size() &&
-           std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(float)) == 0;
 }
 
 /// Per-pixel mean and variance of the mean of the luminance Y over K independent renders.
@@ -131,7 +113,7 @@ Stats independent_renders(const std::string &integrator, int size, int spp, int 
     std::vector<double> sum(n, 0.0), sum2(n, 0.0);
     for (int i = 0; i < k; ++i) {
         auto scene = load_temp_scene("agree", box_scene(integrator, size, spp, 1000003u * i));
-        Image img = render_with(*scene, 2).image;
+        Image img = test::render_quiet(*scene, 2).image;
         for (size_t p = 0; p < n; ++p) {
             const float *c = img.data.data() + p * size_t(img.channels);
             const double y = srgb_to_xyz(Color3f(c[0], c[1], c[2])).g;
@@ -155,9 +137,9 @@ Stats independent_renders(const std::string &integrator, int size, int spp, int 
 TEST(ParticleTracer, BitIdenticalForAnyThreadCount) {
     auto scene =
         load_temp_scene("threads", box_scene(PTRACER, 24, 8, 5, "<rfilter type=\"gaussian\"/>"));
-    RenderResult one = render_with(*scene, 1);
-    RenderResult two = render_with(*scene, 2);
-    RenderResult four = render_with(*scene, 4);
+    RenderResult one = test::render_quiet(*scene, 1);
+    RenderResult two = test::render_quiet(*scene, 2);
+    RenderResult four = test::render_quiet(*scene, 4);
     EXPECT_EQ(one.samples, 24u * 24u * 8u); // light paths: pixels x spp
     EXPECT_FALSE(one.cancelled);
     EXPECT_EQ(one.blocks_done, one.blocks_total);
@@ -172,7 +154,7 @@ TEST(ParticleTracer, BitIdenticalForAnyThreadCount) {
     // Another seed, other noise.
     auto other =
         load_temp_scene("seed", box_scene(PTRACER, 24, 8, 6, "<rfilter type=\"gaussian\"/>"));
-    EXPECT_FALSE(identical(one.image, render_with(*other, 2).image));
+    EXPECT_FALSE(identical(one.image, test::render_quiet(*other, 2).image));
 }
 
 TEST(ParticleTracer, StoppedRenderKeepsTheLightPathsPerPixelItReached) {
@@ -232,7 +214,7 @@ TEST(ParticleTracer, HideEmittersAndMaxDepth) {
         "hidden", box_scene(R"(<integrator type="ptracer"><integer name="max_depth" value="1"/>
                                <boolean name="hide_emitters" value="true"/></integrator>)",
                             16, 16, 0));
-    Image a = render_with(*direct, 2).image, b = render_with(*hidden, 2).image;
+    Image a = test::render_quiet(*direct, 2).image, b = test::render_quiet(*hidden, 2).image;
     int lit = 0;
     for (size_t i = 0; i < a.data.size(); ++i) {
         if (a.data[i] > 0.f) ++lit;
@@ -272,7 +254,7 @@ TEST(ParticleTracer, DirectionalAreaLightsTheFloorBelowIt) {
     </shape>
 </scene>)";
     auto scene = load_temp_scene("dirarea", xml);
-    Image img = render_with(*scene, 2).image;
+    Image img = test::render_quiet(*scene, 2).image;
     // The camera sees x in [-2, 2] and z in [-2, 2] (orthographic, 0.25 per pixel); the beam
     // covers |x| < 0.8, |z| < 0.5 (pixel columns 4.8..11.2, rows 6..10).
     double inside = 0.0;
@@ -317,7 +299,7 @@ TEST(ParticleTracer, DirectionalLightOnADiffuseFloor) {
     </shape>
 </scene>)";
     auto scene = load_temp_scene("sun", xml);
-    Image img = render_with(*scene, 2).image;
+    Image img = test::render_quiet(*scene, 2).image;
     double mean = 0.0;
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) mean += img.at(x, y, 1) / 256.0;
@@ -451,7 +433,7 @@ TEST(ParticleTracer, HiddenEnvironmentLeavesTheSkyBlack) {
     // floor and sphere still do.
     auto scene = load_temp_scene(
         "env-hidden", environment_scene("ptracer", R"(<emitter type="constant"/>)", true));
-    Image img = render_with(*scene, 2).image;
+    Image img = test::render_quiet(*scene, 2).image;
     for (int x = 0; x < img.width; ++x)
         for (int c = 0; c < 3; ++c) EXPECT_EQ(img.at(x, 0, c), 0.f) << x;
     EXPECT_GT(img.at(12, 12, 1), 0.f); // the sphere

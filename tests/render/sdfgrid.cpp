@@ -2,6 +2,8 @@
 // the analytic sphere, through the aov integrator (depth and shading normals per pixel, both
 // normal modes) and through path-traced image means; and the example scene in scenes/sdfgrid.
 
+#include "test_util.h"
+
 #include <facet/image.h>
 #include <facet/render.h>
 #include <facet/scene.h>
@@ -18,6 +20,8 @@
 #include <unistd.h>
 
 using namespace facet;
+using test::channel;
+using test::render_xml;
 
 namespace {
 
@@ -85,19 +89,6 @@ std::string sphere_scene(const std::string &integrator) {
     return std::string("<scene version=\"3.0.0\">") + integrator + SENSOR +
            R"(<shape type="sphere"><point name="center" x="0" y="0.7" z="0"/>
               <float name="radius" value="0.7"/><bsdf type="roughplastic"/></shape></scene>)";
-}
-
-Image render_xml(const std::string &xml) {
-    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
-    RenderOptions opts;
-    opts.progress = false;
-    return render(*scene, *scene->sensors().at(0), opts).image;
-}
-
-int channel(const Image &img, const std::string &name) {
-    for (size_t i = 0; i < img.channel_names.size(); ++i)
-        if (img.channel_names[i] == name) return int(i);
-    return -1;
 }
 
 } // namespace
