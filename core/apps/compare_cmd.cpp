@@ -3,6 +3,8 @@
 // per pixel, z = |ours - ref| · sqrt(N / max(var, 1e-4)), p = erfc(z / √2), and with the
 // Šidák-corrected level alpha = 1 - 0.99^(1 / pixels) the render agrees when at least 99.75% of
 // the pixel-channels have p > alpha. This file only reads the images and prints the verdict.
+// With --mean-sigmas K it also fails when an image mean (X, Y or Z) differs from the reference's
+// by more than K of its standard errors: a bias over the whole image the per-pixel rule misses.
 // The last line of the output is the verdict:
 //   PASS|FAIL agreeing=<%> required=<%> rel_error=<%> ratio=<mean Y ours / mean Y reference>
 
@@ -15,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <cmath>
 #include <string>
 
 using namespace facet;
@@ -22,6 +25,7 @@ using namespace facet;
 int compare_main(int argc, char **argv) {
     std::string ours_path, mean_path, var_path, z_path;
     int spp = 0;
+    double mean_sigmas = 0.0;
     CLI::App app("Compare a render with a reference mean image and its per-sample XYZ variance",
                  "facet compare");
     app.add_option("ours", ours_path, "The render to check (linear RGB EXR)")->required();
@@ -31,6 +35,10 @@ int compare_main(int argc, char **argv) {
     app.add_option("--spp", spp, "Samples per pixel of the render being checked")
         ->required()
         ->check(CLI::PositiveNumber);
+    app.add_option("--mean-sigmas", mean_sigmas,
+                   "Also fail when an image mean (X, Y or Z) is more than this many standard "
+                   "errors from the reference's (0: no such check)")
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--z-image", z_path, "Write the per-channel z scores (XYZ) to this EXR");
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
 
@@ -40,7 +48,19 @@ int compare_main(int argc, char **argv) {
         {"\"" + ours_path + "\"", "\"" + mean_path + "\"", "\"" + var_path + "\""});
     const size_t pixels = r.pixels;
     const double fraction = r.fraction, brightness = r.brightness_difference();
-    const bool ok = r.passed_rule;
+    auto rel = [&](int k) {
+        return r.mean_ref_xyz[size_t(k)] != 0.0
+                   ? r.mean_ours_xyz[size_t(k)] / r.mean_ref_xyz[size_t(k)] - 1.0
+                   : 0.0;
+    };
+    auto se = [&](int k) {
+        return r.mean_ref_xyz[size_t(k)] != 0.0
+                   ? r.mean_error[size_t(k)] / std::abs(r.mean_ref_xyz[size_t(k)])
+                   : 0.0;
+    };
+    const double sigmas = r.max_mean_sigmas();
+    const bool mean_ok = mean_sigmas <= 0.0 || sigmas <= mean_sigmas; // false for NaN
+    const bool ok = r.passed_rule && mean_ok;
 
     fmt::print("{}x{} pixels, {} spp, alpha = {:.3g} (Sidak over {} pixels)\n", r.width, r.height,
                spp, r.alpha, pixels);
@@ -52,6 +72,13 @@ int compare_main(int argc, char **argv) {
     if (r.non_finite) fmt::print("non-finite values: {}\n", r.non_finite);
     fmt::print("mean brightness (Y): ours {:.6g}, reference {:.6g}, relative difference {:+.3f}%\n",
                r.mean_ours, r.mean_ref, 100.0 * brightness);
+    fmt::print("image mean ours/reference - 1 (X, Y, Z): {:+.3f}%, {:+.3f}%, {:+.3f}%; standard "
+               "error {:.3f}%, {:.3f}%, {:.3f}%; {:.2f} sigma at most",
+               100.0 * rel(0), 100.0 * rel(1), 100.0 * rel(2), 100.0 * se(0), 100.0 * se(1),
+               100.0 * se(2), sigmas);
+    if (mean_sigmas > 0.0)
+        fmt::print(" ({} {:g})", mean_ok ? "within" : "FAILS the bound of", mean_sigmas);
+    fmt::print("\n");
     if (!z_path.empty()) write_image(z_path, r.z);
     // The verdict in one stable line for scripts and test logs: the agreeing fraction and the
     // relative error of the mean (mean brightness ratio - 1).

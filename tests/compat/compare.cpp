@@ -152,7 +152,7 @@ TEST_F(CompareCli, ReferencePlusItsOwnNoiseAgrees) {
             auto rgb = xyz_to_rgb(xyz);
             for (int c = 0; c < 3; ++c) ours.at(x, y, c) = float(rgb[size_t(c)]);
         }
-    Verdict v = compare(write("noisy.exr", ours));
+    Verdict v = compare(write("noisy.exr", ours), "--mean-sigmas 4");
     EXPECT_TRUE(v.pass) << v.out;
     EXPECT_GT(v.agreeing, 99.9) << v.out;
     EXPECT_NEAR(v.ratio, 1.0, 2e-3) << v.out;
@@ -209,4 +209,20 @@ TEST_F(CompareCli, MismatchedSizesAreAnError) {
     std::stringstream ss;
     ss << in.rdbuf();
     EXPECT_NE(ss.str().find("image sizes differ"), std::string::npos) << ss.str();
+}
+
+TEST_F(CompareCli, HalfAPercentBrighterFailsOnlyTheMeanBound) {
+    // 0.5 % brighter everywhere: every pixel is well within its noise at the test spp, but the
+    // image mean is about ten standard errors off (filters-gaussian: 0.036 % at 488 spp).
+    Image ours = m_mean;
+    for (float &value : ours.data) value *= 1.005f;
+    std::string path = write("brighter.exr", ours);
+    Verdict plain = compare(path);
+    EXPECT_TRUE(plain.pass) << plain.out;
+    EXPECT_GT(plain.agreeing, 99.9) << plain.out;
+    Verdict bounded = compare(path, "--mean-sigmas 4");
+    EXPECT_FALSE(bounded.pass) << bounded.out;
+    EXPECT_EQ(bounded.agreeing, plain.agreeing) << bounded.out;
+    EXPECT_NEAR(bounded.rel_error, 0.5, 1e-3) << bounded.out;
+    EXPECT_NE(bounded.out.find("FAILS the bound of 4"), std::string::npos) << bounded.out;
 }

@@ -82,3 +82,32 @@ TEST(PeerComparison, MismatchedImagesAreErrors) {
     EXPECT_THROW(compare_with_reference(grey, ref, var, 16), Error);
     EXPECT_THROW(compare_with_reference(ref, ref, var, 0), Error);
 }
+
+TEST(PeerComparison, ImageMeansAndTheirStandardErrors) {
+    // 10x10 pixels, per-sample variance 0.04 in every channel, 100 spp: each pixel's error is
+    // 0.02, the mean's 0.02 / sqrt(100) = 0.002. A grey offset of 0.005 moves X, Y and Z by
+    // 0.005 times the rows' sums of the RGB to XYZ matrix.
+    Image ours = constant(10, 10, 0.505f, 0.505f, 0.505f), ref = constant(10, 10, 0.5f, 0.5f, 0.5f);
+    Image var = constant(10, 10, 0.04f, 0.04f, 0.04f, "XYZ");
+    PeerComparison r = compare_with_reference(ours, ref, var, 100);
+    const double row[3] = {0.412453 + 0.357580 + 0.180423, 0.212671 + 0.715160 + 0.072169,
+                           0.019334 + 0.119193 + 0.950227};
+    for (size_t k = 0; k < 3; ++k) {
+        EXPECT_NEAR(r.mean_ref_xyz[k], 0.5 * row[k], 1e-6);
+        EXPECT_NEAR(r.mean_ours_xyz[k], 0.505 * row[k], 1e-6);
+        EXPECT_NEAR(r.mean_error[k], 0.002, 1e-9);
+        EXPECT_NEAR(r.mean_sigmas[k], 0.005 * row[k] / 0.002, 1e-3);
+    }
+    EXPECT_NEAR(r.max_mean_sigmas(), 0.005 * row[2] / 0.002, 1e-3);
+    EXPECT_TRUE(r.passed_rule); // z = 0.025 per pixel: only the mean can tell
+
+    // The variance floor of the rule also bounds the standard error from below.
+    PeerComparison f =
+        compare_with_reference(ours, ref, constant(10, 10, 0.f, 0.f, 0.f, "XYZ"), 100);
+    EXPECT_NEAR(f.mean_error[1], std::sqrt(100 * PeerComparison::MinVariance / 100) / 100, 1e-12);
+
+    // A non-finite render has no finite distance from the reference.
+    Image bad = ours;
+    bad.at(3, 3, 1) = std::nanf("");
+    EXPECT_TRUE(std::isnan(compare_with_reference(bad, ref, var, 100).max_mean_sigmas()));
+}

@@ -57,6 +57,7 @@ PeerComparison compare_with_reference(const Image &ours, const Image &mean, cons
     r.z.channel_names = {"X", "Y", "Z"};
 
     double sum_ours = 0.0, sum_ref = 0.0;
+    std::array<double, 3> sum_ours_xyz{0, 0, 0}, sum_ref_xyz{0, 0, 0}, sum_var{0, 0, 0};
     for (int y = 0; y < ours.height; ++y) {
         for (int x = 0; x < ours.width; ++x) {
             auto a = rgb_to_xyz(ours.at(x, y, ours_c[0]), ours.at(x, y, ours_c[1]),
@@ -68,6 +69,9 @@ PeerComparison compare_with_reference(const Image &ours, const Image &mean, cons
             for (int k = 0; k < 3; ++k) {
                 double v =
                     std::max(double(var.at(x, y, var_c[size_t(k)])), PeerComparison::MinVariance);
+                sum_ours_xyz[size_t(k)] += a[size_t(k)];
+                sum_ref_xyz[size_t(k)] += b[size_t(k)];
+                sum_var[size_t(k)] += v;
                 double z = std::abs(a[size_t(k)] - b[size_t(k)]) * std::sqrt(double(spp) / v);
                 r.z.at(x, y, k) = float(z);
                 if (!std::isfinite(z)) {
@@ -82,6 +86,13 @@ PeerComparison compare_with_reference(const Image &ours, const Image &mean, cons
     r.fraction = total ? double(good) / double(total) : 0.0;
     r.mean_ours = r.pixels ? sum_ours / double(r.pixels) : 0.0;
     r.mean_ref = r.pixels ? sum_ref / double(r.pixels) : 0.0;
+    for (size_t k = 0; k < 3 && r.pixels; ++k) {
+        const double n = double(r.pixels);
+        r.mean_ours_xyz[k] = sum_ours_xyz[k] / n;
+        r.mean_ref_xyz[k] = sum_ref_xyz[k] / n;
+        r.mean_error[k] = std::sqrt(sum_var[k] / double(spp)) / n;
+        r.mean_sigmas[k] = (r.mean_ours_xyz[k] - r.mean_ref_xyz[k]) / r.mean_error[k];
+    }
     r.passed_rule = total > 0 && r.fraction >= PeerComparison::PassFraction;
     return r;
 }
