@@ -526,10 +526,12 @@ namespace {
 void check_exr_headers(const std::string &path) {
     std::FILE *f = std::fopen(path.c_str(), "rb");
     if (!f) return; // OpenImageIO reports it
-    std::vector<unsigned char> buf(size_t(1) << 20);
-    size_t n = std::fread(buf.data(), 1, buf.size(), f);
     std::fseek(f, 0, SEEK_END);
     long file_size = std::ftell(f);
+    std::rewind(f);
+    std::vector<unsigned char> buf(
+        std::clamp<size_t>(file_size > 0 ? size_t(file_size) : 0, 8, size_t(1) << 20));
+    size_t n = std::fread(buf.data(), 1, buf.size(), f);
     std::fclose(f);
     if (n < 8 || buf[0] != 0x76 || buf[1] != 0x2f || buf[2] != 0x31 || buf[3] != 0x01) return;
     const bool multipart = (buf[5] & 0x10) != 0; // version field bit 12
@@ -606,17 +608,32 @@ Image read_image(const std::string &path) {
     const int band = spec.tile_width > 0
                          ? std::max(spec.tile_height, 1)
                          : int(std::clamp<size_t>((size_t(1) << 22) / row, 1, 4096));
+    // Scanlines of one type are read in the file's own layout (all channels of spec.format) and
+    // converted here, band by band: asked for any other layout, OpenImageIO converts through a
+    // 64 MB buffer it allocates for every read, however small the image.
+    const bool native_layout = spec.tile_width <= 0 && spec.channelformats.empty();
+    const bool convert_here = native_layout && spec.format != OIIO::TypeDesc::FLOAT;
+    std::vector<unsigned char> native;
     bool ok = true;
     for (int y0 = 0; ok && y0 < spec.height; y0 += band) {
         const int y1 = std::min(spec.height, y0 + std::max(band, 1));
         img.data.resize(size_t(y1) * row);
         float *dst = img.data.data() + size_t(y0) * row;
-        if (spec.tile_width > 0)
+        const size_t values = size_t(y1 - y0) * row;
+        if (spec.tile_width > 0) {
             ok = in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1, spec.z,
                                 spec.z + 1, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, dst);
-        else
+        } else if (convert_here) {
+            native.resize(values * spec.format.size());
             ok = in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0, spec.nchannels,
-                                    OIIO::TypeDesc::FLOAT, dst);
+                                    OIIO::TypeDesc::UNKNOWN, native.data()) &&
+                 OIIO::convert_pixel_values(spec.format, native.data(), OIIO::TypeDesc::FLOAT, dst,
+                                            int(values));
+        } else {
+            ok = in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0, spec.nchannels,
+                                    native_layout ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::FLOAT,
+                                    dst);
+        }
     }
     std::string err = ok ? "" : in->geterror();
     in->close();
