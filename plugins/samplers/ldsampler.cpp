@@ -9,7 +9,7 @@ best stratified. Deterministic for a given `seed`.
 
 | Parameter    | Type    | Default | Description                                         |
 |--------------|---------|---------|-----------------------------------------------------|
-| sample_count | integer | 4       | Samples per pixel; rounded up to a power of two     |
+| sample_count | integer | 4       | Samples per pixel; rounded up to a power of two (at most 2^31) |
 | seed         | integer | 0       | Seed offset of the scrambles and permutations       |
 
 ```xml
@@ -27,7 +27,14 @@ namespace facet {
 
 class LowDiscrepancySampler final : public Sampler {
 public:
-    explicit LowDiscrepancySampler(const Properties &props) : Sampler(props) { round_count(); }
+    explicit LowDiscrepancySampler(const Properties &props) : Sampler(props) {
+        if (m_sample_count > MaxCount)
+            FACET_THROW_AT(props.location("sample_count"),
+                           "ldsampler: sample_count must be at most 2^31 = {} (it is rounded up "
+                           "to a power of two), got {}",
+                           MaxCount, m_sample_count);
+        round_count();
+    }
 
     std::unique_ptr<Sampler> clone() const override {
         return std::make_unique<LowDiscrepancySampler>(*this);
@@ -58,7 +65,14 @@ public:
     }
 
 private:
+    /// The largest power of two of a uint32_t: the rounding of any larger count would overflow.
+    static constexpr uint32_t MaxCount = uint32_t(1) << 31;
+
     void round_count() {
+        if (m_sample_count > MaxCount)
+            FACET_THROW("ldsampler: the sample count must be at most 2^31 = {} (it is rounded up "
+                        "to a power of two), got {}",
+                        MaxCount, m_sample_count);
         uint32_t n = 1;
         while (n < m_sample_count) n <<= 1;
         m_sample_count = n;

@@ -149,6 +149,31 @@ TEST(Samplers, SampleCountRounding) {
     }
 }
 
+// ldsampler rounds up to a power of two in 32 bits: 2^31 is the largest count it can take; a
+// larger one is an error (once the rounding looped forever above 2^31).
+TEST(Samplers, LowDiscrepancyCountLimit) {
+    Properties props("ldsampler");
+    props.set_int("sample_count", int64_t(1) << 31);
+    auto s = PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler, props);
+    EXPECT_EQ(s->sample_count(), uint32_t(1) << 31);
+    auto big = make_sampler("ldsampler", (1 << 30) + 1)->clone();
+    EXPECT_EQ(big->sample_count(), uint32_t(1) << 31);
+    for (int64_t count : {(int64_t(1) << 31) + 1, int64_t(UINT32_MAX)}) {
+        Properties bad("ldsampler");
+        bad.set_int("sample_count", count);
+        try {
+            PluginRegistry::instance().create(ObjectType::Sampler, bad);
+            ADD_FAILURE() << "sample_count " << count << " was accepted";
+        } catch (const Error &e) {
+            EXPECT_NE(std::string(e.what()).find("at most 2^31"), std::string::npos) << e.what();
+        }
+        // The same limit when the render loop sets the count.
+        auto clone = make_sampler("ldsampler", 4)->clone();
+        clone->set_sample_count(uint32_t(count));
+        EXPECT_THROW(clone->seed(0), Error);
+    }
+}
+
 TEST(Samplers, MultijitterStratifiesGridAndProjections) {
     const int n = 24; // a 4 x 6 grid
     auto s = make_sampler("multijitter", n)->clone();
