@@ -165,6 +165,12 @@ void Mesh::build_face_table() {
         const Vector3f dp0 = p1 - p0, dp1 = p2 - p0;
         Normal3f n = cross(dp0, dp1);
         float n_len = norm(n);
+        if (!std::isfinite(n_len)) {
+            // The cross product of a huge face overflows in float: take it in double.
+            const Vector3d nd = cross(Vector3d(dp0), Vector3d(dp1));
+            n = Normal3f(nd / norm(nd));
+            n_len = 1.f;
+        }
         if (!(n_len > 0.f)) { // a degenerate face has no normal of its own: per hit
             m_face_table.clear();
             return;
