@@ -57,12 +57,12 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
     if (filter.is_box() && fp.nx <= 2 && fp.ny <= 2) {
         // A radius of 0.5 reaches at most two pixels per axis: the same weights as the loops
         // below, without a virtual call per pixel (nor the loops' vectorised set-up).
-        fp.sum_x = m_wx[0] = ReconstructionFilter::box_eval(px - float(fp.x0));
+        fp.sum_x = m_wx[0] = ReconstructionFilter::box_eval(px - float(fp.ox + fp.x0));
         if (fp.nx == 2)
-            fp.sum_x += (m_wx[1] = ReconstructionFilter::box_eval(px - float(fp.x0 + 1)));
-        fp.sum_y = m_wy[0] = ReconstructionFilter::box_eval(py - float(fp.y0));
+            fp.sum_x += (m_wx[1] = ReconstructionFilter::box_eval(px - float(fp.ox + fp.x0 + 1)));
+        fp.sum_y = m_wy[0] = ReconstructionFilter::box_eval(py - float(fp.oy + fp.y0));
         if (fp.ny == 2)
-            fp.sum_y += (m_wy[1] = ReconstructionFilter::box_eval(py - float(fp.y0 + 1)));
+            fp.sum_y += (m_wy[1] = ReconstructionFilter::box_eval(py - float(fp.oy + fp.y0 + 1)));
         return true;
     }
     for (size_t i = 0; i < fp.nx; ++i)
