@@ -5,15 +5,42 @@
 /// Warps from the unit square to other domains, each with the density of what it produces.
 namespace facet::warp {
 
-Point2f square_to_uniform_disk_concentric(const Point2f &u);
+// The warps of diffuse reflection and of triangle lights are inline: they run several times per
+// path vertex.
+
+inline Point2f square_to_uniform_disk_concentric(const Point2f &u) {
+    // Shirley and Chiu's concentric map, in the branch-light form of Shirley's 2011 note.
+    float x = 2.f * u.x - 1.f, y = 2.f * u.y - 1.f;
+    if (x == 0.f && y == 0.f) return {0.f, 0.f};
+    float r, phi;
+    if (std::abs(x) > std::abs(y)) {
+        r = x;
+        phi = (Pi / 4.f) * (y / x);
+    } else {
+        r = y;
+        phi = (Pi / 2.f) - (Pi / 4.f) * (x / y);
+    }
+    return {r * std::cos(phi), r * std::sin(phi)};
+}
 float square_to_uniform_disk_concentric_pdf(const Point2f &p);
-Point2f square_to_uniform_triangle(const Point2f &u); ///< barycentric (b1, b2)
+/// Barycentric (b1, b2), uniform over the triangle.
+inline Point2f square_to_uniform_triangle(const Point2f &u) {
+    float t = safe_sqrt(1.f - u.x);
+    return {1.f - t, t * u.y};
+}
 Vector3f square_to_uniform_sphere(const Point2f &u);
 float square_to_uniform_sphere_pdf(const Vector3f &v);
 Vector3f square_to_uniform_hemisphere(const Point2f &u);
 float square_to_uniform_hemisphere_pdf(const Vector3f &v);
-Vector3f square_to_cosine_hemisphere(const Point2f &u);
-float square_to_cosine_hemisphere_pdf(const Vector3f &v);
+inline Vector3f square_to_cosine_hemisphere(const Point2f &u) {
+    // Malley's method: project the uniform disk up to the hemisphere.
+    Point2f p = square_to_uniform_disk_concentric(u);
+    float z = safe_sqrt(1.f - p.x * p.x - p.y * p.y);
+    return {p.x, p.y, z};
+}
+inline float square_to_cosine_hemisphere_pdf(const Vector3f &v) {
+    return v.z >= 0.f ? v.z * InvPi : 0.f;
+}
 /// Uniform direction inside the cone of directions with cos θ >= cos_cutoff around +Z.
 Vector3f square_to_uniform_cone(const Point2f &u, float cos_cutoff);
 float square_to_uniform_cone_pdf(const Vector3f &v, float cos_cutoff);
