@@ -359,8 +359,9 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     const EmitterEntry &entry = m_emitter_table[index];
 
     if (entry.mesh) {
-        // A triangle light: a point uniform in area on the mesh (no virtual call).
-        static_cast<PositionSample &>(ds) = entry.mesh->Mesh::sample_position(u);
+        // A triangle light: a point uniform in area on the mesh (inline, no virtual call; the
+        // table holds only meshes with area).
+        entry.mesh->sample_point(u, ds);
         ds.d = ds.p - ref.p;
         ds.dist = norm(ds.d);
         if (!(ds.dist > 0.f)) return result;

@@ -2,7 +2,9 @@
 
 #include <facet/shape.h>
 #include <facet/transform.h>
+#include <facet/warp.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,10 @@ public:
     void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
                                      const Point2f &uv, SurfaceInteraction &si) const override;
     PositionSample sample_position(const Point2f &u) const override;
+    /// sample_position() written into `ps` (p, n, uv, pdf and delta), inline for the triangle
+    /// lights of Scene::sample_emitter_direction(). Only for a mesh with area (surface_area() >
+    /// 0): sample_position() checks it.
+    void sample_point(Point2f u, PositionSample &ps) const;
     bool is_mesh() const override { return true; }
     std::string to_string() const override;
 
@@ -95,5 +101,35 @@ private:
     float m_area = 0.f;
     BoundingBox3f m_bbox;
 };
+
+inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
+    // Pick a triangle in proportion to its area and reuse the sample within its interval.
+    size_t f =
+        size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) - m_area_cdf.begin());
+    f = std::min(f, m_area_cdf.size() - 1);
+    const float lo = f > 0 ? m_area_cdf[f - 1] : 0.f, hi = m_area_cdf[f];
+    u.x = hi > lo ? clamp((u.x - lo) / (hi - lo), 0.f, OneMinusEpsilon) : 0.f;
+
+    const uint32_t i0 = m_faces[3 * f], i1 = m_faces[3 * f + 1], i2 = m_faces[3 * f + 2];
+    const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
+    const Point2f b = warp::square_to_uniform_triangle(u);
+    const float b0 = 1.f - b.x - b.y;
+    ps.p = p0 * b0 + p1 * b.x + p2 * b.y;
+    if (!m_face_table.empty()) {
+        const float *t = &m_face_table[9 * f];
+        ps.n = Normal3f(t[0], t[1], t[2]);
+    } else {
+        Normal3f n = normalize(cross(p1 - p0, p2 - p0));
+        ps.n = m_flip_normals ? -n : n;
+    }
+    if (has_uvs())
+        ps.uv = Point2f(m_uvs[2 * i0], m_uvs[2 * i0 + 1]) * b0 +
+                Point2f(m_uvs[2 * i1], m_uvs[2 * i1 + 1]) * b.x +
+                Point2f(m_uvs[2 * i2], m_uvs[2 * i2 + 1]) * b.y;
+    else
+        ps.uv = b;
+    ps.pdf = 1.f / m_area;
+    ps.delta = false;
+}
 
 } // namespace facet
