@@ -1,6 +1,7 @@
 #include <facet/film.h>
 #include <facet/plugin.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace facet {
@@ -72,28 +73,63 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
     return true;
 }
 
+namespace {
+
+/// floor() and ceil() of a float well inside the int range (|v| < 2^30), as ints.
+inline int floor_to_int(float v) {
+    const int i = int(v); // towards zero
+    return float(i) > v ? i - 1 : i;
+}
+inline int ceil_to_int(float v) {
+    const int i = int(v);
+    return float(i) < v ? i + 1 : i;
+}
+
+/// Adds a sample of weight w to pixel p: r, g, b, the AOVs (when given), then the weight.
+inline void add_sample(float *p, float w, const Color3f &L, const float *aovs, int aov_count) {
+    p[0] += w * L.r;
+    p[1] += w * L.g;
+    p[2] += w * L.b;
+    if (aovs)
+        for (int k = 0; k < aov_count; ++k) p[3 + k] += w * aovs[k];
+    p[3 + aov_count] += w;
+}
+
+} // namespace
+
 void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
                      const ReconstructionFilter &filter) {
+    const Point2i s = storage_size();
+    const int nc = channel_count();
+    if (filter.is_box() && std::abs(pos.x) < 1e9f && std::abs(pos.y) < 1e9f) {
+        // The box (radius 0.5) reaches at most two pixels per axis: footprint()'s pixels and
+        // weights, computed in place without its tables (the same floats, so the same sums).
+        const float px = pos.x - 0.5f, py = pos.y - 0.5f;
+        const int ox = m_offset.x - m_border, oy = m_offset.y - m_border;
+        const int x0 = std::max(0, ceil_to_int(px - 0.5f) - ox);
+        const int x1 = std::min(s.x - 1, floor_to_int(px + 0.5f) - ox);
+        const int y0 = std::max(0, ceil_to_int(py - 0.5f) - oy);
+        const int y1 = std::min(s.y - 1, floor_to_int(py + 0.5f) - oy);
+        for (int y = y0; y <= y1; ++y) {
+            const float wy = ReconstructionFilter::box_eval(py - float(oy + y));
+            if (wy == 0.f) continue;
+            float *row = m_data.data() + size_t(y) * size_t(s.x) * nc;
+            for (int x = x0; x <= x1; ++x) {
+                const float w = ReconstructionFilter::box_eval(px - float(ox + x)) * wy;
+                if (w != 0.f) add_sample(row + size_t(x) * nc, w, L, aovs, m_aov_count);
+            }
+        }
+        return;
+    }
     Footprint fp;
     if (!footprint(pos, filter, fp)) return;
-    const Point2i s = storage_size();
-    const size_t nx = fp.nx, ny = fp.ny;
-    const int x0 = fp.x0, y0 = fp.y0;
-    const int nc = channel_count();
-    for (size_t j = 0; j < ny; ++j) {
+    for (size_t j = 0; j < fp.ny; ++j) {
         const float wy = m_wy[j];
         if (wy == 0.f) continue;
-        float *row = m_data.data() + (size_t(y0) + j) * size_t(s.x) * nc;
-        for (size_t i = 0; i < nx; ++i) {
+        float *row = m_data.data() + (size_t(fp.y0) + j) * size_t(s.x) * nc;
+        for (size_t i = 0; i < fp.nx; ++i) {
             const float w = m_wx[i] * wy;
-            if (w == 0.f) continue;
-            float *p = row + (size_t(x0) + i) * nc;
-            p[0] += w * L.r;
-            p[1] += w * L.g;
-            p[2] += w * L.b;
-            if (aovs)
-                for (int k = 0; k < m_aov_count; ++k) p[3 + k] += w * aovs[k];
-            p[nc - 1] += w;
+            if (w != 0.f) add_sample(row + (size_t(fp.x0) + i) * nc, w, L, aovs, m_aov_count);
         }
     }
 }
