@@ -8,7 +8,7 @@ stratum. Deterministic for a given `seed`.
 
 | Parameter    | Type    | Default | Description                                             |
 |--------------|---------|---------|---------------------------------------------------------|
-| sample_count | integer | 4       | Samples per pixel; rounded up to the next square number |
+| sample_count | integer | 4       | Samples per pixel; rounded up to the next square number (at most 65535²) |
 | seed         | integer | 0       | Seed offset of the random permutations and jitter       |
 | jitter       | boolean | true    | Jitter inside each stratum (false: stratum centres)     |
 
@@ -31,6 +31,11 @@ class StratifiedSampler final : public Sampler {
 public:
     explicit StratifiedSampler(const Properties &props) : Sampler(props) {
         m_jitter = props.get_bool("jitter", true);
+        if (m_sample_count > MaxCount)
+            FACET_THROW_AT(props.location("sample_count"),
+                           "stratified: sample_count must be at most 65535^2 = {} (it is rounded "
+                           "up to a square), got {}",
+                           MaxCount, m_sample_count);
         update_resolution();
     }
 
@@ -67,7 +72,14 @@ public:
     }
 
 private:
+    /// The largest square of a uint32_t: a larger count would round up to 65536^2 = 2^32.
+    static constexpr uint32_t MaxCount = 65535u * 65535u;
+
     void update_resolution() {
+        if (m_sample_count > MaxCount)
+            FACET_THROW("stratified: the sample count must be at most 65535^2 = {} (it is rounded "
+                        "up to a square), got {}",
+                        MaxCount, m_sample_count);
         m_resolution = uint32_t(std::ceil(std::sqrt(double(m_sample_count)) - 1e-9));
         m_sample_count = m_resolution * m_resolution;
     }

@@ -13,7 +13,7 @@ using namespace facet;
 
 namespace {
 
-std::shared_ptr<Sampler> make_sampler(const std::string &type, int spp) {
+std::shared_ptr<Sampler> make_sampler(const std::string &type, int64_t spp) {
     Properties props(type);
     props.set_int("sample_count", spp);
     return PluginRegistry::instance().create_as<Sampler>(ObjectType::Sampler, props);
@@ -172,6 +172,41 @@ TEST(Samplers, LowDiscrepancyCountLimit) {
         clone->set_sample_count(uint32_t(count));
         EXPECT_THROW(clone->seed(0), Error);
     }
+}
+
+// The sample counts near 2^32: stratified rounds up to a square in 32 bits, so 65535^2 is the
+// largest count it can take and a larger one is an error (it once wrapped to 0 and took `% 0`);
+// orthogonal's prime square must fit too; multijitter takes any count.
+TEST(Samplers, HugeSampleCounts) {
+    const uint32_t max_square = 65535u * 65535u;
+    auto s = make_sampler("stratified", max_square)->clone();
+    EXPECT_EQ(s->sample_count(), max_square);
+    s->seed(3);
+    Point2f p = s->next_2d();
+    EXPECT_TRUE(p.x >= 0.f && p.x < 1.f && p.y >= 0.f && p.y < 1.f);
+    for (int64_t count : {int64_t(max_square) + 1, int64_t(UINT32_MAX)}) {
+        Properties bad("stratified");
+        bad.set_int("sample_count", count);
+        try {
+            PluginRegistry::instance().create(ObjectType::Sampler, bad);
+            ADD_FAILURE() << "stratified sample_count " << count << " was accepted";
+        } catch (const Error &e) {
+            EXPECT_NE(std::string(e.what()).find("at most 65535^2"), std::string::npos) << e.what();
+        }
+        auto clone = make_sampler("stratified", 4)->clone();
+        clone->set_sample_count(uint32_t(count));
+        EXPECT_THROW(clone->seed(0), Error);
+    }
+    // 65521 is the largest prime below 2^16: a larger count needs 65537^2 > 2^32 rows.
+    EXPECT_EQ(make_sampler("orthogonal", 65521u * 65521u)->sample_count(), 65521u * 65521u);
+    Properties ortho("orthogonal");
+    ortho.set_int("sample_count", int64_t(65521u) * 65521u + 1);
+    EXPECT_THROW(PluginRegistry::instance().create(ObjectType::Sampler, ortho), Error);
+    auto mj = make_sampler("multijitter", UINT32_MAX)->clone();
+    EXPECT_EQ(mj->sample_count(), UINT32_MAX);
+    mj->seed(5);
+    p = mj->next_2d();
+    EXPECT_TRUE(p.x >= 0.f && p.x < 1.f && p.y >= 0.f && p.y < 1.f);
 }
 
 TEST(Samplers, MultijitterStratifiesGridAndProjections) {
