@@ -258,10 +258,10 @@ TEST(Warp, UniformDiskConcentric) {
 
 TEST(Warp, UniformTriangle) {
     // Exact cell integrals: the grid's diagonal cells are half inside.
-    const int n = 20;
+    constexpr int n = 20;
     HistogramTest t{n, n, 0, 1, 0, 1, 1};
     t.run(
-        [n](double x, double y) {
+        [](double x, double y) {
             int i = int(x * n), j = int(y * n);
             return i + j < n - 1 ? 2.0 : (i + j == n - 1 ? 1.0 : 0.0);
         },
