@@ -21,3 +21,11 @@ def cornell():
 def facet_cli():
     assert FACET_CLI.exists(), f"{FACET_CLI} is missing: build the facet command first"
     return FACET_CLI
+
+
+@pytest.fixture
+def cli_env():
+    """The environment of a facet command the tests start: this one without LD_PRELOAD. The
+    sanitizer build preloads AddressSanitizer's shared runtime into the interpreter
+    (python/CMakeLists.txt); the command links its own, and ASan refuses two in one process."""
+    return {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}

@@ -14,7 +14,7 @@ import facet
 SMALL = dict(res=48, spp=8, max_depth=4)
 
 
-def test_render_matches_cli_exr(cornell, facet_cli, tmp_path):
+def test_render_matches_cli_exr(cornell, facet_cli, cli_env, tmp_path):
     """The array facet.render returns is the image `facet render` writes: same pixels after the
     film's float16 rounding, same channels."""
     scene = facet.load_file(cornell, **SMALL)
@@ -28,7 +28,7 @@ def test_render_matches_cli_exr(cornell, facet_cli, tmp_path):
     out = tmp_path / "cli.exr"
     cmd = [str(facet_cli), "render", str(cornell), "-q", "--seed", "3", "-t", "1", "-o", str(out)]
     cmd += [f"-D{k}={v}" for k, v in SMALL.items()]
-    subprocess.run(cmd, check=True)
+    subprocess.run(cmd, check=True, env=cli_env)
     cli_pixels, cli_channels = facet.read(out)
     assert cli_channels == channels
     assert np.array_equal(pixels.astype(np.float16).astype(np.float32), cli_pixels)

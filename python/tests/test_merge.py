@@ -25,7 +25,7 @@ def test_crop_is_the_same_pixels(scene):
     assert crop.metadata["facet:crop"] == "5 7 30 21"
 
 
-def test_merge_crops_is_bit_identical(scene, cornell, facet_cli, tmp_path):
+def test_merge_crops_is_bit_identical(scene, cornell, facet_cli, cli_env, tmp_path):
     full = facet.render(scene, seed=1)
     parts = [facet.render(scene, seed=1, crop=c) for c in
              [(0, 0, 40, 13), (0, 13, 11, 40), (11, 13, 40, 40)]]
@@ -38,7 +38,7 @@ def test_merge_crops_is_bit_identical(scene, cornell, facet_cli, tmp_path):
     cli_part = tmp_path / "top.exr"
     cmd = [str(facet_cli), "render", str(cornell), "-q", "--seed", "1", "--crop", "0", "0", "40",
            "13", "-o", str(cli_part)] + [f"-D{k}={v}" for k, v in SMALL.items()]
-    subprocess.run(cmd, check=True)
+    subprocess.run(cmd, check=True, env=cli_env)
     assert facet.read(cli_part)[0].shape == (13, 40, 3)
     mixed = facet.merge([str(cli_part), parts[1], parts[2]])
     half = full.pixels.astype(np.float16).astype(np.float32)
