@@ -43,16 +43,56 @@ are skipped with a warning.
 #include <facet/plugin.h>
 #include <facet/resolver.h>
 
+#include <sys/mman.h>
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
+#include <string_view>
+#include <unistd.h>
 
 namespace facet {
 
 namespace {
+
+/// A regular file's bytes mapped read-only: the parser reads them where the page cache holds
+/// them, without copying the file into memory first. Empty when the file cannot be mapped
+/// (missing, not a regular file, empty): the caller then reads it with read_file(), which says
+/// why it cannot. The file must not be truncated while it is mapped (the mapping is released
+/// before the constructor returns).
+class MappedFile {
+public:
+    explicit MappedFile(const std::string &path) {
+        const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) return;
+        struct stat st;
+        if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+            void *p =
+                ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+            if (p != MAP_FAILED) {
+                m_data = static_cast<const char *>(p);
+                m_size = size_t(st.st_size);
+            }
+        }
+        ::close(fd);
+    }
+    ~MappedFile() {
+        if (m_data) ::munmap(const_cast<char *>(m_data), m_size);
+    }
+    MappedFile(const MappedFile &) = delete;
+    MappedFile &operator=(const MappedFile &) = delete;
+    bool mapped() const { return m_data != nullptr; }
+    std::string_view view() const { return {m_data, m_size}; }
+
+private:
+    const char *m_data = nullptr;
+    size_t m_size = 0;
+};
 
 enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
 
@@ -242,8 +282,16 @@ public:
         Transform to_world = props.get_transform("to_world", Transform());
         m_name = filename;
 
-        std::string data = read_file(file_resolver().resolve(filename), "ply");
-        load(filename, data, flip_tex_coords);
+        const std::string path = file_resolver().resolve(filename);
+        {
+            MappedFile file(path);
+            if (file.mapped()) {
+                load(filename, file.view(), flip_tex_coords);
+            } else {
+                const std::string data = read_file(path, "ply");
+                load(filename, data, flip_tex_coords);
+            }
+        }
         initialize(to_world, face_normals, flip_normals);
         if (!face_normals && !has_vertex_normals()) recompute_vertex_normals();
         FACET_LOG(Debug, "ply: \"{}\": {} vertices, {} triangles", filename, vertex_count(),
@@ -251,14 +299,14 @@ public:
     }
 
 private:
-    void load(const std::string &name, const std::string &data, bool flip_tex_coords) {
+    void load(const std::string &name, std::string_view data, bool flip_tex_coords) {
         // --- Header --------------------------------------------------------------------------
         size_t pos = 0, line_no = 0;
         auto next_line = [&](std::string &line) {
             if (pos >= data.size()) FACET_THROW("{}: the header ends without end_header", name);
             size_t eol = data.find('\n', pos);
-            if (eol == std::string::npos) eol = data.size();
-            line = data.substr(pos, eol - pos);
+            if (eol == std::string_view::npos) eol = data.size();
+            line.assign(data.substr(pos, eol - pos));
             if (!line.empty() && line.back() == '\r') line.pop_back();
             pos = eol + 1;
             ++line_no;
@@ -545,6 +593,8 @@ private:
         // check_count() bounds n by the file size, so 3 n cannot wrap; the limit still applies.
         size_t n = el.count;
         allocation_bytes(n, 3 * sizeof(float), m_name, "vertex positions");
+        // initialize() appends a float of padding for Embree: room for it now, not a copy then.
+        m_positions.reserve(3 * n + 1);
         m_positions.resize(3 * n);
         if (normals) m_normals.resize(3 * n);
         if (uvs) m_uvs.resize(2 * n);
