@@ -601,24 +601,46 @@ private:
         for (AttributeGroup &g : groups) g.data.reserve(g.props.size() * n);
         std::vector<double> values(el.props.size(), 0.0);
         double sv[8] = {};
-        // The common binary layout, floats only in the machine's byte order, is copied a
-        // vertex at a time (the general reader below decodes value by value).
+        // The common binary layout, floats only in the machine's byte order, is copied from the
+        // file's rows straight into the arrays (the general reader below decodes value by value).
         const bool raw_floats =
             reader.is_native_binary() &&
             std::all_of(el.props.begin(), el.props.end(), [](const PlyProperty &p) {
                 return !p.is_list && p.type == PlyType::Float32;
             });
-        const size_t stride = el.props.size() * sizeof(float);
-        for (size_t v = 0; v < n; ++v) {
-            if (raw_floats) {
-                const char *row = reader.take(stride, "a vertex");
-                for (size_t i = 0; i < el.props.size(); ++i) {
-                    float f;
-                    std::memcpy(&f, row + i * sizeof(float), sizeof(float));
-                    values[i] = f;
-                    if (slot[i] >= 0) sv[slot[i]] = f;
+        if (raw_floats) {
+            // check_count() made sure the file holds n rows of `stride` bytes.
+            const size_t stride = el.props.size() * sizeof(float);
+            const char *rows = reader.take(n * stride, "the vertices");
+            // The byte offset in a row of each slot's float (the last property of a name wins,
+            // as in the general reader).
+            size_t offset[8] = {};
+            for (size_t i = 0; i < el.props.size(); ++i)
+                if (slot[i] >= 0) offset[slot[i]] = i * sizeof(float);
+            auto get = [](const char *p) {
+                float f;
+                std::memcpy(&f, p, sizeof(float));
+                return f;
+            };
+            for (size_t v = 0; v < n; ++v) {
+                const char *row = rows + v * stride;
+                for (int k = 0; k < 3; ++k) m_positions[3 * v + k] = get(row + offset[k]);
+                if (normals)
+                    for (int k = 0; k < 3; ++k) m_normals[3 * v + k] = get(row + offset[3 + k]);
+                if (uvs) {
+                    m_uvs[2 * v] = get(row + offset[6]);
+                    const float t = get(row + offset[7]);
+                    m_uvs[2 * v + 1] = flip_tex_coords ? 1.f - t : t;
                 }
-            } else {
+                for (AttributeGroup &g : groups)
+                    for (size_t i : g.props) g.data.push_back(get(row + i * sizeof(float)));
+            }
+            for (AttributeGroup &g : groups)
+                add_attribute(g.name, uint32_t(g.props.size()), std::move(g.data));
+            return;
+        }
+        for (size_t v = 0; v < n; ++v) {
+            {
                 for (size_t i = 0; i < el.props.size(); ++i) {
                     if (el.props[i].is_list)
                         skip(el.props[i], reader);
@@ -641,6 +663,43 @@ private:
         }
         for (AttributeGroup &g : groups)
             add_attribute(g.name, uint32_t(g.props.size()), std::move(g.data));
+    }
+
+    /// Faces of the common binary layout (a uchar count and 32-bit indices in the machine's byte
+    /// order, nothing else) written straight into m_faces, triangles as they are and polygons
+    /// as fans. The checks are those of the general reader in read_faces().
+    void read_raw_faces(size_t count, bool signed_indices, PlyReader &reader) {
+        // A triangle per face to begin with (check_count() bounded the count by the file);
+        // polygons with more corners grow the array.
+        m_faces.resize(3 * count);
+        size_t out = 0;
+        auto bad_index = [&](size_t f, uint32_t index) {
+            if (signed_indices && int32_t(index) < 0)
+                FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f,
+                            int32_t(index));
+            FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f, index);
+        };
+        // A negative int32 index reads as a huge uint32: out of range in initialize().
+        const uint32_t limit = signed_indices ? 0x7fffffffu : 0xfffffffeu;
+        uint32_t polygon[255];
+        for (size_t f = 0; f < count; ++f) {
+            const size_t corners = size_t(uint8_t(*reader.take(1, "a face's vertex count")));
+            if (corners < 3)
+                FACET_THROW("{}: face {} has {} vertices (at least 3 needed)", reader.where(), f,
+                            corners);
+            const char *idx = reader.take(corners * sizeof(uint32_t), "a vertex index");
+            std::memcpy(polygon, idx, corners * sizeof(uint32_t));
+            for (size_t k = 0; k < corners; ++k)
+                if (polygon[k] > limit) bad_index(f, polygon[k]);
+            const size_t need = out + 3 * (corners - 2);
+            if (need > m_faces.size()) m_faces.resize(std::max(need, 2 * m_faces.size()));
+            for (size_t k = 1; k + 1 < corners; ++k) {
+                m_faces[out++] = polygon[0];
+                m_faces[out++] = polygon[k];
+                m_faces[out++] = polygon[k + 1];
+            }
+        }
+        m_faces.resize(out);
     }
 
     void read_faces(const PlyElement &el, PlyReader &reader) {
@@ -669,27 +728,12 @@ private:
         const bool raw_indices = reader.is_native_binary() && el.props.size() == 1 &&
                                  el.props[0].count_type == PlyType::UInt8 &&
                                  (index_type == PlyType::Int32 || index_type == PlyType::UInt32);
+        if (raw_indices) {
+            read_raw_faces(el.count, index_type == PlyType::Int32, reader);
+            return;
+        }
         for (size_t f = 0; f < el.count; ++f) {
-            if (raw_indices) {
-                const size_t count = size_t(uint8_t(*reader.take(1, "a face's vertex count")));
-                if (count < 3)
-                    FACET_THROW("{}: face {} has {} vertices (at least 3 needed)", reader.where(),
-                                f, count);
-                const char *idx = reader.take(count * sizeof(uint32_t), "a vertex index");
-                polygon.resize(count);
-                std::memcpy(polygon.data(), idx, count * sizeof(uint32_t));
-                // A negative int32 index reads as a huge uint32: out of range below.
-                if (index_type == PlyType::Int32)
-                    for (size_t k = 0; k < count; ++k)
-                        if (int32_t(polygon[k]) < 0)
-                            FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f,
-                                        int32_t(polygon[k]));
-                for (size_t k = 0; k < count; ++k)
-                    if (polygon[k] == 4294967295u)
-                        FACET_THROW("{}: face {} has a bad vertex index {}", reader.where(), f,
-                                    polygon[k]);
-            }
-            for (size_t i = 0; !raw_indices && i < el.props.size(); ++i) {
+            for (size_t i = 0; i < el.props.size(); ++i) {
                 const auto &prop = el.props[i];
                 if (int(i) != list) {
                     if (prop.is_list)
