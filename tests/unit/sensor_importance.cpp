@@ -61,15 +61,23 @@ void expect_round_trip(const Sensor &cam, bool aperture) {
 
 /// ∫ We cos θ dω over all directions (points at unit distance, uniform on the sphere) is one:
 /// the importance of the whole film is normalised. sample_direction returns We cos θ / dist².
+/// The directions come from a jittered 632 x 632 grid on the square (square_to_uniform_sphere
+/// keeps areas, so every stratum is the same solid angle), the two jitters drawn in a set order:
+/// 400,000 independent directions scattered the estimate by about 0.005 from seed to seed, and
+/// `Point2f(rng.next_float(), rng.next_float())` drew x and y in a compiler's order.
 double importance_integral(const Sensor &cam, const Point3f &centre) {
     PCG32 rng(7);
-    const int n = 400000;
+    const int n = 632;
     double sum = 0.0;
-    for (int i = 0; i < n; ++i) {
-        Vector3f d = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
-        sum += cam.sample_direction(point(centre + d), Point2f(0.5f)).second.g;
-    }
-    return sum * 4.0 * Pi / n;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const float ju = rng.next_float();
+            const float jv = rng.next_float();
+            const Point2f u((float(i) + ju) / float(n), (float(j) + jv) / float(n));
+            Vector3f d = warp::square_to_uniform_sphere(u);
+            sum += cam.sample_direction(point(centre + d), Point2f(0.5f)).second.g;
+        }
+    return sum * 4.0 * Pi / (double(n) * double(n));
 }
 
 /// A sensor that implements only sample_ray (as measurement sensors may).
@@ -113,7 +121,7 @@ TEST(SensorImportance, PerspectiveClosedForm) {
 
 TEST(SensorImportance, PerspectiveIntegratesToOne) {
     auto cam = make_sensor("perspective", LOOK, {{"fov", 70.0}});
-    EXPECT_NEAR(importance_integral(*cam, Point3f(1, 2, 3)), 1.0, 0.01);
+    EXPECT_NEAR(importance_integral(*cam, Point3f(1, 2, 3)), 1.0, 0.005);
 }
 
 TEST(SensorImportance, ThinLensRoundTripAndClosedForm) {
