@@ -191,7 +191,9 @@ EmbreeLoop embree_loop(const Scene &scene, const std::vector<Hit> &hits, uint64_
                     uint64_t end = std::min(count, (chunk + 1) * Chunk);
                     for (uint64_t i = chunk * Chunk; i < end; ++i) {
                         const Hit &hit = hits[rng.next_uint32(uint32_t(hits.size()))];
-                        Point2f u(rng.next_float(), rng.next_float());
+                        const float ux = rng.next_float(); // one draw per statement: a set
+                        const float uy = rng.next_float(); // order whatever the compiler
+                        Point2f u(ux, uy);
                         Vector3f d = Frame(hit.n).to_world(warp::square_to_cosine_hemisphere(u));
                         Interaction it;
                         it.p = hit.p;

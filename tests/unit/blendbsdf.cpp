@@ -3,6 +3,7 @@
 // chi-square.
 
 #include "bsdf_checks.h"
+#include "draws.h"
 
 #include <facet/texture.h>
 #include <facet/xml.h>
@@ -68,7 +69,7 @@ TEST(BlendBSDF, ExtremeWeightsSelectOneBSDF) {
             EXPECT_EQ(bsdf->eval(BSDFContext(), si, wo), only->eval(BSDFContext(), si, wo));
             EXPECT_EQ(bsdf->pdf(BSDFContext(), si, wo), only->pdf(BSDFContext(), si, wo));
             float s1 = rng.next_float();
-            Point2f s2(rng.next_float(), rng.next_float());
+            Point2f s2 = next_point2f(rng);
             auto [bs, weight] = bsdf->sample(BSDFContext(), si, s1, s2);
             auto [bs_o, weight_o] = only->sample(BSDFContext(), si, s1, s2);
             EXPECT_EQ(bs.wo, bs_o.wo);

@@ -4,6 +4,8 @@
 // parameters, error messages, eval/pdf/sample consistency and energy (white furnace). Chi-square
 // tests are lines of tests/chi2/configs.txt, not GoogleTest cases.
 
+#include "draws.h"
+
 #include <facet/bsdf.h>
 #include <facet/chi2.h> // direction_from_angles
 #include <facet/plugin.h>
@@ -98,15 +100,6 @@ inline SurfaceInteraction make_si(const Vector3f &wi) {
     return si;
 }
 
-/// Two draws as a point, x first. The order matters: in Point2f(rng.next_float(),
-/// rng.next_float()) it is unspecified (g++ evaluates right to left, clang left to right), so
-/// a test would see different numbers with each compiler.
-inline Point2f next_point2f(PCG32 &rng) {
-    float x = rng.next_float();
-    float y = rng.next_float();
-    return Point2f(x, y);
-}
-
 /// Uniform direction on the sphere, or on the upper hemisphere; kept away from the horizon
 /// (|cos θ| >= 1e-2), where float results are legitimately fragile.
 inline Vector3f random_direction(PCG32 &rng, bool upper_only) {
@@ -181,7 +174,7 @@ inline Color3f furnace(const BSDF &bsdf, const BSDFContext &ctx, const Vector3f 
     double sum[3] = {0, 0, 0};
     for (int i = 0; i < count; ++i) {
         float s1 = rng.next_float();
-        Point2f s2(rng.next_float(), rng.next_float());
+        Point2f s2 = next_point2f(rng);
         auto [bs, weight] = bsdf.sample(ctx, si, s1, s2);
         float scale = ctx.mode == TransportMode::Radiance ? bs.eta * bs.eta : 1.f;
         for (int c = 0; c < 3; ++c) sum[c] += double(weight[c]) * scale;

@@ -2,6 +2,8 @@
 // dp/du, dp/dv), the open ends, flip_normals, to_world (rigid, scaled along the axis, and
 // scaled unevenly across it as Mitsuba allows), position sampling, and the chi-square test of
 // an area light on it.
+#include "draws.h"
+
 #include <facet/chi2.h>
 #include <facet/interaction.h>
 #include <facet/logger.h>
@@ -252,7 +254,7 @@ TEST(Cylinder, PositionSamplesLieOnTheSurfaceWithUniformPdf) {
     double mean_along = 0.0;
     const int n = 20000;
     for (int i = 0; i < n; ++i) {
-        PositionSample ps = cyl->sample_position(Point2f(rng.next_float(), rng.next_float()));
+        PositionSample ps = cyl->sample_position(next_point2f(rng));
         const float along = dot(ps.p, axis);
         const Vector3f radial = ps.p - axis * along;
         EXPECT_NEAR(norm(radial), 0.3f, 1e-5f);

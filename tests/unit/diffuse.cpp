@@ -2,6 +2,7 @@
 // (its chi-square tests are lines of tests/chi2/configs.txt).
 
 #include "bsdf_checks.h"
+#include "draws.h"
 
 #include <facet/bsdf.h>
 #include <facet/plugin.h>
@@ -96,8 +97,8 @@ TEST(BSDFSampling, DiffuseConsistency) {
     int checked = 0;
     for (int i = 0; i < 10000; ++i) {
         SurfaceInteraction si = make_si(random_direction(rng, true));
-        auto [bs, weight] =
-            bsdf->sample(ctx, si, rng.next_float(), Point2f(rng.next_float(), rng.next_float()));
+        float s1 = rng.next_float();
+        auto [bs, weight] = bsdf->sample(ctx, si, s1, next_point2f(rng));
         if (weight.is_black()) continue;
         ++checked;
         EXPECT_EQ(bs.sampled_type, BSDFFlags::DiffuseReflection);
@@ -124,10 +125,9 @@ TEST(BSDFEnergy, DiffuseAlbedoEqualsReflectance) {
     const int n = 200000;
     double sum_w[3] = {0, 0, 0}, sum_u[3] = {0, 0, 0}, sum_u2 = 0;
     for (int i = 0; i < n; ++i) {
-        auto [bs, weight] =
-            bsdf->sample(ctx, si, rng.next_float(), Point2f(rng.next_float(), rng.next_float()));
-        Vector3f wo =
-            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        float s1 = rng.next_float();
+        auto [bs, weight] = bsdf->sample(ctx, si, s1, next_point2f(rng));
+        Vector3f wo = warp::square_to_uniform_hemisphere(next_point2f(rng));
         Color3f f = bsdf->eval(ctx, si, wo) / warp::square_to_uniform_hemisphere_pdf(wo);
         for (int c = 0; c < 3; ++c) {
             sum_w[c] += weight[c];

@@ -1,6 +1,8 @@
 // The directionalarea emitter: rays leave uniformly distributed points of the shape along its
 // normal and carry radiance x area (the emitted power); cameras and emitter sampling never see it.
 
+#include "draws.h"
+
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/random.h>
@@ -60,8 +62,8 @@ TEST(DirectionalArea, SampleRayIsUniformAlongTheNormalWithThePower) {
     const int n = 64000, bins = 8;
     std::vector<int> hist(size_t(bins * bins), 0);
     for (int i = 0; i < n; ++i) {
-        auto [ray, weight] = e->sample_ray(Point2f(rng.next_float(), rng.next_float()),
-                                           Point2f(rng.next_float(), rng.next_float()));
+        const Point2f u_pos = next_point2f(rng);
+        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng));
         // Power: radiance x area (3 x 1) for every ray.
         EXPECT_NEAR(weight.r, 9.f, 1e-4f);
         EXPECT_NEAR(weight.b, 6.f, 1e-4f);

@@ -1,6 +1,8 @@
 // Emitters point, area and constant: sampling records and weights, pdf consistency, and the
 // irradiance their direction sampling estimates against closed forms.
 
+#include "draws.h"
+
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -59,8 +61,7 @@ Estimate irradiance(const Emitter &emitter, const Interaction &ref, int n, uint6
     double sum[3] = {0, 0, 0}, sum2 = 0;
     int pdf_failures = 0;
     for (int i = 0; i < n; ++i) {
-        auto [ds, weight] =
-            emitter.sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        auto [ds, weight] = emitter.sample_direction(ref, next_point2f(rng));
         float cos_theta = std::max(0.f, dot(ref.n, ds.d));
         if (!weight.is_black()) {
             EXPECT_EQ(ds.emitter, &emitter);
@@ -126,8 +127,8 @@ TEST(EmitterPoint, SampleRay) {
     PCG32 rng(12);
     Vector3f mean_d(0.f);
     for (int i = 0; i < 10000; ++i) {
-        auto [ray, weight] = e->sample_ray(Point2f(rng.next_float(), rng.next_float()),
-                                           Point2f(rng.next_float(), rng.next_float()));
+        const Point2f u_pos = next_point2f(rng);
+        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng));
         EXPECT_EQ(ray.o, Point3f(1.f, -2.f, 0.5f));
         EXPECT_NEAR(norm(ray.d), 1.f, 1e-5f);
         EXPECT_NEAR(e->pdf_ray_direction(ray.d), InvFourPi, 1e-7f);
@@ -255,8 +256,8 @@ TEST(EmitterArea, SampleRayCarriesThePower) {
     double mean_cos = 0;
     const int n = 20000;
     for (int i = 0; i < n; ++i) {
-        auto [ray, weight] = e->sample_ray(Point2f(rng.next_float(), rng.next_float()),
-                                           Point2f(rng.next_float(), rng.next_float()));
+        const Point2f u_pos = next_point2f(rng);
+        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng));
         expect_color_near(weight, Color3f(2.f, 1.f, 0.5f) * (Pi * 4.f), 1e-5f);
         EXPECT_LE(std::abs(ray.o.x), 1.f + 1e-5f);
         EXPECT_LE(std::abs(ray.o.y), 1.f + 1e-5f);
@@ -285,7 +286,7 @@ TEST(EmitterArea, TexturedRadiance) {
     PCG32 rng(14);
     int seen[2] = {0, 0};
     for (int i = 0; i < 1000; ++i) {
-        auto [ds, weight] = e->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        auto [ds, weight] = e->sample_direction(ref, next_point2f(rng));
         bool first = (ds.uv.x > 0.5f) == (ds.uv.y > 0.5f);
         ++seen[first ? 0 : 1];
         Color3f expected = first ? Color3f(1.f, 2.f, 3.f) : Color3f(5.f);
@@ -306,7 +307,7 @@ TEST(EmitterArea, BackSideGivesNothing) {
     Interaction below = reference(Point3f(0.1f, 0.2f, -1.f), Normal3f(0.f, 0.f, 1.f));
     PCG32 rng(5);
     for (int i = 0; i < 1000; ++i) {
-        auto [ds, weight] = e->sample_direction(below, Point2f(rng.next_float(), rng.next_float()));
+        auto [ds, weight] = e->sample_direction(below, next_point2f(rng));
         EXPECT_TRUE(weight.is_black());
         EXPECT_EQ(e->pdf_direction(below, ds), 0.f);
     }
@@ -344,7 +345,7 @@ TEST(EmitterConstant, SamplingRecord) {
     Interaction ref = reference(Point3f(0.2f, 0.3f, -0.1f), Normal3f(0.f, 1.f, 0.f));
     PCG32 rng(9);
     for (int i = 0; i < 1000; ++i) {
-        auto [ds, weight] = e->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        auto [ds, weight] = e->sample_direction(ref, next_point2f(rng));
         EXPECT_NEAR(ds.pdf, InvFourPi, 1e-7f);
         EXPECT_EQ(e->pdf_direction(ref, ds), ds.pdf);
         EXPECT_FALSE(ds.delta);
@@ -381,7 +382,7 @@ TEST(EmitterConstant, SampledPointsLieOutsideTheScene) {
     Interaction ref = reference(Point3f(12.f, 0.f, 0.f), Normal3f(1.f, 0.f, 0.f));
     PCG32 rng(10);
     for (int i = 0; i < 1000; ++i) {
-        auto [ds, weight] = env->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        auto [ds, weight] = env->sample_direction(ref, next_point2f(rng));
         EXPECT_GE(ds.dist, 4.f);
         EXPECT_GT(norm(ds.p - Point3f(10.f, 0.f, 0.f)), 2.f * std::sqrt(3.f));
     }

@@ -1,6 +1,8 @@
 // Fresnel equations, reflection/refraction directions and the IOR tables: closed forms, Snell's
 // law, total internal reflection, the conductor/dielectric agreement at k = 0.
 
+#include "draws.h"
+
 #include <facet/frame.h>
 #include <facet/fresnel.h>
 #include <facet/ior.h>
@@ -78,7 +80,7 @@ TEST(Fresnel, RefractionFollowsSnellsLaw) {
     PCG32 rng(3);
     for (int i = 0; i < 1000; ++i) {
         float eta = 1.f + 1.5f * rng.next_float();
-        Vector3f wi = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f wi = warp::square_to_uniform_sphere(next_point2f(rng));
         auto [F, cos_t, eta_it, eta_ti] = fresnel_dielectric(wi.z, eta);
         EXPECT_NEAR(eta_it * eta_ti, 1.f, 1e-6f);
         EXPECT_EQ(eta_it, wi.z >= 0.f ? eta : 1.f / eta);
@@ -151,10 +153,8 @@ TEST(Fresnel, ConductorClosedForms) {
 TEST(Fresnel, ReflectAndRefractAboutAMicronormal) {
     PCG32 rng(11);
     for (int i = 0; i < 1000; ++i) {
-        Vector3f wi =
-            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
-        Vector3f m =
-            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f wi = warp::square_to_uniform_hemisphere(next_point2f(rng));
+        Vector3f m = warp::square_to_uniform_hemisphere(next_point2f(rng));
         if (dot(wi, m) <= 1e-3f) continue;
         Vector3f r = reflect(wi, m);
         EXPECT_NEAR(norm(r), 1.f, 1e-5f);

@@ -2,6 +2,7 @@
 // eval and pdf, single-part contexts, textured opacity, consistency, energy and chi-square.
 
 #include "bsdf_checks.h"
+#include "draws.h"
 
 #include <facet/texture.h>
 #include <facet/xml.h>
@@ -74,7 +75,7 @@ TEST(Mask, OpacityOneIsTheNestedBSDF) {
         EXPECT_EQ(bsdf->eval(BSDFContext(), si, wo), nested->eval(BSDFContext(), si, wo));
         EXPECT_EQ(bsdf->pdf(BSDFContext(), si, wo), nested->pdf(BSDFContext(), si, wo));
         float s1 = rng.next_float();
-        Point2f s2(rng.next_float(), rng.next_float());
+        Point2f s2 = next_point2f(rng);
         auto [bs, weight] = bsdf->sample(BSDFContext(), si, s1, s2);
         auto [bs_n, weight_n] = nested->sample(BSDFContext(), si, s1, s2);
         EXPECT_EQ(weight, weight_n);

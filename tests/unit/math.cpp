@@ -1,4 +1,6 @@
 // Transforms, warps and erfinv.
+#include "draws.h"
+
 #include <facet/math.h>
 #include <facet/random.h>
 #include <facet/transform.h>
@@ -187,7 +189,7 @@ struct HistogramTest {
         std::vector<double> observed(nx * ny, 0.0);
         PCG32 rng(42, 7);
         for (int k = 0; k < n_samples; ++k) {
-            Vector2f s = sample(Point2f(rng.next_float(), rng.next_float()));
+            Vector2f s = sample(next_point2f(rng));
             ASSERT_TRUE(std::isfinite(s.x) && std::isfinite(s.y));
             int i = std::min(nx - 1, std::max(0, int((s.x - x0) / dx)));
             int j = std::min(ny - 1, std::max(0, int((s.y - y0) / dy)));

@@ -1,6 +1,8 @@
 // Microfacet distributions: normalisation of D, the visible-normal density, Smith G1 against the
 // lecture's formulas, sampling for Beckmann and GGX, and the parameter reader.
 
+#include "draws.h"
+
 #include <facet/chi2.h> // direction_from_angles
 #include <facet/microfacet.h>
 #include <facet/properties.h>
@@ -143,8 +145,7 @@ TEST(Microfacet, AnisotropicMaskingUsesTheProjectedRoughness) {
     for (MicrofacetType type : {MicrofacetType::Beckmann, MicrofacetType::GGX}) {
         MicrofacetDistribution aniso(type, 0.1f, 0.6f);
         for (int i = 0; i < 100; ++i) {
-            Vector3f v =
-                warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+            Vector3f v = warp::square_to_uniform_hemisphere(next_point2f(rng));
             float alpha = aniso.project_roughness(v);
             float phi = std::atan2(v.y, v.x);
             EXPECT_NEAR(sqr(alpha), sqr(std::cos(phi) * 0.1f) + sqr(std::sin(phi) * 0.6f), 1e-5f);
@@ -175,9 +176,8 @@ TEST(Microfacet, SampleReturnsItsPdf) {
             MicrofacetDistribution distr(c.type, c.alpha_u, c.alpha_v, visible);
             int ok = 0;
             for (int i = 0; i < 2000; ++i) {
-                Vector3f wi =
-                    warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
-                auto [m, pdf] = distr.sample(wi, Point2f(rng.next_float(), rng.next_float()));
+                Vector3f wi = warp::square_to_uniform_hemisphere(next_point2f(rng));
+                auto [m, pdf] = distr.sample(wi, next_point2f(rng));
                 if (pdf == 0.f) continue;
                 ASSERT_TRUE(is_finite(m));
                 EXPECT_NEAR(norm(m), 1.f, 1e-5f);
@@ -205,7 +205,7 @@ TEST(MicrofacetSampling, VisibleNormalsAreSeenFromWi) {
         PCG32 rng(2);
         double mean_x = 0.0;
         for (int i = 0; i < 20000; ++i) {
-            auto [m, pdf] = distr.sample(wi, Point2f(rng.next_float(), rng.next_float()));
+            auto [m, pdf] = distr.sample(wi, next_point2f(rng));
             ASSERT_GT(pdf, 0.f);
             ASSERT_GT(dot(wi, m), 0.f);
             mean_x += m.x;
@@ -347,9 +347,8 @@ TEST(MicrofacetSampling, SampledPdfMatchesDoublePrecision) {
         double worst = 0.0;
         int checked = 0;
         for (int i = 0; i < 200000; ++i) {
-            Vector3f wi =
-                warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
-            Point2f u(rng.next_float(), rng.next_float());
+            Vector3f wi = warp::square_to_uniform_hemisphere(next_point2f(rng));
+            Point2f u = next_point2f(rng);
             if (wi.z < 0.05f) continue;
             auto [m, pdf] = distr.sample(wi, u);
             if (pdf == 0.f) continue;

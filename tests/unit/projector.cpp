@@ -1,6 +1,8 @@
 // The projector light: irradiance on facing and tilted planes against the closed form
 // E = π·scale·irradiance / z² (z along the axis), the frustum from fov and the texture's aspect,
 // the orientation of the projected image, and its emitted rays (weights and a chi-square test).
+#include "draws.h"
+
 #include <facet/chi2.h>
 #include <facet/emitter.h>
 #include <facet/image.h>
@@ -78,8 +80,9 @@ TEST(Projector, TiltedPlaneAndToWorld) {
     for (int i = 0; i < 20; ++i) {
         // Points of the plane x = -1 + (tilted) around the axis point (-1, 2, 3).
         const Vector3f t1 = Vector3f(0, 1, 0), t2 = cross(n, t1);
-        const Point3f p =
-            Point3f(-1, 2, 3) + t1 * (rng.next_float() - 0.5f) + t2 * (rng.next_float() - 0.5f);
+        const float a = rng.next_float() - 0.5f;
+        const float b = rng.next_float() - 0.5f;
+        const Point3f p = Point3f(-1, 2, 3) + t1 * a + t2 * b;
         const float z = 1.f - p.x; // distance along the axis (-x) from the projector
         const Vector3f to_light = normalize(Point3f(1, 2, 3) - p);
         // Irradiance = intensity·cos/dist² with intensity π/cos³θ (θ off the axis).
@@ -143,8 +146,7 @@ TEST(Projector, EmittedRaysCarryIntensityOverDensity) {
     auto proj = make_projector(props);
     PCG32 rng(11);
     for (int i = 0; i < 100; ++i) {
-        auto [ray, weight] =
-            proj->sample_ray(Point2f(0.5f, 0.5f), Point2f(rng.next_float(), rng.next_float()));
+        auto [ray, weight] = proj->sample_ray(Point2f(0.5f, 0.5f), next_point2f(rng));
         ASSERT_FALSE(weight.is_black());
         EXPECT_NEAR(norm(ray.d), 1.f, 1e-5f);
         // Intensity towards ray.d: the sample_direction weight times dist².

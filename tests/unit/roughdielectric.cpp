@@ -3,6 +3,7 @@
 // reciprocity, single-lobe contexts, energy and chi-square of the sampling.
 
 #include "bsdf_checks.h"
+#include "draws.h"
 
 #include <facet/fresnel.h>
 #include <facet/microfacet.h>
@@ -103,8 +104,8 @@ TEST(RoughDielectric, RefractionFollowsSnellsLawAboutTheMicronormal) {
         int refracted = 0;
         for (int i = 0; i < 3000; ++i) {
             SurfaceInteraction si = make_si(random_direction(rng, false));
-            auto [bs, weight] = bsdf->sample(BSDFContext(), si, rng.next_float(),
-                                             Point2f(rng.next_float(), rng.next_float()));
+            float s1 = rng.next_float();
+            auto [bs, weight] = bsdf->sample(BSDFContext(), si, s1, next_point2f(rng));
             if (weight.is_black() || bs.sampled_type != BSDFFlags::GlossyTransmission) continue;
             ++refracted;
             float cos_i = si.wi.z;
@@ -136,8 +137,8 @@ TEST(RoughDielectric, RadianceScalingAndGeneralisedReciprocity) {
             // Sampled pairs (most random pairs carry no transmission) and random pairs.
             Vector3f wi = random_direction(rng, false), wo = random_direction(rng, false);
             if (i % 2 == 0) {
-                auto [bs, weight] = bsdf->sample(rad, make_si(wi), rng.next_float(),
-                                                 Point2f(rng.next_float(), rng.next_float()));
+                float s1 = rng.next_float();
+                auto [bs, weight] = bsdf->sample(rad, make_si(wi), s1, next_point2f(rng));
                 if (!weight.is_black()) wo = bs.wo;
             }
             if (wi.z * wo.z < 0.f) {
@@ -172,7 +173,7 @@ TEST(RoughDielectric, SingleLobeContexts) {
     for (int i = 0; i < 500; ++i) {
         SurfaceInteraction si = make_si(random_direction(rng, false));
         float s1 = rng.next_float();
-        Point2f s2(rng.next_float(), rng.next_float());
+        Point2f s2 = next_point2f(rng);
         auto [r, wr] = bsdf->sample(make_ctx(TransportMode::Radiance, 0), si, s1, s2);
         if (!wr.is_black()) {
             EXPECT_EQ(r.sampled_type, BSDFFlags::GlossyReflection);

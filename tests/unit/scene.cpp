@@ -1,5 +1,7 @@
 // The scene: collecting children, defaults, Embree queries, spawned rays that neither self-hit nor
 // leak, and emitter sampling.
+#include "draws.h"
+
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/integrator.h>
@@ -199,20 +201,21 @@ void check_spawned_rays(const Transform &to_world, float radius_world, uint64_t 
         bool on_sphere = i % 2 == 1;
         Point3f target = on_sphere ? center : plane_center;
         // Camera rays from far away, aimed at the shape with a random offset.
-        Vector3f from = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f from = warp::square_to_uniform_sphere(next_point2f(rng));
         if (!on_sphere) from.z = std::abs(from.z) + 0.05f;
         Point3f o = target + normalize(from) * (radius_world * 20.f);
-        Point3f aim = target + Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f,
-                                        on_sphere ? rng.next_float() - 0.5f : 0.f) *
-                                   (1.6f * radius_world);
+        Vector3f jitter;
+        jitter.x = rng.next_float() - 0.5f;
+        jitter.y = rng.next_float() - 0.5f;
+        jitter.z = on_sphere ? rng.next_float() - 0.5f : 0.f;
+        Point3f aim = target + jitter * (1.6f * radius_world);
         SurfaceInteraction si;
         if (!scene.ray_intersect(Ray(o, normalize(aim - o)), si)) continue;
         if (si.shape != (on_sphere ? ball : rect_shape)) continue;
         ++hits;
         // A random direction back into the hemisphere the ray came from (including grazing).
         Vector3f n = si.n * sign(dot(si.n, o - si.p));
-        Vector3f local =
-            warp::square_to_uniform_hemisphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f local = warp::square_to_uniform_hemisphere(next_point2f(rng));
         Frame frame(n);
         Vector3f d = frame.to_world(local);
         SurfaceInteraction si2;
@@ -271,13 +274,14 @@ TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
     const Shape &ball = *scene.shapes()[2];
     for (int i = 0; i < 2000; ++i) {
         // A point on the floor right of the wall, found by tracing down.
-        Point3f start(0.05f + 1.9f * rng.next_float(), 3.8f * rng.next_float() - 1.9f, 1.f);
+        const Point2f q = next_point2f(rng);
+        Point3f start(0.05f + 1.9f * q.x, 3.8f * q.y - 1.9f, 1.f);
         SurfaceInteraction ref;
         ASSERT_TRUE(
             scene.ray_intersect(Ray(Point3f(start.x, start.y, 3.f), Vector3f(0, 0, -1)), ref));
         if (ref.shape != scene.shapes()[0].get()) continue; // under the ball
         // Points on the ball: those facing the reference point are visible, the others are not.
-        PositionSample ps = ball.sample_position(Point2f(rng.next_float(), rng.next_float()));
+        PositionSample ps = ball.sample_position(next_point2f(rng));
         Vector3f to_ref = normalize(ref.p - ps.p);
         float facing = dot(ps.n, to_ref);
         if (std::abs(facing) < 0.05f) continue; // the silhouette, where both answers are right
@@ -313,7 +317,7 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
     PCG32 rng(8);
     int area_samples = 0, point_samples = 0;
     for (int i = 0; i < 1000; ++i) {
-        Point2f u(rng.next_float(), rng.next_float());
+        Point2f u = next_point2f(rng);
         auto [ds, weight] = scene.sample_emitter_direction(ref, u, true);
         if (u.x < 0.5f) {
             ASSERT_EQ(ds.emitter, sphere_light);
@@ -378,7 +382,7 @@ TEST(SceneEmitters, TriangleLightsMatchTheirEmitter) {
     PCG32 rng(21);
     int panel = 0, box = 0;
     for (int i = 0; i < 2000; ++i) {
-        Point2f u(rng.next_float(), rng.next_float());
+        Point2f u = next_point2f(rng);
         auto [ds, weight] = scene.sample_emitter_direction(ref, u, false);
         if (!(ds.pdf > 0.f)) continue;
         ASSERT_TRUE(ds.emitter);

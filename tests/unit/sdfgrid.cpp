@@ -4,6 +4,8 @@
 // inside, grazing, and running along voxel faces and edges), a sphere's sampled SDF against the
 // analytic sphere (silhouette, distance, both normal modes), the bounding box and the parameters
 // Mitsuba refuses.
+#include "draws.h"
+
 #include <facet/interaction.h>
 #include <facet/logger.h>
 #include <facet/plugin.h>
@@ -165,12 +167,12 @@ TEST(SDFGrid, PlanarFieldIsHitExactly) {
         int hits = 0, smooth_checked = 0;
         for (int k = 0; k < 400; ++k) {
             // A point on the plane inside the grid, approached from a random direction.
-            Vector3d x(rng.next_float(), rng.next_float(), 0.0);
+            const Point2f q = next_point2f(rng);
+            Vector3d x(q.x, q.y, 0.0);
             x.z = -(PLANE_N.x * x.x + PLANE_N.y * x.y + PLANE_D) / PLANE_N.z;
             if (x.z < 0.02 || x.z > 0.98) continue;
             Point3f target = to_world.apply_point(Point3f(x));
-            Vector3f d = normalize(Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f,
-                                            rng.next_float() - 0.5f));
+            Vector3f d = normalize(next_vector3f(rng) - Vector3f(0.5f));
             if (std::abs(dot(d, world_n)) < 0.2f) continue;
             float dist = 4.f + 3.f * rng.next_float();
             Ray ray(target - d * dist, d);
@@ -337,8 +339,7 @@ TEST(SDFGrid, StartsInsideAndGrazes) {
     // From the centre outwards: the first hit is the sphere at distance r, normal outwards.
     PCG32 rng(3);
     for (int k = 0; k < 50; ++k) {
-        Vector3f d = normalize(
-            Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
+        Vector3f d = normalize(next_vector3f(rng) - Vector3f(0.5f));
         SurfaceInteraction si;
         ASSERT_TRUE(scene->ray_intersect(Ray(Point3f(0.5f), d), si));
         EXPECT_NEAR(si.t, 0.3f, 1e-3f);
@@ -469,9 +470,8 @@ TEST(SDFGrid, ClosedSurfaceHasNoPinholes) {
     // Random rays from outside towards the inner half of the ball.
     PCG32 rng(11);
     for (int k = 0; k < 20000; ++k) {
-        Vector3f target(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f);
-        Vector3f dir = normalize(
-            Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
+        Vector3f target = next_vector3f(rng) - Vector3f(0.5f);
+        Vector3f dir = normalize(next_vector3f(rng) - Vector3f(0.5f));
         Point3f t = Point3f(0.5f) + target * 0.3f;
         ++rays;
         missed += !scene->ray_test(Ray(t - dir * 2.f, dir));
@@ -487,9 +487,10 @@ TEST(SDFGrid, ClosedSurfaceHasNoPinholes) {
     auto flat = grid_scene(flat_path);
     missed = 0;
     for (int k = 0; k < 20000; ++k) {
-        Point3f target(0.05f + 0.9f * rng.next_float(), 0.05f + 0.9f * rng.next_float(), 0.5f);
-        Vector3f dir = normalize(
-            Vector3f(rng.next_float() - 0.5f, rng.next_float() - 0.5f, -0.05f - rng.next_float()));
+        const Point2f q = next_point2f(rng);
+        Point3f target(0.05f + 0.9f * q.x, 0.05f + 0.9f * q.y, 0.5f);
+        const Vector3f r = next_vector3f(rng);
+        Vector3f dir = normalize(Vector3f(r.x - 0.5f, r.y - 0.5f, -0.05f - r.z));
         missed += !flat->ray_test(Ray(target - dir * (1.5f / std::abs(dir.z)), dir));
     }
     EXPECT_EQ(missed, 0) << "rays through the zero sample plane that missed";

@@ -4,6 +4,8 @@
 // sampling (camera rays against the importance, the thin lens's aperture against pdf_direction)
 // are lines of tests/chi2/configs.txt (`facet chi2 sensor`).
 
+#include "draws.h"
+
 #include <facet/plugin.h>
 #include <facet/random.h>
 #include <facet/sensor.h>
@@ -46,8 +48,8 @@ void expect_round_trip(const Sensor &cam, bool aperture) {
     PCG32 rng;
     const Point2i size = cam.film().size();
     for (int i = 0; i < 200; ++i) {
-        Point2f film(rng.next_float(), rng.next_float());
-        Point2f ap = aperture ? Point2f(rng.next_float(), rng.next_float()) : Point2f(0.5f);
+        Point2f film = next_point2f(rng);
+        Point2f ap = aperture ? next_point2f(rng) : Point2f(0.5f);
         auto [ray, w] = cam.sample_ray(0.f, film, ap);
         const float t = 0.5f + 5.f * rng.next_float();
         auto [ds, weight] = cam.sample_direction(point(ray.o + ray.d * t), ap);
@@ -64,7 +66,7 @@ void expect_round_trip(const Sensor &cam, bool aperture) {
 /// The directions come from a jittered 632 x 632 grid on the square (square_to_uniform_sphere
 /// keeps areas, so every stratum is the same solid angle), the two jitters drawn in a set order:
 /// 400,000 independent directions scattered the estimate by about 0.005 from seed to seed, and
-/// `Point2f(rng.next_float(), rng.next_float())` drew x and y in a compiler's order.
+/// `next_point2f(rng)` drew x and y in a compiler's order.
 double importance_integral(const Sensor &cam, const Point3f &centre) {
     PCG32 rng(7);
     const int n = 632;
@@ -154,8 +156,8 @@ TEST(SensorImportance, ThinLensIntegratesToOne) {
     const float R = 2.f;
     double sum = 0.0, sum2 = 0.0;
     for (int i = 0; i < n; ++i) {
-        Vector3f d = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
-        Point2f u(rng.next_float(), rng.next_float());
+        Vector3f d = warp::square_to_uniform_sphere(next_point2f(rng));
+        Point2f u = next_point2f(rng);
         auto [ds, weight] = cam->sample_direction(point(Point3f(1, 2, 3) + d * R), u);
         const double v = weight.g * std::abs(dot(d, ds.d)) * 4.0 * Pi * R * R;
         sum += v;

@@ -1,6 +1,8 @@
 // Shapes: the mesh loaders (obj, ply), the built-in meshes (rectangle, cube), the exact shapes
 // (sphere, disk), their areas, bounds, position sampling and direction sampling, and exact
 // intersections through Embree.
+#include "draws.h"
+
 #include <facet/interaction.h>
 #include <facet/mesh.h>
 #include <facet/plugin.h>
@@ -567,7 +569,7 @@ TEST(ShapeSampling, PositionsLieOnTheSurfaceWithUniformPdf) {
         auto shape = make_shape(c.type, props);
         PCG32 rng(7);
         for (int i = 0; i < 2000; ++i) {
-            PositionSample ps = shape->sample_position(Point2f(rng.next_float(), rng.next_float()));
+            PositionSample ps = shape->sample_position(next_point2f(rng));
             ASSERT_NEAR(c.residual(ps.p), 0.f, 1e-5f) << ps.p;
             ASSERT_NEAR(ps.pdf, 1.f / shape->surface_area(), 1e-6f);
             ASSERT_NEAR(norm(ps.n), 1.f, 1e-5f);
@@ -589,7 +591,7 @@ TEST(ShapeSampling, MeshPicksTrianglesByArea) {
     int upper = 0;
     double mean_x = 0.0;
     for (int i = 0; i < n; ++i) {
-        PositionSample ps = mesh->sample_position(Point2f(rng.next_float(), rng.next_float()));
+        PositionSample ps = mesh->sample_position(next_point2f(rng));
         if (ps.p.z > 2.5f) {
             ++upper;
             mean_x += ps.p.x;
@@ -617,12 +619,10 @@ TEST(ShapeIntersection, SphereHitDistanceIsExact) {
     for (int i = 0; i < 2000; ++i) {
         // Origins at distances from 2 to 1000 radii, aimed near the sphere.
         float dist = radius * std::pow(500.f, rng.next_float()) * 2.f;
-        Vector3f dir_o =
-            warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f dir_o = warp::square_to_uniform_sphere(next_point2f(rng));
         Point3f o = center + dir_o * dist;
         Point3f target =
-            center + warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float())) *
-                         (radius * 1.2f);
+            center + warp::square_to_uniform_sphere(next_point2f(rng)) * (radius * 1.2f);
         Vector3f d = normalize(target - o);
         // Reference in double.
         Vector3d od = Vector3d(o) - Vector3d(center), dd = Vector3d(d);
@@ -678,8 +678,9 @@ TEST(ShapeIntersection, DiskHitIsExactWithUvAndNormal) {
     SingleShape scene(disk);
     PCG32 rng(5);
     for (int i = 0; i < 1000; ++i) {
-        Point3f o(rng.next_float() * 8 - 4, rng.next_float() * 8 - 4, -5.f);
-        Point3f target(rng.next_float() * 5 - 2.5f, rng.next_float() * 5 - 2.5f, 3.f);
+        const Point2f qo = next_point2f(rng), qt = next_point2f(rng);
+        Point3f o(qo.x * 8 - 4, qo.y * 8 - 4, -5.f);
+        Point3f target(qt.x * 5 - 2.5f, qt.y * 5 - 2.5f, 3.f);
         Vector3f d = normalize(target - o);
         double t_ref = (3.0 - double(o.z)) / double(d.z);
         double r = std::hypot(double(o.x) + t_ref * d.x, double(o.y) + t_ref * d.y);
@@ -766,7 +767,7 @@ double integrate_direction_pdf(const Shape &shape, const SingleShape &scene, con
     PCG32 rng(seed);
     double sum = 0.0;
     for (int i = 0; i < n; ++i) {
-        Vector3f d = warp::square_to_uniform_sphere(Point2f(rng.next_float(), rng.next_float()));
+        Vector3f d = warp::square_to_uniform_sphere(next_point2f(rng));
         SurfaceInteraction si;
         if (!scene.intersect(Ray(ref.p, d), si)) continue;
         DirectionSample ds;
@@ -812,8 +813,7 @@ TEST(ShapeSampling, SphereConeSamplingIsUniformInTheCone) {
     std::vector<int> hist(bins * bins, 0);
     PCG32 rng(99);
     for (int i = 0; i < n; ++i) {
-        DirectionSample ds =
-            sphere->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+        DirectionSample ds = sphere->sample_direction(ref, next_point2f(rng));
         ASSERT_NEAR(ds.pdf, expected_pdf, 1e-3f * expected_pdf);
         ASSERT_NEAR(sphere->pdf_direction(ref, ds), ds.pdf, 1e-6f * ds.pdf);
         ASSERT_NEAR(norm(ds.p), 0.5f, 1e-6f);
@@ -848,8 +848,7 @@ TEST(ShapeSampling, DefaultDirectionPdfMatchesAndIntegrates) {
         ref.p = Point3f(0.3f, -0.2f, -1.5f);
         PCG32 rng(1);
         for (int i = 0; i < 200; ++i) {
-            DirectionSample ds =
-                shape->sample_direction(ref, Point2f(rng.next_float(), rng.next_float()));
+            DirectionSample ds = shape->sample_direction(ref, next_point2f(rng));
             ASSERT_GT(ds.pdf, 0.f);
             EXPECT_NEAR(shape->pdf_direction(ref, ds), ds.pdf, 1e-4f * ds.pdf);
             EXPECT_NEAR(norm(ds.d), 1.f, 1e-5f);

@@ -3,6 +3,7 @@
 // consistency on both sides, energy and chi-square from the back side.
 
 #include "bsdf_checks.h"
+#include "draws.h"
 
 #include <facet/texture.h>
 #include <facet/xml.h>
@@ -92,7 +93,7 @@ TEST(TwoSided, BackSideIsTheMirroredFrontSide) {
             EXPECT_TRUE(bsdf->eval(BSDFContext(), front, mirror(wo)).is_black());
 
             float s1 = rng.next_float();
-            Point2f s2(rng.next_float(), rng.next_float());
+            Point2f s2 = next_point2f(rng);
             auto [bs_f, w_f] = bsdf->sample(BSDFContext(), front, s1, s2);
             auto [bs_b, w_b] = bsdf->sample(BSDFContext(), back, s1, s2);
             EXPECT_EQ(w_f, w_b);
