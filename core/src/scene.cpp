@@ -216,6 +216,11 @@ Scene::Scene(const Properties &props) {
     rtcSetSceneFlags(m_rtc_scene, m_robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
     try {
+        // Shape groups first, with the scene's triangle test: their instances (attached below)
+        // only fetch the group's scene.
+        for (auto &shape : m_shapes)
+            if (auto group = dynamic_cast<const ShapeGroup *>(shape.get()))
+                group->group_scene(m_device, m_robust);
         for (auto &shape : m_shapes) {
             RTCGeometry geom = shape->embree_geometry(m_device);
             if (!geom) continue; // a shape group: only visible through its instances

@@ -38,11 +38,11 @@ ShapeGroup::~ShapeGroup() {
     if (m_scene) rtcReleaseScene(m_scene);
 }
 
-RTCScene ShapeGroup::group_scene(RTCDevice device) const {
+RTCScene ShapeGroup::group_scene(RTCDevice device, bool robust) const {
     std::lock_guard<std::mutex> lock(m_mutex); // scene construction only, not a hot path
     if (m_scene) return m_scene;
     m_scene = rtcNewScene(device);
-    rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(m_scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(m_scene, RTC_BUILD_QUALITY_HIGH);
     for (size_t i = 0; i < m_shapes.size(); ++i) {
         RTCGeometry geom = m_shapes[i]->embree_geometry(device);

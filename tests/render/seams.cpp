@@ -10,6 +10,7 @@
 #include <facet/mesh.h>
 #include <facet/random.h>
 #include <facet/scene.h>
+#include <facet/shapegroup.h>
 #include <facet/xml.h>
 
 #include <gtest/gtest.h>
@@ -202,5 +203,31 @@ TEST(Seams, FastIntersectionOnlyMissesExactlyAimedRays) {
         std::printf("fast intersection: %d of %d rays aimed at seams escaped\n", leaks.escaped,
                     leaks.rays);
         EXPECT_LT(leaks.escaped, leaks.rays / 10);
+    }
+}
+
+// A shape group's own Embree scene uses the triangle test of the scene that instances it, as
+// the scene's own meshes do (it was always the robust one).
+TEST(Seams, InstancedGroupsFollowTheSceneOption) {
+    for (bool robust : {false, true}) {
+        std::string xml = std::string("<scene version=\"3.0.0\"><boolean "
+                                      "name=\"embree_use_robust_intersections\" value=\"") +
+                          (robust ? "true" : "false") +
+                          "\"/><shape type=\"shapegroup\" id=\"group\"><shape type=\"cube\"/>"
+                          "</shape><shape type=\"instance\"><ref id=\"group\"/><transform "
+                          "name=\"to_world\">" +
+                          ROTATED + "</transform></shape></scene>";
+        auto scene = std::static_pointer_cast<Scene>(load_string(xml));
+        const ShapeGroup *group = nullptr;
+        for (const auto &shape : scene->shapes())
+            if (auto g = dynamic_cast<const ShapeGroup *>(shape.get())) group = g;
+        ASSERT_TRUE(group);
+        const RTCSceneFlags flags = rtcGetSceneFlags(group->group_scene(scene->embree_device()));
+        EXPECT_EQ((flags & RTC_SCENE_FLAG_ROBUST) != 0, robust) << "robust = " << robust;
+        // The instance is there: a ray at the centre of the placed cube hits it.
+        const Point3f centre = 0.5f * (scene->bbox().min + scene->bbox().max);
+        SurfaceInteraction si;
+        EXPECT_TRUE(scene->ray_intersect(
+            Ray(centre + Vector3f(0.f, 0.f, 1e3f), Vector3f(0.f, 0.f, -1.f), 0.f, Infinity), si));
     }
 }

@@ -23,8 +23,10 @@ public:
     PositionSample sample_position(const Point2f &u) const override;
     std::string to_string() const override;
 
-    /// The group's committed Embree scene (built on first use; geometry id i = shape i).
-    RTCScene group_scene(RTCDevice device) const;
+    /// The group's committed Embree scene (built on first use; geometry id i = shape i), with
+    /// Embree's robust triangle test when `robust`. The first call fixes it: the scene builds its
+    /// groups with its own `embree_use_robust_intersections` before it attaches their instances.
+    RTCScene group_scene(RTCDevice device, bool robust = false) const;
     const Shape &shape(uint32_t geom_id) const { return *m_shapes[geom_id]; }
     const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
 
