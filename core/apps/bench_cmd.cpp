@@ -30,7 +30,6 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <linux/perf_event.h>
-#include <sys/resource.h>
 #include <sys/syscall.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -71,14 +70,6 @@ std::vector<Hit> primary_hits(const Scene &scene, const Sensor &sensor) {
         }
     }
     return hits;
-}
-
-/// CPU seconds (user + system) of the whole process so far.
-double process_cpu_seconds() {
-    rusage ru{};
-    getrusage(RUSAGE_SELF, &ru);
-    return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
-           1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
 /// User-space instructions retired by every thread of the process (those alive when started

@@ -255,7 +255,8 @@ int render_main(int argc, char **argv) {
     cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
                                   film.crop_size().x, film.crop_size().y, range.count));
     RenderResult result;
-    preload_image_library(); // meanwhile, for the write
+    // The image library (for the write) loads while the render runs, from its first pixels on.
+    ropts.on_first_block = [] { preload_image_library(); };
     try {
         result = render(*scene, sensor, ropts);
         result.load_seconds = load_seconds;
@@ -294,6 +295,10 @@ int render_main(int argc, char **argv) {
             fmt::print("  sampling                {} ({} of {} work units, {:.3g} samples/s)\n",
                        format_seconds(result.sampling_seconds), result.blocks_done,
                        result.blocks_total, rate);
+            if (result.first_block_cpu_seconds > 0.0)
+                fmt::print("  first pixels            {:.3f} s CPU from the start of the process "
+                           "(every thread)\n",
+                           result.first_block_cpu_seconds);
             fmt::print("  developing the film     {}\n", format_seconds(result.develop_seconds));
             fmt::print("  writing the image       {}\n", format_seconds(write_seconds));
         }

@@ -8,6 +8,7 @@
 #include <facet/scene.h>
 #include <facet/sensor.h>
 
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -165,6 +166,13 @@ size_t BlockMerger::finished() {
 // ---------------------------------------------------------------------------------------------
 // Work units on the render threads
 
+double process_cpu_seconds() {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+           1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
 int render_thread_count(const RenderOptions &opts) {
     if (opts.threads < 0)
         FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
@@ -205,6 +213,8 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
     ProgressLine progress(opts.progress);
     std::atomic<size_t> next_unit{0};
     std::atomic<bool> cancelled{false}, timed_out{false};
+    std::atomic<bool> first_done{false};
+    double first_unit_cpu = 0.0; // written once, by the thread that finished the first unit
 
     std::mutex monitor_mutex;
     std::condition_variable monitor_cv;
@@ -241,6 +251,10 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
             const size_t index = next_unit.fetch_add(1);
             if (index >= count) return;
             run(index);
+            if (!first_done.load(std::memory_order_relaxed) && !first_done.exchange(true)) {
+                first_unit_cpu = process_cpu_seconds();
+                if (opts.on_first_block) opts.on_first_block();
+            }
         }
     };
     try {
@@ -257,6 +271,7 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
 
     WorkUnitsRun run;
     run.seconds = seconds_since(start);
+    run.first_unit_cpu_seconds = first_unit_cpu; // the threads were joined: no race
     run.cancelled = cancelled || stop.cancelled();
     run.timed_out = !run.cancelled && (timed_out || stop.timed_out());
     {
@@ -496,6 +511,7 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
     const size_t passes_done = merger.merged() / std::max<size_t>(blocks, 1);
     result.blocks_total = total;
     result.blocks_done = merger.merged();
+    result.first_block_cpu_seconds = run.first_unit_cpu_seconds;
     result.cancelled = passes_done < passes;
     result.timed_out = result.cancelled && run.timed_out;
     result.spp_target = spp;

@@ -353,6 +353,19 @@ TEST(RenderLoop, LargeRenderStopsWithinASecondOfTheTimeout) {
         for (int x = 0; x < 96; ++x) ASSERT_GT(r.image.at(x, y, 2), 0.f) << x << "," << y;
 }
 
+// The time to first pixels `facet render -v` prints: the process's CPU time when the first
+// block was done, so it lies between the CPU times read before and after the render; and the
+// first of the 36 blocks (of 4 passes) is done long before the render's last CPU second.
+TEST(RenderLoop, FirstBlockCpuTimeIsTakenWhenTheFirstBlockIsDone) {
+    auto scene = load_temp_scene("first", scene_xml(PATH, 48, 8, ""));
+    const double before = process_cpu_seconds();
+    RenderResult r = render_with(*scene, 2, 0, 16);
+    const double after = process_cpu_seconds();
+    EXPECT_EQ(r.blocks_done, 9u * 4u);
+    EXPECT_GE(r.first_block_cpu_seconds, before);
+    EXPECT_LE(r.first_block_cpu_seconds, after);
+}
+
 TEST(RenderLoop, ProgressiveRenderIsDeterministicAndConverges) {
     // The same image for any thread count, and the passes build up the same picture as a
     // render in one pass of all samples (samples_per_pass = spp).

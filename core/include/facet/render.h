@@ -44,6 +44,10 @@ struct RenderOptions {
     /// their merge combines them (bit-identical to it; a merge of crops of parts too).
     int pass_index = 0;
     int pass_count = 1;
+    /// Called once, on a render thread, when the first work unit is done (`facet render` starts
+    /// loading the image library for the write then, not before: while the dynamic loader loads
+    /// a library, creating a thread waits for it, and the render creates its threads first).
+    std::function<void()> on_first_block;
 };
 
 /// The samples per pixel a render takes: sample indices [first, first + count) of each pixel of
@@ -79,6 +83,10 @@ struct RenderResult {
     /// (whole passes only), light-path batches of a light tracer.
     size_t blocks_done = 0, blocks_total = 0;
     uint64_t samples = 0; ///< camera samples (or light paths) taken
+    /// Time to first pixels: CPU time of the whole process (start-up, scene loading and every
+    /// thread included) when the first image block of a sampling integrator was rendered; 0 when
+    /// none was (or for a light tracer).
+    double first_block_cpu_seconds = 0.0;
 };
 
 /// Renders `sensor` of `scene` with the scene's integrator (Integrator::render). Deterministic:
@@ -168,6 +176,9 @@ struct WorkUnitsRun {
     bool cancelled = false; ///< stopped by the cancel flag before every unit was taken
     bool timed_out = false; ///< stopped by the timeout before every unit was taken
     double seconds = 0.0;
+    /// CPU time of the whole process (all its threads, from its start) when the first unit was
+    /// done; 0 when none was.
+    double first_unit_cpu_seconds = 0.0;
 };
 
 /// The render loop of every integrator: runs work units 0..count-1 on opts.threads threads (a
@@ -182,5 +193,8 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
 
 /// Number of threads a render with `opts` uses.
 int render_thread_count(const RenderOptions &opts);
+
+/// CPU seconds (user + system, every thread) of the whole process so far.
+double process_cpu_seconds();
 
 } // namespace facet
