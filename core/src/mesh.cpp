@@ -295,6 +295,10 @@ void Mesh::compute_surface_interaction(const Ray &ray, float /*t*/, uint32_t pri
                                        const Point2f &uv, SurfaceInteraction &si) const {
     // Geometry only: the scene sets t, shape, prim_index and wi (an instance sets them for its
     // members).
+    if (has_flat_hit()) { // the common case, taken first
+        flat_hit(prim_index, uv, si);
+        return;
+    }
     const uint32_t *face = &m_faces[3 * size_t(prim_index)];
     const uint32_t i0 = face[0], i1 = face[1], i2 = face[2];
     const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
@@ -306,22 +310,6 @@ void Mesh::compute_surface_interaction(const Ray &ray, float /*t*/, uint32_t pri
     // Interpolating the vertices is more accurate than ray(t) far from the ray origin.
     si.p = p0 * b0 + p1 * b1 + p2 * b2;
     const Vector3f dp0 = p1 - p0, dp1 = p2 - p0;
-
-    if (!m_face_table.empty() && m_uvs.empty()) {
-        // A flat mesh without texture coordinates (the common case, taken first): normals and
-        // frame of the face were computed at load, the barycentrics serve as (u, v).
-        const float *f = &m_face_table[9 * size_t(prim_index)];
-        si.n = Normal3f(f[0], f[1], f[2]);
-        const Normal3f ns(f[3], f[4], f[5]);
-        const Vector3f s(f[6], f[7], f[8]);
-        si.sh_frame.s = s;
-        si.sh_frame.t = cross(ns, s);
-        si.sh_frame.n = ns;
-        si.uv = Point2f(b1, b2);
-        si.dp_du = dp0;
-        si.dp_dv = dp1;
-        return;
-    }
 
     const Point2f *uvs = nullptr;
     Point2f uv_corner[3];

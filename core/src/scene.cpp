@@ -226,8 +226,10 @@ Scene::Scene(const Properties &props) {
             if (!geom) continue; // a shape group: only visible through its instances
             unsigned id = rtcAttachGeometry(m_rtc_scene, geom);
             rtcReleaseGeometry(geom); // the scene holds it now
-            if (id >= m_geometry_shapes.size()) m_geometry_shapes.resize(id + 1, nullptr);
-            m_geometry_shapes[id] = shape.get();
+            if (id >= m_geometries.size()) m_geometries.resize(id + 1);
+            m_geometries[id].shape = shape.get();
+            if (shape->is_mesh() && static_cast<const Mesh &>(*shape).has_flat_hit())
+                m_geometries[id].flat_mesh = static_cast<const Mesh *>(shape.get());
             m_bbox.expand(shape->bbox());
         }
         rtcCommitScene(m_rtc_scene);
@@ -293,15 +295,20 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     const Point2f uv(rh.hit.u, rh.hit.v);
     if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
         // A hit inside an instanced group: geomID is the member of the group.
-        FACET_ASSERT(rh.hit.instID[0] < m_geometry_shapes.size());
-        m_geometry_shapes[rh.hit.instID[0]]->compute_instance_interaction(
+        FACET_ASSERT(rh.hit.instID[0] < m_geometries.size());
+        m_geometries[rh.hit.instID[0]].shape->compute_instance_interaction(
             ray, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, uv, si);
         si.instance_index = rh.hit.instID[0];
     } else {
-        FACET_ASSERT(rh.hit.geomID < m_geometry_shapes.size());
-        const Shape *shape = m_geometry_shapes[rh.hit.geomID];
-        // The shape fills in its geometry; the hit is finished here, once for every shape.
-        shape->compute_surface_interaction(ray, rh.ray.tfar, rh.hit.primID, uv, si);
+        FACET_ASSERT(rh.hit.geomID < m_geometries.size());
+        const GeometryEntry &geometry = m_geometries[rh.hit.geomID];
+        const Shape *shape = geometry.shape;
+        // The shape fills in its geometry (a flat mesh inline); the hit is finished here, once
+        // for every shape.
+        if (geometry.flat_mesh)
+            geometry.flat_mesh->flat_hit(rh.hit.primID, uv, si);
+        else
+            shape->compute_surface_interaction(ray, rh.ray.tfar, rh.hit.primID, uv, si);
         si.t = rh.ray.tfar;
         si.shape = shape;
         si.prim_index = rh.hit.primID;

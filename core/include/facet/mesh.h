@@ -19,8 +19,16 @@ public:
     BoundingBox3f bbox() const override { return m_bbox; }
     float surface_area() const override { return m_area; }
     RTCGeometry embree_geometry(RTCDevice device) const override;
+    /// Final: the scene computes the hits of meshes with has_flat_hit() by flat_hit() directly.
     void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
-                                     const Point2f &uv, SurfaceInteraction &si) const override;
+                                     const Point2f &uv, SurfaceInteraction &si) const final;
+    /// True for a flat mesh without texture coordinates (the common case), whose hits
+    /// flat_hit() computes.
+    bool has_flat_hit() const { return !m_face_table.empty() && m_uvs.empty(); }
+    /// compute_surface_interaction() of a mesh with has_flat_hit(), inline for
+    /// Scene::ray_intersect() (no virtual call): p, n, sh_frame, uv, dp_du, dp_dv, shape and
+    /// prim_index of the hit at Embree's barycentrics `uv` on face `prim_index`.
+    void flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceInteraction &si) const;
     PositionSample sample_position(const Point2f &u) const override;
     /// sample_position() written into `ps` (p, n, uv, pdf and delta), inline for the triangle
     /// lights of Scene::sample_emitter_direction(). Only for a mesh with area (surface_area() >
@@ -101,6 +109,30 @@ private:
     float m_area = 0.f;
     BoundingBox3f m_bbox;
 };
+
+inline void Mesh::flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceInteraction &si) const {
+    FACET_ASSERT(has_flat_hit());
+    const uint32_t *face = &m_faces[3 * size_t(prim_index)];
+    const Point3f p0 = vertex_position(face[0]), p1 = vertex_position(face[1]),
+                  p2 = vertex_position(face[2]);
+    // Embree's (u, v) weight vertices 1 and 2; they serve as the texture coordinates too.
+    const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
+    si.shape = this;
+    si.prim_index = prim_index;
+    // Interpolating the vertices is more accurate than ray(t) far from the ray origin.
+    si.p = p0 * b0 + p1 * b1 + p2 * b2;
+    // Normals and the shading frame of the face were computed at load.
+    const float *f = &m_face_table[9 * size_t(prim_index)];
+    si.n = Normal3f(f[0], f[1], f[2]);
+    const Normal3f ns(f[3], f[4], f[5]);
+    const Vector3f s(f[6], f[7], f[8]);
+    si.sh_frame.s = s;
+    si.sh_frame.t = cross(ns, s);
+    si.sh_frame.n = ns;
+    si.uv = Point2f(b1, b2);
+    si.dp_du = p1 - p0;
+    si.dp_dv = p2 - p0;
+}
 
 inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
     // Pick a triangle in proportion to its area and reuse the sample within its interval.

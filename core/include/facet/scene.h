@@ -89,7 +89,13 @@ private:
         float inv_area = 0.f;       ///< of a triangle light: its area density
     };
     std::vector<EmitterEntry> m_emitter_table;
-    std::vector<const Shape *> m_geometry_shapes; ///< Embree geometry id -> shape
+    /// Per Embree geometry id: its shape, and the same shape as a Mesh when the hits on it are
+    /// Mesh::flat_hit() (computed inline, without the virtual call).
+    struct GeometryEntry {
+        const Shape *shape = nullptr;
+        const Mesh *flat_mesh = nullptr;
+    };
+    std::vector<GeometryEntry> m_geometries;
     BoundingBox3f m_bbox;
     double m_accel_seconds = 0.0;
     RTCDevice m_device = nullptr;
