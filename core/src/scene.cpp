@@ -14,6 +14,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <mutex>
 #include <pmmintrin.h>
 #include <vector>
@@ -76,13 +77,48 @@ void embree_error_callback(void *, RTCError code, const char *str) {
 /// Embree's own precondition on rays (it asserts it and aborts): origin and direction below
 /// 1.8e18 in magnitude (so not NaN), tnear and tfar not NaN. Scenes are validated so that their
 /// rays meet it; this catches what a plugin computes from bad data (a NaN normal, say).
-inline bool embree_can_trace(const Ray &ray) {
+/// `a` and `b` are the ray's first eight floats (ray_words()): o, d, mint and maxt.
+inline bool embree_can_trace(__m128 a, __m128 b) {
     constexpr float Large = 1.8e18f;
-    return std::abs(ray.o.x) <= Large && std::abs(ray.o.y) <= Large && std::abs(ray.o.z) <= Large &&
-           std::abs(ray.d.x) <= Large && std::abs(ray.d.y) <= Large && std::abs(ray.d.z) <= Large &&
-           !std::isnan(ray.mint) && !std::isnan(ray.maxt);
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    // |x| <= limit is false for NaN; the limit of mint and maxt is infinity (only NaN fails).
+    const __m128 ok_a = _mm_cmple_ps(_mm_and_ps(a, abs_mask), _mm_set1_ps(Large));
+    const __m128 ok_b =
+        _mm_cmple_ps(_mm_and_ps(b, abs_mask), _mm_setr_ps(Large, Large, Infinity, Infinity));
+    return _mm_movemask_ps(_mm_and_ps(ok_a, ok_b)) == 0xF;
 }
 
+/// The first eight floats of `ray`, (o.x, o.y, o.z, d.x) and (d.y, d.z, mint, maxt), in two
+/// registers: the check and the Embree ray are built from them.
+inline void ray_words(const Ray &ray, __m128 &a, __m128 &b) {
+    static_assert(offsetof(Ray, o) == 0 && offsetof(Ray, d) == 12 && offsetof(Ray, mint) == 24 &&
+                      offsetof(Ray, maxt) == 28,
+                  "Ray: o, d, mint, maxt are eight consecutive floats");
+    const float *f = reinterpret_cast<const float *>(&ray);
+    a = _mm_loadu_ps(f);
+    b = _mm_loadu_ps(f + 4);
+}
+
+/// Fills the ray part of an Embree ray (RTCRay, the first part of RTCRayHit) from ray_words():
+/// origin, tnear = mint, direction, time 0, tfar = maxt, all mask bits, id and flags 0.
+inline void set_embree_ray(__m128 a, __m128 b, RTCRay &r) {
+    static_assert(offsetof(RTCRay, tnear) == 12 && offsetof(RTCRay, time) == 28 &&
+                      offsetof(RTCRay, tfar) == 32 && offsetof(RTCRay, flags) == 44 &&
+                      alignof(RTCRay) >= 16,
+                  "RTCRay: three rows of four words");
+    float *out = &r.org_x;
+    // Row 0: o.x, o.y, o.z, mint.
+    const __m128 z = _mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 2, 2, 2)); // o.z o.z mint mint
+    _mm_store_ps(out, _mm_shuffle_ps(a, z, _MM_SHUFFLE(2, 0, 1, 0)));
+    // Row 1: d.x, d.y, d.z, time = 0.
+    const __m128 d = _mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 0, 3, 3)); // d.x d.x d.y d.z
+    const __m128 keep3 = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    _mm_store_ps(out + 4, _mm_and_ps(_mm_shuffle_ps(d, d, _MM_SHUFFLE(3, 3, 2, 0)), keep3));
+    // Row 2: tfar = maxt, mask = all bits (the Debian build has ray masks on: any other value
+    // can miss), id = 0, flags = 0.
+    const __m128 row2 = _mm_castsi128_ps(_mm_setr_epi32(0, -1, 0, 0));
+    _mm_store_ps(out + 8, _mm_move_ss(row2, _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 3, 3, 3))));
+}
 std::string object_label(const Object &obj) {
     return obj.id().empty() ? obj.to_string() : "\"" + obj.id() + "\"";
 }
@@ -265,25 +301,16 @@ uint64_t Scene::ray_count() {
 
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     count_ray();
-    if (!embree_can_trace(ray)) {
+    __m128 a, b;
+    ray_words(ray, a, b);
+    if (!embree_can_trace(a, b)) {
         escaped(ray, si); // a NaN direction, say: Embree would abort the process
         return false;
     }
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
-    rh.ray.org_x = ray.o.x;
-    rh.ray.org_y = ray.o.y;
-    rh.ray.org_z = ray.o.z;
-    rh.ray.tnear = ray.mint;
-    rh.ray.dir_x = ray.d.x;
-    rh.ray.dir_y = ray.d.y;
-    rh.ray.dir_z = ray.d.z;
-    rh.ray.time = 0.f;
-    rh.ray.tfar = ray.maxt;
-    rh.ray.mask = 0xFFFFFFFFu; // the Debian build has ray masks on: any other value can miss
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    set_embree_ray(a, b, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -322,22 +349,13 @@ bool Scene::ray_test(const Ray &ray) const { return occluded(ray); }
 
 inline bool Scene::occluded(const Ray &ray) const {
     count_ray();
-    if (!embree_can_trace(ray)) return false;
+    __m128 a, b;
+    ray_words(ray, a, b);
+    if (!embree_can_trace(a, b)) return false;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay r;
-    r.org_x = ray.o.x;
-    r.org_y = ray.o.y;
-    r.org_z = ray.o.z;
-    r.tnear = ray.mint;
-    r.dir_x = ray.d.x;
-    r.dir_y = ray.d.y;
-    r.dir_z = ray.d.z;
-    r.time = 0.f;
-    r.tfar = ray.maxt;
-    r.mask = 0xFFFFFFFFu;
-    r.id = 0;
-    r.flags = 0;
+    set_embree_ray(a, b, r);
     rtcOccluded1(m_rtc_scene, &context, &r);
     // Embree sets tfar to -inf when something was hit.
     return r.tfar == -Infinity;

@@ -234,6 +234,23 @@ TEST(HostileScene, RaysEmbreeCannotTakeMissInsteadOfAborting) {
     Ray far(Point3f(1e19f, 0.f, 5.f), Vector3f(0.f, 0.f, -1.f), 0.f, Infinity);
     EXPECT_FALSE(scene->ray_intersect(far, si));
     EXPECT_FALSE(scene->ray_test(far));
+    // Each field on its own: NaN anywhere, or beyond the range in the origin or direction.
+    auto field = [](Ray &r, int k) -> float & {
+        float *f[8] = {&r.o.x, &r.o.y, &r.o.z, &r.d.x, &r.d.y, &r.d.z, &r.mint, &r.maxt};
+        return *f[k];
+    };
+    for (int k = 0; k < 8; ++k)
+        for (float bad : {float(NAN), 1e19f, -1e19f}) {
+            if (k >= 6 && !std::isnan(bad)) continue; // a huge mint or maxt is valid (below)
+            Ray r = good;
+            field(r, k) = bad;
+            EXPECT_FALSE(scene->ray_intersect(r, si)) << "field " << k << " = " << bad;
+            EXPECT_FALSE(scene->ray_test(r)) << "field " << k << " = " << bad;
+        }
+    Ray long_ray = good;
+    long_ray.maxt = 1e19f;
+    EXPECT_TRUE(scene->ray_intersect(long_ray, si));
+    EXPECT_TRUE(scene->ray_test(long_ray));
 }
 
 // -- Memory ---------------------------------------------------------------------------------------

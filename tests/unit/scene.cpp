@@ -175,6 +175,22 @@ TEST(SceneQuery, IntersectionRecords) {
     EXPECT_FALSE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.4f)));
     EXPECT_TRUE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.6f)));
     EXPECT_FALSE(scene.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 3.6f, 4.9f)));
+    // And so do closest-hit queries: the sphere's top at t = 2.5, its bottom at 3.5, the floor
+    // at 5; along every axis (each component of the origin and direction reaches Embree).
+    EXPECT_FALSE(scene.ray_intersect(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.4f), si));
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.6f), si));
+    EXPECT_NEAR(si.t, 2.5f, 1e-5f);
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 3.f, 10.f), si));
+    EXPECT_NEAR(si.t, 3.5f, 1e-5f);
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 4.f, 10.f), si));
+    EXPECT_NEAR(si.t, 5.f, 1e-5f);
+    EXPECT_EQ(si.shape, scene.shapes()[0].get());
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(0, -3, 2), Vector3f(0, 1, 0), 0.f, 10.f), si));
+    EXPECT_NEAR(si.t, 2.5f, 1e-5f);
+    expect_near_vec(si.n, Vector3f(0, -1, 0), 1e-5f);
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-4, 0, 2), Vector3f(1, 0, 0), 0.f, 10.f), si));
+    EXPECT_NEAR(si.t, 3.5f, 1e-5f);
+    expect_near_vec(si.n, Vector3f(-1, 0, 0), 1e-5f);
 }
 
 namespace {
