@@ -32,6 +32,7 @@ bounces, Russian roulette ends paths whose throughput has become small.
 #include <facet/properties.h>
 #include <facet/sampler.h>
 #include <facet/scene.h>
+#include <facet/shape.h>
 
 #include <fmt/format.h>
 
@@ -73,8 +74,11 @@ public:
                               environment_mis(scene, si, prev_si, prev_bsdf_pdf, prev_bsdf_delta);
                 break;
             }
+            // The emitter and BSDF of the shape hit, read inline (si.emitter() and si.bsdf()
+            // are calls into the library).
+            const Shape *shape = si.shape;
             if (count_emission) {
-                if (const Emitter *emitter = si.emitter()) {
+                if (const Emitter *emitter = shape ? shape->emitter() : nullptr) {
                     Color3f L = emitter->eval(si);
                     if (!L.is_black()) {
                         float w = 1.f;
@@ -89,7 +93,7 @@ public:
             }
 
             if (depth + 1 >= m_max_depth) break;
-            const BSDF *bsdf = si.bsdf();
+            const BSDF *bsdf = shape ? shape->bsdf() : nullptr;
             if (!bsdf) break;
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
