@@ -12,8 +12,10 @@
 #include <facet/shape.h>
 #include <facet/warp.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -601,6 +603,33 @@ TEST(ShapeSampling, MeshPicksTrianglesByArea) {
     EXPECT_NEAR(upper, 30000, 5 * 87);
     // The centroid of the second triangle has x = 1.
     EXPECT_NEAR(mean_x / upper, 1.0, 0.02);
+}
+
+TEST(ShapeSampling, MeshPicksTheTriangleOfEachCdfInterval) {
+    // n triangles of area 1 at z = 0, 1, ..., n - 1: the cumulative areas are (k + 1) / n. A
+    // sample u.x picks the first triangle whose cumulative area exceeds it, so a value on a
+    // boundary belongs to the next triangle. Few triangles (a light) and many (a binary search).
+    for (int n : {2, 3, 8, 9, 12}) {
+        SCOPED_TRACE(n);
+        TempDir dir;
+        std::string obj;
+        for (int k = 0; k < n; ++k) obj += fmt::format("v 0 0 {0}\nv 2 0 {0}\nv 0 1 {0}\n", k);
+        for (int k = 0; k < n; ++k)
+            obj += fmt::format("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+        auto mesh = make_mesh("obj", file_props(dir.write("tris.obj", obj)));
+        ASSERT_NEAR(mesh->surface_area(), float(n), 1e-5f);
+        auto picked = [&](float ux) {
+            return int(std::lround(mesh->sample_position(Point2f(ux, 0.5f)).p.z));
+        };
+        EXPECT_EQ(picked(0.f), 0);
+        EXPECT_EQ(picked(OneMinusEpsilon), n - 1);
+        EXPECT_EQ(picked(1.f), n - 1);
+        for (int k = 0; k + 1 < n; ++k) {
+            const float boundary = float(double(k + 1) / double(n));
+            EXPECT_EQ(picked(std::nextafter(boundary, 0.f)), k) << "below boundary " << k;
+            EXPECT_EQ(picked(boundary), k + 1) << "on boundary " << k;
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

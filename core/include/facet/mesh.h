@@ -135,10 +135,18 @@ inline void Mesh::flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceIntera
 }
 
 inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
-    // Pick a triangle in proportion to its area and reuse the sample within its interval.
-    size_t f =
-        size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) - m_area_cdf.begin());
-    f = std::min(f, m_area_cdf.size() - 1);
+    // Pick a triangle in proportion to its area and reuse the sample within its interval: the
+    // first whose cumulative area exceeds u.x (the last one if none does), by a linear scan for
+    // the few triangles of a typical light.
+    const size_t count = m_area_cdf.size();
+    size_t f = 0;
+    if (count <= 8) {
+        while (f + 1 < count && !(u.x < m_area_cdf[f])) ++f;
+    } else {
+        f = size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) -
+                   m_area_cdf.begin());
+        f = std::min(f, count - 1);
+    }
     const float lo = f > 0 ? m_area_cdf[f - 1] : 0.f, hi = m_area_cdf[f];
     u.x = hi > lo ? clamp((u.x - lo) / (hi - lo), 0.f, OneMinusEpsilon) : 0.f;
 
