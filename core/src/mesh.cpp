@@ -356,6 +356,27 @@ void Mesh::compute_surface_interaction(const Ray &ray, float /*t*/, uint32_t pri
     si.sh_frame = shading_frame(ns, si.dp_du);
 }
 
+size_t Mesh::find_area_face(float u_x) const {
+    size_t f =
+        size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u_x) - m_area_cdf.begin());
+    return std::min(f, m_area_cdf.size() - 1);
+}
+
+Normal3f Mesh::face_normal(size_t f) const {
+    const Point3f p0 = vertex_position(m_faces[3 * f]), p1 = vertex_position(m_faces[3 * f + 1]),
+                  p2 = vertex_position(m_faces[3 * f + 2]);
+    Normal3f n = normalize(cross(p1 - p0, p2 - p0));
+    return m_flip_normals ? -n : n;
+}
+
+Point2f Mesh::face_uv(size_t f, const Point2f &b) const {
+    const uint32_t i0 = m_faces[3 * f], i1 = m_faces[3 * f + 1], i2 = m_faces[3 * f + 2];
+    const float b0 = 1.f - b.x - b.y;
+    return Point2f(m_uvs[2 * i0], m_uvs[2 * i0 + 1]) * b0 +
+           Point2f(m_uvs[2 * i1], m_uvs[2 * i1 + 1]) * b.x +
+           Point2f(m_uvs[2 * i2], m_uvs[2 * i2 + 1]) * b.y;
+}
+
 PositionSample Mesh::sample_position(const Point2f &u) const {
     PositionSample ps;
     if (m_area_cdf.empty() || !(m_area > 0.f)) return ps;

@@ -106,6 +106,11 @@ private:
     std::vector<float> m_face_table;
     std::vector<Attribute> m_attributes;
     std::vector<float> m_area_cdf; ///< cumulative triangle areas, normalised
+    /// sample_point()'s out-of-line parts: the face of u_x in m_area_cdf by a binary search, the
+    /// unit normal of face f (flip_normals applied) and the uv at barycentrics b of face f.
+    size_t find_area_face(float u_x) const;
+    Normal3f face_normal(size_t f) const;
+    Point2f face_uv(size_t f, const Point2f &b) const;
     float m_area = 0.f;
     BoundingBox3f m_bbox;
 };
@@ -137,15 +142,14 @@ inline void Mesh::flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceIntera
 inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
     // Pick a triangle in proportion to its area and reuse the sample within its interval: the
     // first whose cumulative area exceeds u.x (the last one if none does), by a linear scan for
-    // the few triangles of a typical light.
+    // the few triangles of a typical light. (The rarer cases are out of line, so that this
+    // stays small enough to inline.)
     const size_t count = m_area_cdf.size();
     size_t f = 0;
     if (count <= 8) {
         while (f + 1 < count && !(u.x < m_area_cdf[f])) ++f;
     } else {
-        f = size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u.x) -
-                   m_area_cdf.begin());
-        f = std::min(f, count - 1);
+        f = find_area_face(u.x);
     }
     const float lo = f > 0 ? m_area_cdf[f - 1] : 0.f, hi = m_area_cdf[f];
     u.x = hi > lo ? clamp((u.x - lo) / (hi - lo), 0.f, OneMinusEpsilon) : 0.f;
@@ -159,15 +163,9 @@ inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
         const float *t = &m_face_table[9 * f];
         ps.n = Normal3f(t[0], t[1], t[2]);
     } else {
-        Normal3f n = normalize(cross(p1 - p0, p2 - p0));
-        ps.n = m_flip_normals ? -n : n;
+        ps.n = face_normal(f);
     }
-    if (has_uvs())
-        ps.uv = Point2f(m_uvs[2 * i0], m_uvs[2 * i0 + 1]) * b0 +
-                Point2f(m_uvs[2 * i1], m_uvs[2 * i1 + 1]) * b.x +
-                Point2f(m_uvs[2 * i2], m_uvs[2 * i2 + 1]) * b.y;
-    else
-        ps.uv = b;
+    ps.uv = has_uvs() ? face_uv(f, b) : b;
     ps.pdf = 1.f / m_area;
     ps.delta = false;
 }
