@@ -110,6 +110,16 @@ void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
         const int x1 = std::min(s.x - 1, floor_to_int(px + 0.5f) - ox);
         const int y0 = std::max(0, ceil_to_int(py - 0.5f) - oy);
         const int y1 = std::min(s.y - 1, floor_to_int(py + 0.5f) - oy);
+        if (x0 == x1 && y0 == y1) {
+            // One candidate pixel (the sample is not on a pixel boundary): the loops below
+            // without their set-up.
+            const float w = ReconstructionFilter::box_eval(px - float(ox + x0)) *
+                            ReconstructionFilter::box_eval(py - float(oy + y0));
+            if (w != 0.f)
+                add_sample(m_data.data() + size_t(y0) * size_t(s.x) * nc + size_t(x0) * nc, w, L,
+                           aovs, m_aov_count);
+            return;
+        }
         for (int y = y0; y <= y1; ++y) {
             const float wy = ReconstructionFilter::box_eval(py - float(oy + y));
             if (wy == 0.f) continue;
