@@ -1,8 +1,9 @@
 # `facet bench`'s equal-error mode (label bench): tests/bench/equal_error_test.sh on the Cornell
-# box and an environment-lit material scene at tiny resolutions. tests/bench/make_ply.py writes
-# the 1M-triangle PLY of the README's loading benchmark (not a test: it takes seconds).
+# box, an environment-lit material scene and a large area light close to a floor (near-light) at
+# tiny resolutions. tests/bench/make_ply.py writes the 1M-triangle PLY of the README's loading
+# benchmark (not a test: it takes seconds).
 if(TARGET facet_cli)
-    foreach(scene cornell-box/scene.xml materials/rough-copper.xml)
+    foreach(scene cornell-box/scene.xml materials/rough-copper.xml near-light/scene.xml)
         get_filename_component(_name ${scene} NAME_WE)
         get_filename_component(_dir ${scene} DIRECTORY)
         add_test(NAME bench.equal_error.${_dir}
