@@ -1,11 +1,12 @@
 static const char *DOC = R"DOC(
 # bitmap: image texture
 
-An image file (PNG, JPEG, EXR, HDR, TIFF, ... anything OpenImageIO reads) looked up by the
-texture coordinates of the surface point. The pixel at the top-left corner of the image is at
-uv = (0, 0) and u grows to the right, v downwards, as in Mitsuba; mesh loaders that flip v (OBJ,
-by default) therefore show the image's top row at the file's v = 1. Outside [0, 1]² the image
-repeats, mirrors or clamps as `wrap_mode` says.
+An image file (OpenEXR, PNG, JPEG, Radiance RGBE, PFM and PNM, Targa, BMP or TIFF, read through
+OpenImageIO by the reader the extension names, or else the one that recognises the contents)
+looked up by the texture coordinates of the surface point. The pixel at the top-left corner of
+the image is at uv = (0, 0) and u grows to the right, v downwards, as in Mitsuba; mesh loaders
+that flip v (OBJ, by default) therefore show the image's top row at the file's v = 1. Outside
+[0, 1]² the image repeats, mirrors or clamps as `wrap_mode` says.
 
 8-bit and 16-bit formats (PNG, JPEG, ...) store sRGB-encoded values and are decoded to linear
 RGB on load, unless `raw` is set (for data such as roughness, opacity or normal maps); EXR, HDR

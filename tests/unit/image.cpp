@@ -382,6 +382,46 @@ TEST_F(ImageIO, ReadErrorsNameTheFile) {
     }
 }
 
+TEST_F(ImageIO, ReadsItsFormatsByContentsAndNoOthers) {
+    Image img = gradient(4, 3, 3);
+    img.channel_names = {"R", "G", "B"};
+    write_image(path("a.png"), img);
+    const Image png = read_image(path("a.png"));
+    // A PNG whose name says otherwise, or nothing, is read by the reader that recognises it.
+    for (const char *name : {"named.jpg", "named.cr2", "no-extension"}) {
+        fs::copy_file(path("a.png"), path(name));
+        const Image back = read_image(path(name));
+        ASSERT_EQ(back.width, 4) << name;
+        EXPECT_EQ(back.data, png.data) << name;
+    }
+    // A format OpenImageIO reads but facet does not: refused by name, whatever reads it.
+    {
+        auto out = OIIO::ImageOutput::create(path("a.gif"));
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(4, 3, 3, OIIO::TypeDesc::UINT8);
+        std::vector<unsigned char> pixels(4 * 3 * 3, 100);
+        ASSERT_TRUE(out->open(path("a.gif"), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+        out->close();
+        ASSERT_TRUE(OIIO::ImageInput::open(path("a.gif"))) << OIIO::geterror();
+    }
+    std::ofstream(path("junk.cr2")) << "not a camera raw file";
+    for (const auto &[name, says] : {std::pair<std::string, std::string>{"a.gif", "gif files"},
+                                     {"junk.cr2", "raw files"},
+                                     {"junk.unknown", "extension names no image format"}}) {
+        if (!fs::exists(path(name))) std::ofstream(path(name)) << "junk";
+        try {
+            read_image(path(name));
+            FAIL() << name << ": expected an error";
+        } catch (const Error &e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find(name), std::string::npos) << what;
+            EXPECT_NE(what.find(says), std::string::npos) << what;
+            EXPECT_NE(what.find("facet reads OpenEXR"), std::string::npos) << what;
+        }
+    }
+}
+
 TEST(OcioConfig, SearchOrder) {
     EXPECT_EQ(ocio_config_path("/explicit/config.ocio"), "/explicit/config.ocio");
     const char *old = std::getenv("OCIO");
