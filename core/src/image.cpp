@@ -520,11 +520,34 @@ void check_image_output(const std::string &path, const ImageWriteOptions &opts) 
 }
 namespace {
 
+/// Bytes OpenEXR (3.1) reads for a value of each fixed-size attribute type, whatever size the
+/// file gives it.
+int exr_fixed_size(const std::string &type) {
+    static const std::map<std::string, int> sizes = {
+        {"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
+        {"compression", 1}, {"double", 8},   {"envmap", 1},
+        {"float", 4},       {"int", 4},      {"keycode", 28},
+        {"lineOrder", 1},   {"m33f", 36},    {"m44f", 64},
+        {"m33d", 72},       {"m44d", 128},   {"rational", 8},
+        {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
+        {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
+        {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
+    auto it = sizes.find(type);
+    return it == sizes.end() ? -1 : it->second;
+}
+
 /**
- * OpenEXR (3.1) allocates every header attribute at the size the file gives before reading it,
- * so a 1 KB file whose attribute claims 1.7 GB costs that much memory and a minute. The headers
- * are scanned here first: every attribute must fit in the rest of the file. Only the first MiB
- * is scanned (headers are a few KB; a longer one is left to OpenEXR).
+ * OpenEXR (3.1) allocates header attributes at sizes the file gives before reading them, so a
+ * 1 KB file whose attribute claims 1.7 GB costs that much memory and a minute. The headers are
+ * scanned here first, the way OpenEXR reads them:
+ * - every attribute must fit in the rest of the file;
+ * - a value OpenEXR reads by its contents (fixed-size types, a channel list, a string vector, a
+ *   preview image) must take exactly the bytes its size says: OpenEXR does not skip to the
+ *   declared end, so a value read past it or short of it makes OpenEXR read the next attribute
+ *   from the middle of a value (a channel list that ran on gave a 1.6 GB "attribute" from a
+ *   223-byte file);
+ * - the pixels the data window and the channel list declare must pass allocation_bytes().
+ * Only the first MiB is scanned (headers are a few KB; a longer one is left to OpenEXR).
  */
 void check_exr_headers(const std::string &path) {
     std::FILE *f = std::fopen(path.c_str(), "rb");
@@ -539,31 +562,88 @@ void check_exr_headers(const std::string &path) {
     if (n < 8 || buf[0] != 0x76 || buf[1] != 0x2f || buf[2] != 0x31 || buf[3] != 0x01) return;
     const bool multipart = (buf[5] & 0x10) != 0; // version field bit 12
     size_t pos = 8;
-    auto cstring = [&](std::string &out) {
+    auto cstring = [&](size_t &at, size_t limit, std::string &out) {
         out.clear();
-        while (pos < n && buf[pos] != 0 && out.size() < 256) out += char(buf[pos++]);
-        if (pos >= n || buf[pos] != 0) return false;
-        ++pos;
+        while (at < limit && buf[at] != 0 && out.size() < 256) out += char(buf[at++]);
+        if (at >= limit || buf[at] != 0) return false;
+        ++at;
         return true;
     };
-    std::string name, type;
+    auto int32_at = [&](size_t at) {
+        int32_t v;
+        std::memcpy(&v, buf.data() + at, 4);
+        return v;
+    };
+    auto fail = [&](const std::string &name, const std::string &type, const std::string &why) {
+        FACET_THROW("cannot read image \"{}\": the EXR attribute \"{}\" ({}) {}", path, name, type,
+                    why);
+    };
+    std::string name, type, channel;
     for (int header = 0; pos < n; ++header) {
         if (buf[pos] == 0) break; // an empty header ends the list of a multi-part file
+        int64_t width = 0, height = 0, pixel_bytes = -1;
         for (;;) {
             if (pos >= n) return;
             if (buf[pos] == 0) {
                 ++pos;
                 break;
             }
-            if (!cstring(name) || !cstring(type) || pos + 4 > n) return;
-            int32_t size;
-            std::memcpy(&size, buf.data() + pos, 4);
+            if (!cstring(pos, n, name) || !cstring(pos, n, type) || pos + 4 > n) return;
+            const int32_t size = int32_at(pos);
             pos += 4;
             if (size < 0 || int64_t(size) > int64_t(file_size) - int64_t(pos))
-                FACET_THROW("cannot read image \"{}\": the EXR attribute \"{}\" claims {} bytes, "
-                            "more than the file holds",
-                            path, name, size);
-            pos += size_t(size);
+                fail(name, type, fmt::format("claims {} bytes, more than the file holds", size));
+            const size_t end = pos + size_t(size);
+            if (end > n) return; // past the scanned MiB
+            if (const int fixed = exr_fixed_size(type); fixed >= 0 && size != fixed) {
+                fail(name, type, fmt::format("has {} bytes instead of {}", size, fixed));
+            } else if (type == "chlist") {
+                // Channels (a name, then type, pLinear, 3 reserved bytes, x and y sampling),
+                // then an empty name.
+                size_t at = pos;
+                pixel_bytes = 0;
+                for (;;) {
+                    if (at < end && buf[at] == 0) {
+                        ++at;
+                        break;
+                    }
+                    if (!cstring(at, end, channel) || at + 16 > end)
+                        fail(name, type, "runs past its size");
+                    const int32_t pixel_type = int32_at(at);
+                    pixel_bytes += pixel_type == 1 ? 2 : 4; // HALF, or UINT and FLOAT
+                    at += 16;
+                }
+                if (at != end) fail(name, type, "ends before its size");
+            } else if (type == "stringvector") {
+                size_t at = pos;
+                while (at < end) {
+                    const int32_t length = at + 4 <= end ? int32_at(at) : -1;
+                    if (length < 0 || int64_t(length) > int64_t(end - at - 4))
+                        fail(name, type, "has a string that runs past its size");
+                    at += 4 + size_t(length);
+                }
+            } else if (type == "floatvector") {
+                if (size % 4 != 0) fail(name, type, "is not a whole number of floats");
+            } else if (type == "preview") {
+                const uint32_t w = size >= 8 ? uint32_t(int32_at(pos)) : 0;
+                const uint32_t h = size >= 8 ? uint32_t(int32_at(pos + 4)) : 0;
+                if (size < 8 || uint64_t(w) * h * 4 != uint64_t(size) - 8)
+                    fail(name, type, "declares a size its pixels do not have");
+            } else if (type == "idmanifest") {
+                fail(name, type, "is not read by facet"); // parsed by its contents in OpenEXR
+            }
+            if (type == "box2i" && name == "dataWindow") {
+                width = int64_t(int32_at(pos + 8)) - int32_at(pos) + 1;
+                height = int64_t(int32_at(pos + 12)) - int32_at(pos + 4) + 1;
+            }
+            pos = end;
+        }
+        // The pixels of this part at full resolution, before OpenEXR sizes its buffers by them.
+        size_t pixels = 0;
+        if (width > 0 && height > 0 && pixel_bytes > 0) {
+            if (!checked_mul(size_t(width), size_t(height), pixels))
+                pixels = std::numeric_limits<size_t>::max();
+            allocation_bytes(pixels, size_t(pixel_bytes), path, "EXR data window");
         }
         if (!multipart) break;
     }

@@ -347,8 +347,88 @@ TEST(HostileImages, ExrAttributesLargerThanTheFile) {
         ADD_FAILURE() << "expected an error";
     } catch (const Error &e) {
         EXPECT_CONTAINS(e.what(), "attr.exr");
-        EXPECT_CONTAINS(e.what(), "\"capDate\" claims 1701994871 bytes");
+        EXPECT_CONTAINS(e.what(), "\"capDate\" (string) claims 1701994871 bytes");
     }
+}
+
+namespace {
+
+/// A small valid EXR (written by OpenImageIO) as bytes.
+std::string small_exr(const TempDir &dir, int w = 4, int h = 3) {
+    std::string path = dir.write("valid.exr", "");
+    OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::HALF);
+    std::vector<float> pixels(size_t(w) * size_t(h) * 3, 0.5f);
+    auto out = OIIO::ImageOutput::create(path);
+    EXPECT_TRUE(out && out->open(path, spec));
+    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    out->close();
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// `exr` with the size field of the attribute `name` of type `type` changed by `delta`.
+std::string resize_attribute(std::string exr, const std::string &name, const std::string &type,
+                             int delta) {
+    const std::string key = name + '\0' + type + '\0';
+    const size_t at = exr.find(key);
+    EXPECT_NE(at, std::string::npos) << key;
+    int32_t size;
+    std::memcpy(&size, exr.data() + at + key.size(), 4);
+    size += delta;
+    std::memcpy(exr.data() + at + key.size(), &size, 4);
+    return exr;
+}
+
+std::string read_error(const std::string &path) {
+    try {
+        read_image(path);
+    } catch (const Error &e) {
+        return e.what();
+    }
+    ADD_FAILURE() << path << ": expected an error";
+    return "";
+}
+
+} // namespace
+
+TEST(HostileImages, ExrAttributesReadPastOrShortOfTheirSize) {
+    // Found by the image fuzz target: OpenEXR reads a channel list up to its terminating empty
+    // name, not up to its declared size. A list that ran on past its size made OpenEXR read the
+    // next "attribute" from the middle of a value, one claiming 1.6 GB, in a 223-byte file.
+    TempDir dir;
+    const std::string exr = small_exr(dir);
+    ASSERT_EQ(read_image(dir.write("ok.exr", exr)).width, 4);
+    struct Case {
+        const char *name, *type;
+        int delta;
+        const char *says;
+    } cases[] = {
+        {"channels", "chlist", -1, "\"channels\" (chlist) runs past its size"},
+        {"channels", "chlist", +1, "\"channels\" (chlist) ends before its size"},
+        {"compression", "compression", +1, "(compression) has 2 bytes instead of 1"},
+        {"dataWindow", "box2i", -4, "(box2i) has 12 bytes instead of 16"},
+        {"screenWindowWidth", "float", +3, "(float) has 7 bytes instead of 4"},
+    };
+    for (const Case &c : cases) {
+        SCOPED_TRACE(c.says);
+        const std::string msg =
+            read_error(dir.write("bad.exr", resize_attribute(exr, c.name, c.type, c.delta)));
+        EXPECT_CONTAINS(msg, "bad.exr");
+        EXPECT_CONTAINS(msg, c.says);
+    }
+}
+
+TEST(HostileImages, ExrDataWindowWithinTheAllocationLimit) {
+    // The data window's pixels are checked before OpenEXR sizes its buffers by them.
+    TempDir dir;
+    const std::string path = dir.write("big.exr", small_exr(dir, 64, 64));
+    LimitGuard guard;
+    set_allocation_limit(64 * 64 * 6 - 1); // three half channels
+    const std::string msg = read_error(path);
+    EXPECT_CONTAINS(msg, "big.exr");
+    EXPECT_CONTAINS(msg, "EXR data window: 4096 items of 6 bytes");
+    set_allocation_limit(64 * 64 * 3 * sizeof(float)); // what read_image itself allocates
+    EXPECT_EQ(read_image(path).width, 64);
 }
 
 TEST(HostileImages, ValidImagesStillRead) {
