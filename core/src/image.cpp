@@ -649,6 +649,49 @@ void check_exr_headers(const std::string &path) {
     }
 }
 
+/**
+ * OpenImageIO (2.4) decodes an RLE-compressed BMP whole as it opens the file, into a buffer of
+ * a byte per pixel sized from the header: a 55-byte file declaring 604 million by 3 pixels took
+ * 1.9 GB and 2 s before any size could be checked. So the header is read here first: the
+ * pixels must pass allocation_bytes() (as floats, as read_image() will hold them), and an RLE
+ * image may have at most 256 pixels per byte of the file (a run of 255 pixels takes two bytes;
+ * only pixels the file leaves undefined can make an image sparser).
+ */
+void check_bmp_header(const std::string &path) {
+    std::FILE *f = std::fopen(path.c_str(), "rb");
+    if (!f) return; // OpenImageIO reports it
+    unsigned char h[34] = {};
+    const size_t n = std::fread(h, 1, sizeof h, f);
+    std::fseek(f, 0, SEEK_END);
+    const long file_size = std::ftell(f);
+    std::fclose(f);
+    if (n < 26 || h[0] != 'B' || h[1] != 'M') return; // too short: OpenImageIO reports it
+    auto u32 = [&](int at) {
+        return uint32_t(h[at]) | uint32_t(h[at + 1]) << 8 | uint32_t(h[at + 2]) << 16 |
+               uint32_t(h[at + 3]) << 24;
+    };
+    const uint32_t header_size = u32(14);
+    int64_t width, height;
+    uint32_t compression = 0;
+    if (header_size == 12) { // OS/2 BITMAPCOREHEADER: 16-bit sizes, no compression
+        width = int64_t(h[18] | h[19] << 8);
+        height = int64_t(h[20] | h[21] << 8);
+    } else {
+        width = std::abs(int64_t(int32_t(u32(18))));
+        height = std::abs(int64_t(int32_t(u32(22)))); // negative: rows stored top down
+        if (n >= 34) compression = u32(30);
+    }
+    size_t pixels = 0;
+    if (!checked_mul(size_t(width), size_t(height), pixels))
+        pixels = std::numeric_limits<size_t>::max();
+    allocation_bytes(pixels, sizeof(float), path, "BMP pixels");
+    const bool rle = compression == 1 || compression == 2;
+    if (rle && file_size > 0 && pixels / 256 > size_t(file_size))
+        FACET_THROW("cannot read image \"{}\": the RLE-compressed BMP declares {}x{} pixels, more "
+                    "than 256 per byte of its {}-byte file",
+                    path, width, height, file_size);
+}
+
 /// The image formats facet reads: Mitsuba 3's (OpenEXR, PNG, JPEG, Radiance RGBE, PFM and the
 /// other PNM formats, Targa, BMP) and TIFF, by OpenImageIO's names for its readers.
 constexpr const char *ReadableFormats[] = {"openexr", "png",   "jpeg", "hdr",
@@ -700,6 +743,7 @@ Image read_image(const std::string &path) {
         FACET_THROW("cannot read image \"{}\": {}", path,
                     fs::exists(path, ec) ? "not a regular file" : "no such file");
     check_exr_headers(path);
+    check_bmp_header(path);
     auto in = open_image(path);
     const OIIO::ImageSpec spec = in->spec();
     // The header's sizes are checked before anything is allocated: positive, a 2D flat image,

@@ -431,6 +431,35 @@ TEST(HostileImages, ExrDataWindowWithinTheAllocationLimit) {
     EXPECT_EQ(read_image(path).width, 64);
 }
 
+TEST(HostileImages, BmpHeadersAreCheckedBeforeOpenImageIODecodes) {
+    // Found by the image fuzz target: OpenImageIO decodes an RLE BMP whole as it opens it, into
+    // a buffer sized from the header (1.9 GB and 2 s for these 55 bytes).
+    TempDir dir;
+    const unsigned char rle[] = {0x42, 0x4d, 0x5a, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x36,
+                                 0x00, 0x00, 0x00, 0x28, 0x00, 0x00, 0x00, 0x04, 0x00, 0x00, 0x24,
+                                 0x03, 0x00, 0x00, 0x00, 0x01, 0x00, 0x18, 0x00, 0x02, 0x00, 0x00,
+                                 0x00, 0x0c, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x5d,
+                                 0xff, 0xff, 0xf9, 0x00, 0x00, 0x00, 0xff, 0xfb, 0xff, 0xff, 0x00};
+    std::string msg = read_error(dir.write("rle.bmp", std::string(rle, rle + sizeof rle)));
+    EXPECT_CONTAINS(msg, "rle.bmp");
+    EXPECT_CONTAINS(msg, "RLE-compressed BMP declares 603979780x3 pixels");
+
+    // An uncompressed BMP reads, and its pixels count against the allocation limit first.
+    std::string path = dir.write("ok.bmp", "");
+    OIIO::ImageSpec spec(40, 30, 3, OIIO::TypeDesc::UINT8);
+    std::vector<unsigned char> pixels(40 * 30 * 3, 77);
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out && out->open(path, spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    out->close();
+    EXPECT_EQ(read_image(path).width, 40);
+    LimitGuard guard;
+    set_allocation_limit(40 * 30 * sizeof(float) - 1);
+    msg = read_error(path);
+    EXPECT_CONTAINS(msg, "ok.bmp");
+    EXPECT_CONTAINS(msg, "BMP pixels: 1200 items of 4 bytes");
+}
+
 TEST(HostileImages, ValidImagesStillRead) {
     TempDir dir;
     std::string pfm = "PF\n2 1\n-1.0\n";
