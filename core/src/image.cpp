@@ -536,6 +536,30 @@ int exr_fixed_size(const std::string &type) {
     return it == sizes.end() ? -1 : it->second;
 }
 
+/// The most raw pixel bytes an EXR compression can store per byte of file, with a factor of two
+/// to spare, or 0 where there is no useful bound: none 1, RLE 64 (a run of 128 bytes in 2),
+/// ZIP and ZIPS 1032 (deflate's limit), PXR24 4/3 of that (24 of 32 bits kept), B44 32/14 and
+/// B44A 32/3 (a flat 4x4 block of halves in 3 bytes). PIZ and DWA have no such limit.
+double exr_max_ratio(int compression) {
+    switch (compression) {
+    case 0:
+        return 2.0;
+    case 1:
+        return 128.0;
+    case 2:
+    case 3:
+        return 2 * 1032.0;
+    case 5:
+        return 2 * 1032.0 * 4.0 / 3.0;
+    case 6:
+        return 2 * 32.0 / 14.0;
+    case 7:
+        return 2 * 32.0 / 3.0;
+    default:
+        return 0.0;
+    }
+}
+
 /**
  * OpenEXR (3.1) allocates header attributes at sizes the file gives before reading them, so a
  * 1 KB file whose attribute claims 1.7 GB costs that much memory and a minute. The headers are
@@ -546,7 +570,8 @@ int exr_fixed_size(const std::string &type) {
  *   declared end, so a value read past it or short of it makes OpenEXR read the next attribute
  *   from the middle of a value (a channel list that ran on gave a 1.6 GB "attribute" from a
  *   223-byte file);
- * - the pixels the data window and the channel list declare must pass allocation_bytes().
+ * - the pixels the data window and the channel list declare must pass allocation_bytes(), and
+ *   fit in the file at the best ratio the compression can reach (exr_max_ratio()).
  * Only the first MiB is scanned (headers are a few KB; a longer one is left to OpenEXR).
  */
 void check_exr_headers(const std::string &path) {
@@ -582,6 +607,9 @@ void check_exr_headers(const std::string &path) {
     for (int header = 0; pos < n; ++header) {
         if (buf[pos] == 0) break; // an empty header ends the list of a multi-part file
         int64_t width = 0, height = 0, pixel_bytes = -1;
+        double sampled_bytes = 0.0; // per pixel, for channels stored at 1/(xs ys) of the pixels
+        int compression = -1;
+        bool deep = false;
         for (;;) {
             if (pos >= n) return;
             if (buf[pos] == 0) {
@@ -610,7 +638,10 @@ void check_exr_headers(const std::string &path) {
                     if (!cstring(at, end, channel) || at + 16 > end)
                         fail(name, type, "runs past its size");
                     const int32_t pixel_type = int32_at(at);
-                    pixel_bytes += pixel_type == 1 ? 2 : 4; // HALF, or UINT and FLOAT
+                    const int bytes = pixel_type == 1 ? 2 : 4; // HALF, or UINT and FLOAT
+                    const int32_t xs = int32_at(at + 8), ys = int32_at(at + 12);
+                    pixel_bytes += bytes;
+                    if (xs > 0 && ys > 0) sampled_bytes += bytes / (double(xs) * double(ys));
                     at += 16;
                 }
                 if (at != end) fail(name, type, "ends before its size");
@@ -632,6 +663,10 @@ void check_exr_headers(const std::string &path) {
             } else if (type == "idmanifest") {
                 fail(name, type, "is not read by facet"); // parsed by its contents in OpenEXR
             }
+            if (type == "compression" && name == "compression") compression = buf[pos];
+            if (type == "string" && name == "type")
+                deep = std::string(buf.begin() + long(pos), buf.begin() + long(end)).find("deep") !=
+                       std::string::npos;
             if (type == "box2i" && name == "dataWindow") {
                 width = int64_t(int32_at(pos + 8)) - int32_at(pos) + 1;
                 height = int64_t(int32_at(pos + 12)) - int32_at(pos + 4) + 1;
@@ -644,6 +679,13 @@ void check_exr_headers(const std::string &path) {
             if (!checked_mul(size_t(width), size_t(height), pixels))
                 pixels = std::numeric_limits<size_t>::max();
             allocation_bytes(pixels, size_t(pixel_bytes), path, "EXR data window");
+            // Pixels that cannot be in the file: more than its compression can pack into its
+            // bytes (OpenEXR pads a short chunk without an error).
+            const double bound = exr_max_ratio(compression) * double(file_size);
+            if (!deep && bound > 0.0 && double(pixels) * sampled_bytes > bound)
+                FACET_THROW("cannot read image \"{}\": its data window declares {}x{} pixels "
+                            "({:.0f} bytes), more than its compression can hold in {} bytes",
+                            path, width, height, double(pixels) * sampled_bytes, file_size);
         }
         if (!multipart) break;
     }

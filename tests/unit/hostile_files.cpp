@@ -431,6 +431,45 @@ TEST(HostileImages, ExrDataWindowWithinTheAllocationLimit) {
     EXPECT_EQ(read_image(path).width, 64);
 }
 
+TEST(HostileImages, ExrPixelsMustFitTheFilesCompression) {
+    // Found by the image fuzz target: a data window widened to 655368x8 in a 661-byte ZIP file
+    // read as 31 MB of pixels (OpenEXR pads a short chunk without an error), 20 s under the
+    // sanitizers.
+    TempDir dir;
+    std::string exr = small_exr(dir, 8, 8);
+    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const size_t at = exr.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const int32_t xmax = 655367;
+    std::memcpy(exr.data() + at + key.size() + 4 + 8, &xmax, 4);
+    const std::string msg = read_error(dir.write("wide.exr", exr));
+    EXPECT_CONTAINS(msg, "wide.exr");
+    EXPECT_CONTAINS(msg, "655368x8 pixels (31457664 bytes), more than its compression can hold");
+}
+
+TEST(HostileImages, ConstantExrsOfEveryCompressionStillRead) {
+    // The most compressible images there are, in every compression OpenEXR has: the ratio bound
+    // above must leave them alone.
+    TempDir dir;
+    const int w = 512, h = 512;
+    for (const char *compression :
+         {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"})
+        for (OIIO::TypeDesc type : {OIIO::TypeDesc::HALF, OIIO::TypeDesc::FLOAT}) {
+            SCOPED_TRACE(fmt::format("{} {}", compression, type.c_str()));
+            const std::string path = dir.write("flat.exr", "");
+            OIIO::ImageSpec spec(w, h, 3, type);
+            spec.attribute("compression", compression);
+            const std::vector<float> pixels(size_t(w) * h * 3, 0.f);
+            auto out = OIIO::ImageOutput::create(path);
+            ASSERT_TRUE(out && out->open(path, spec));
+            ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+            out->close();
+            const Image back = read_image(path);
+            EXPECT_EQ(back.width, w);
+            EXPECT_EQ(back.data, pixels);
+        }
+}
+
 TEST(HostileImages, BmpHeadersAreCheckedBeforeOpenImageIODecodes) {
     // Found by the image fuzz target: OpenImageIO decodes an RLE BMP whole as it opens it, into
     // a buffer sized from the header (1.9 GB and 2 s for these 55 bytes).
