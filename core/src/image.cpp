@@ -571,7 +571,9 @@ double exr_max_ratio(int compression) {
  *   from the middle of a value (a channel list that ran on gave a 1.6 GB "attribute" from a
  *   223-byte file);
  * - the pixels the data window and the channel list declare must pass allocation_bytes(), and
- *   fit in the file at the best ratio the compression can reach (exr_max_ratio()).
+ *   fit in the file at the best ratio the compression can reach (exr_max_ratio());
+ * - a tile (allocated whole) must pass allocation_bytes() and be at most 256x256 pixels or 4
+ *   times the data window (a 20x12 image in tiles of 8 x 16777224 took 2.2 GB and 4 s).
  * Only the first MiB is scanned (headers are a few KB; a longer one is left to OpenEXR).
  */
 void check_exr_headers(const std::string &path) {
@@ -610,6 +612,7 @@ void check_exr_headers(const std::string &path) {
         double sampled_bytes = 0.0; // per pixel, for channels stored at 1/(xs ys) of the pixels
         int compression = -1;
         bool deep = false;
+        int64_t tile_pixels = 0;
         for (;;) {
             if (pos >= n) return;
             if (buf[pos] == 0) {
@@ -667,6 +670,8 @@ void check_exr_headers(const std::string &path) {
             if (type == "string" && name == "type")
                 deep = std::string(buf.begin() + long(pos), buf.begin() + long(end)).find("deep") !=
                        std::string::npos;
+            if (type == "tiledesc" && name == "tiles")
+                tile_pixels = int64_t(uint32_t(int32_at(pos))) * uint32_t(int32_at(pos + 4));
             if (type == "box2i" && name == "dataWindow") {
                 width = int64_t(int32_at(pos + 8)) - int32_at(pos) + 1;
                 height = int64_t(int32_at(pos + 12)) - int32_at(pos + 4) + 1;
@@ -682,6 +687,14 @@ void check_exr_headers(const std::string &path) {
             // Pixels that cannot be in the file: more than its compression can pack into its
             // bytes (OpenEXR pads a short chunk without an error).
             const double bound = exr_max_ratio(compression) * double(file_size);
+            // OpenEXR and OpenImageIO allocate whole tiles; beyond the image they hold padding.
+            if (tile_pixels > 0) {
+                allocation_bytes(size_t(tile_pixels), size_t(pixel_bytes), path, "EXR tile");
+                if (uint64_t(tile_pixels) > std::max<uint64_t>(4 * uint64_t(pixels), 65536))
+                    FACET_THROW("cannot read image \"{}\": its tiles of {} pixels are larger "
+                                "than 256x256 and 4 times its {}x{}-pixel data window",
+                                path, tile_pixels, width, height);
+            }
             if (!deep && bound > 0.0 && double(pixels) * sampled_bytes > bound)
                 FACET_THROW("cannot read image \"{}\": its data window declares {}x{} pixels "
                             "({:.0f} bytes), more than its compression can hold in {} bytes",
@@ -801,6 +814,17 @@ Image read_image(const std::string &path) {
         !checked_mul(row, size_t(spec.height), values))
         values = std::numeric_limits<size_t>::max();
     allocation_bytes(values, sizeof(float), path, "image pixels");
+    // A band of whole tiles, converted to float by OpenImageIO in a buffer of its own.
+    if (spec.tile_width > 0) {
+        size_t tiles_x = 0, tile_values = 0;
+        const size_t tw = size_t(spec.tile_width), th = size_t(std::max(spec.tile_height, 1));
+        const size_t td = size_t(std::max(spec.tile_depth, 1));
+        if (!checked_mul((size_t(spec.width) + tw - 1) / tw, tw, tiles_x) ||
+            !checked_mul(tiles_x, th, tile_values) || !checked_mul(tile_values, td, tile_values) ||
+            !checked_mul(tile_values, size_t(spec.nchannels), tile_values))
+            tile_values = std::numeric_limits<size_t>::max();
+        allocation_bytes(tile_values, sizeof(float), path, "a row of image tiles");
+    }
 
     Image img;
     img.width = spec.width;

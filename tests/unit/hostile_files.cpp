@@ -447,6 +447,47 @@ TEST(HostileImages, ExrPixelsMustFitTheFilesCompression) {
     EXPECT_CONTAINS(msg, "655368x8 pixels (31457664 bytes), more than its compression can hold");
 }
 
+TEST(HostileImages, TilesArePaddingOnlyWithinReason) {
+    // Found by the image fuzz target: a 20x12 EXR in tiles of 8 x 16777224 pixels (654 bytes)
+    // made OpenEXR and OpenImageIO allocate whole tiles: 2.2 GB and 4 s.
+    TempDir dir;
+    const std::string path = dir.write("tiled.exr", "");
+    OIIO::ImageSpec spec(20, 12, 3, OIIO::TypeDesc::FLOAT);
+    spec.tile_width = spec.tile_height = 16;
+    const std::vector<float> pixels(20 * 12 * 3, 0.25f);
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out && out->open(path, spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    out->close();
+    EXPECT_EQ(read_image(path).data, pixels); // tiles larger than the image are fine
+
+    std::ifstream in(path, std::ios::binary);
+    std::string exr((std::istreambuf_iterator<char>(in)), {});
+    const std::string key = std::string("tiles") + '\0' + "tiledesc" + '\0';
+    const size_t at = exr.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const uint32_t tall = 16777224;
+    std::memcpy(exr.data() + at + key.size() + 4 + 4, &tall, 4);
+    std::string msg = read_error(dir.write("tall.exr", exr));
+    EXPECT_CONTAINS(msg, "tall.exr");
+    EXPECT_CONTAINS(msg, "its tiles of 268435584 pixels are larger than 256x256 and 4 times its "
+                         "20x12-pixel data window");
+
+    // Whatever the format, a row of tiles (converted by OpenImageIO in a buffer of its own)
+    // passes the allocation limit before it is read.
+    const std::string tif = dir.write("tiled.tif", "");
+    out = OIIO::ImageOutput::create(tif);
+    ASSERT_TRUE(out && out->open(tif, spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    out->close();
+    EXPECT_EQ(read_image(tif).data, pixels);
+    LimitGuard guard;
+    set_allocation_limit(20 * 12 * 3 * sizeof(float)); // the image, but not 32x16 of tiles
+    msg = read_error(tif);
+    EXPECT_CONTAINS(msg, "tiled.tif");
+    EXPECT_CONTAINS(msg, "a row of image tiles: 1536 items of 4 bytes");
+}
+
 TEST(HostileImages, ConstantExrsOfEveryCompressionStillRead) {
     // The most compressible images there are, in every compression OpenEXR has: the ratio bound
     // above must leave them alone.
