@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <tuple>
 #include <unistd.h>
@@ -278,7 +279,7 @@ std::string verify_written(const std::string &file, uintmax_t expected_size,
     if (size != expected_size)
         return fmt::format("the written file has {} bytes instead of {}", size, expected_size);
     // The temporary file's name has no image extension: the reader is chosen by the output's.
-    auto in = OIIO::ImageInput::create(ext.substr(1), /*do_open=*/false);
+    auto in = ext.size() > 1 ? OIIO::ImageInput::create(ext.substr(1), /*do_open=*/false) : nullptr;
     OIIO::ImageSpec back;
     if (!in) return fmt::format("the written file cannot be read back: {}", OIIO::geterror());
     if (!in->open(file, back))
@@ -574,25 +575,39 @@ double exr_max_ratio(int compression) {
  *   fit in the file at the best ratio the compression can reach (exr_max_ratio());
  * - a tile (allocated whole) must pass allocation_bytes() and be at most 256x256 pixels or 4
  *   times the data window (a 20x12 image in tiles of 8 x 16777224 took 2.2 GB and 4 s).
- * Only the first MiB is scanned (headers are a few KB; a longer one is left to OpenEXR).
+ * Values checked by their size alone are skipped unread; the rest of the file is not read.
  */
 void check_exr_headers(const std::string &path) {
-    std::FILE *f = std::fopen(path.c_str(), "rb");
-    if (!f) return; // OpenImageIO reports it
+    std::unique_ptr<std::FILE, int (*)(std::FILE *)> file(std::fopen(path.c_str(), "rb"),
+                                                          &std::fclose);
+    if (!file) return; // OpenImageIO reports it
+    std::FILE *f = file.get();
     std::fseek(f, 0, SEEK_END);
-    long file_size = std::ftell(f);
+    const long size_or_error = std::ftell(f);
+    if (size_or_error < 8) return;
+    const size_t file_size = size_t(size_or_error);
     std::rewind(f);
-    std::vector<unsigned char> buf(
-        std::clamp<size_t>(file_size > 0 ? size_t(file_size) : 0, 8, size_t(1) << 20));
-    size_t n = std::fread(buf.data(), 1, buf.size(), f);
-    std::fclose(f);
-    if (n < 8 || buf[0] != 0x76 || buf[1] != 0x2f || buf[2] != 0x31 || buf[3] != 0x01) return;
+    // The file's bytes [0, n), read as far as the scan needs them: values checked by their size
+    // alone are skipped unread.
+    std::vector<unsigned char> buf;
+    size_t n = 0;
+    auto have = [&](size_t upto) {
+        if (upto <= n) return true;
+        if (upto > file_size) return false;
+        buf.resize(std::min(file_size, std::max({upto, 2 * n, size_t(1) << 16})));
+        n += std::fread(buf.data() + n, 1, buf.size() - n, f);
+        buf.resize(n);
+        return upto <= n;
+    };
+    if (!have(8) || buf[0] != 0x76 || buf[1] != 0x2f || buf[2] != 0x31 || buf[3] != 0x01) return;
     const bool multipart = (buf[5] & 0x10) != 0; // version field bit 12
+    const bool deep_file = (buf[5] & 0x08) != 0; // bit 11: deep data ("non-image")
     size_t pos = 8;
     auto cstring = [&](size_t &at, size_t limit, std::string &out) {
         out.clear();
-        while (at < limit && buf[at] != 0 && out.size() < 256) out += char(buf[at++]);
-        if (at >= limit || buf[at] != 0) return false;
+        while (at < limit && have(at + 1) && buf[at] != 0 && out.size() < 256)
+            out += char(buf[at++]);
+        if (at >= limit || !have(at + 1) || buf[at] != 0) return false;
         ++at;
         return true;
     };
@@ -606,33 +621,41 @@ void check_exr_headers(const std::string &path) {
                     why);
     };
     std::string name, type, channel;
-    for (int header = 0; pos < n; ++header) {
+    for (int header = 0; have(pos + 1); ++header) {
         if (buf[pos] == 0) break; // an empty header ends the list of a multi-part file
         int64_t width = 0, height = 0, pixel_bytes = -1;
         double sampled_bytes = 0.0; // per pixel, for channels stored at 1/(xs ys) of the pixels
-        int compression = -1;
-        bool deep = false;
+        int compression = 3;        // OpenEXR's default header has ZIP
+        bool deep = deep_file && !multipart;
         int64_t tile_pixels = 0;
         for (;;) {
-            if (pos >= n) return;
+            if (!have(pos + 1)) return;
             if (buf[pos] == 0) {
                 ++pos;
                 break;
             }
-            if (!cstring(pos, n, name) || !cstring(pos, n, type) || pos + 4 > n) return;
+            if (!cstring(pos, file_size, name) || !cstring(pos, file_size, type) || !have(pos + 4))
+                return;
             const int32_t size = int32_at(pos);
             pos += 4;
             if (size < 0 || int64_t(size) > int64_t(file_size) - int64_t(pos))
                 fail(name, type, fmt::format("claims {} bytes, more than the file holds", size));
             const size_t end = pos + size_t(size);
-            if (end > n) return; // past the scanned MiB
-            if (const int fixed = exr_fixed_size(type); fixed >= 0 && size != fixed) {
+            const int fixed = exr_fixed_size(type);
+            const bool read_value = fixed >= 0 || type == "chlist" || type == "stringvector" ||
+                                    type == "preview" || (type == "string" && name == "type");
+            if (read_value && !have(end)) return; // a read error: OpenImageIO reports it
+            if (fixed >= 0 && size != fixed) {
                 fail(name, type, fmt::format("has {} bytes instead of {}", size, fixed));
             } else if (type == "chlist") {
                 // Channels (a name, then type, pLinear, 3 reserved bytes, x and y sampling),
-                // then an empty name.
+                // then an empty name. Only the list named "channels" describes the pixels.
+                const bool pixels_list = name == "channels";
+                if (pixels_list) {
+                    pixel_bytes = 0;
+                    sampled_bytes = 0.0;
+                }
                 size_t at = pos;
-                pixel_bytes = 0;
                 for (;;) {
                     if (at < end && buf[at] == 0) {
                         ++at;
@@ -643,8 +666,10 @@ void check_exr_headers(const std::string &path) {
                     const int32_t pixel_type = int32_at(at);
                     const int bytes = pixel_type == 1 ? 2 : 4; // HALF, or UINT and FLOAT
                     const int32_t xs = int32_at(at + 8), ys = int32_at(at + 12);
-                    pixel_bytes += bytes;
-                    if (xs > 0 && ys > 0) sampled_bytes += bytes / (double(xs) * double(ys));
+                    if (pixels_list) {
+                        pixel_bytes += bytes;
+                        if (xs > 0 && ys > 0) sampled_bytes += bytes / (double(xs) * double(ys));
+                    }
                     at += 16;
                 }
                 if (at != end) fail(name, type, "ends before its size");
@@ -664,12 +689,13 @@ void check_exr_headers(const std::string &path) {
                 if (size < 8 || uint64_t(w) * h * 4 != uint64_t(size) - 8)
                     fail(name, type, "declares a size its pixels do not have");
             } else if (type == "idmanifest") {
-                fail(name, type, "is not read by facet"); // parsed by its contents in OpenEXR
+                if (size < 4) fail(name, type, "is shorter than its 4-byte length");
             }
             if (type == "compression" && name == "compression") compression = buf[pos];
-            if (type == "string" && name == "type")
-                deep = std::string(buf.begin() + long(pos), buf.begin() + long(end)).find("deep") !=
-                       std::string::npos;
+            if (type == "string" && name == "type" && multipart) {
+                const std::string value(buf.begin() + long(pos), buf.begin() + long(end));
+                deep = value == "deepscanline" || value == "deeptile";
+            }
             if (type == "tiledesc" && name == "tiles")
                 tile_pixels = int64_t(uint32_t(int32_at(pos))) * uint32_t(int32_at(pos + 4));
             if (type == "box2i" && name == "dataWindow") {
@@ -684,9 +710,6 @@ void check_exr_headers(const std::string &path) {
             if (!checked_mul(size_t(width), size_t(height), pixels))
                 pixels = std::numeric_limits<size_t>::max();
             allocation_bytes(pixels, size_t(pixel_bytes), path, "EXR data window");
-            // Pixels that cannot be in the file: more than its compression can pack into its
-            // bytes (OpenEXR pads a short chunk without an error).
-            const double bound = exr_max_ratio(compression) * double(file_size);
             // OpenEXR and OpenImageIO allocate whole tiles; beyond the image they hold padding.
             if (tile_pixels > 0) {
                 allocation_bytes(size_t(tile_pixels), size_t(pixel_bytes), path, "EXR tile");
@@ -695,6 +718,9 @@ void check_exr_headers(const std::string &path) {
                                 "than 256x256 and 4 times its {}x{}-pixel data window",
                                 path, tile_pixels, width, height);
             }
+            // Pixels that cannot be in the file: more than its compression can pack into its
+            // bytes (OpenEXR pads a short chunk without an error).
+            const double bound = exr_max_ratio(compression) * double(file_size);
             if (!deep && bound > 0.0 && double(pixels) * sampled_bytes > bound)
                 FACET_THROW("cannot read image \"{}\": its data window declares {}x{} pixels "
                             "({:.0f} bytes), more than its compression can hold in {} bytes",
@@ -720,7 +746,11 @@ void check_bmp_header(const std::string &path) {
     std::fseek(f, 0, SEEK_END);
     const long file_size = std::ftell(f);
     std::fclose(f);
-    if (n < 26 || h[0] != 'B' || h[1] != 'M') return; // too short: OpenImageIO reports it
+    // The magics OpenImageIO's reader takes: BM (Windows), BA, CI, CP, PT (OS/2).
+    const std::string magic{char(h[0]), char(h[1])};
+    if (n < 26 ||
+        (magic != "BM" && magic != "BA" && magic != "CI" && magic != "CP" && magic != "PT"))
+        return; // too short: OpenImageIO reports it
     auto u32 = [&](int at) {
         return uint32_t(h[at]) | uint32_t(h[at + 1]) << 8 | uint32_t(h[at + 2]) << 16 |
                uint32_t(h[at + 3]) << 24;
@@ -759,13 +789,12 @@ bool is_readable_format(const std::string &name) {
 
 /// Opens `path` with the reader its extension names, or, when that reader cannot open it, with
 /// the first other reader of ReadableFormats that recognises the contents. OpenImageIO's own
-/// fallback (try_all_readers, turned off here) would hand a file that is not what its name says
-/// to each of its thirty readers, camera raw, DICOM, GDAL, OpenVDB and video among them: more
-/// parsers exposed to a downloaded asset, and slow (a malformed .png: 0.8 ms of CPU against
-/// 0.01 ms with the one reader; under the address sanitizer, most of the image fuzzer's time).
+/// fallback (try_all_readers, turned off when this library loads: facet_image_library()) would hand
+/// a file that is not what its name says to each of its thirty readers, camera raw, DICOM, GDAL,
+/// OpenVDB and video among them: more parsers exposed to a downloaded asset, and slow (a malformed
+/// .png: 0.8 ms of CPU against 0.01 ms with the one reader; under the address sanitizer, most of
+/// the image fuzzer's time).
 std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path) {
-    static const bool by_extension_only = OIIO::attribute("try_all_readers", 0);
-    (void)by_extension_only;
     // Created from the bare extension, the reader is only made; from a file name OpenImageIO
     // would open the file with it too.
     const std::string ext = lower_extension(path);
@@ -784,7 +813,11 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path) {
     for (const char *format : ReadableFormats) {
         if (in && in->format_name() == std::string(format)) continue;
         auto other = OIIO::ImageInput::create(format, /*do_open=*/false);
-        if (other && other->valid_file(path) && other->open(path, spec)) return other;
+        if (!other || !other->valid_file(path)) continue;
+        if (other->open(path, spec)) return other;
+        // The contents are this format's: its reader's error says what is wrong.
+        error = fmt::format("read as {} (by its contents): {}", format, other->geterror());
+        break;
     }
     if (error.empty()) error = "read error";
     FACET_THROW("cannot read image \"{}\": {}", path, error);
@@ -931,6 +964,9 @@ ImageFile read_image_file(const std::string &path) {
 
 extern "C" __attribute__((visibility("default"))) const facet::detail::ImageLibrary *
 facet_image_library() {
+    // Images are read only by the readers of the formats facet documents (open_image()).
+    static const bool by_extension_only = OIIO::attribute("try_all_readers", 0);
+    (void)by_extension_only;
     static const std::string versions =
         fmt::format("OpenImageIO {}, OpenColorIO {}", OIIO_VERSION_STRING, OCIO::GetVersion());
     static const facet::detail::ImageLibrary table = {

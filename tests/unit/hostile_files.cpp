@@ -445,6 +445,25 @@ TEST(HostileImages, ExrPixelsMustFitTheFilesCompression) {
     const std::string msg = read_error(dir.write("wide.exr", exr));
     EXPECT_CONTAINS(msg, "wide.exr");
     EXPECT_CONTAINS(msg, "655368x8 pixels (31457664 bytes), more than its compression can hold");
+
+    // Neither a second, empty channel list nor a renamed compression attribute (OpenEXR then
+    // uses ZIP, its default) takes the check away.
+    const std::string channels = std::string("channels") + '\0' + "chlist" + '\0';
+    const size_t list = exr.find(channels);
+    ASSERT_NE(list, std::string::npos);
+    int32_t list_size;
+    std::memcpy(&list_size, exr.data() + list + channels.size(), 4);
+    std::string extra = exr;
+    extra.insert(list + channels.size() + 4 + size_t(list_size),
+                 std::string("zz") + '\0' + "chlist" + '\0' + std::string("\1\0\0\0\0", 5));
+    EXPECT_CONTAINS(read_error(dir.write("extra.exr", extra)),
+                    "more than its compression can hold");
+    std::string renamed = exr;
+    const size_t comp = renamed.find(std::string("compression") + '\0' + "compression");
+    ASSERT_NE(comp, std::string::npos);
+    renamed[comp + 10] = 'X';
+    EXPECT_CONTAINS(read_error(dir.write("renamed.exr", renamed)),
+                    "more than its compression can hold");
 }
 
 TEST(HostileImages, TilesArePaddingOnlyWithinReason) {
@@ -523,6 +542,12 @@ TEST(HostileImages, BmpHeadersAreCheckedBeforeOpenImageIODecodes) {
     std::string msg = read_error(dir.write("rle.bmp", std::string(rle, rle + sizeof rle)));
     EXPECT_CONTAINS(msg, "rle.bmp");
     EXPECT_CONTAINS(msg, "RLE-compressed BMP declares 603979780x3 pixels");
+    // The OS/2 magics OpenImageIO's reader also takes.
+    for (const char *magic : {"BA", "CI", "CP", "PT"}) {
+        std::string os2(rle, rle + sizeof rle);
+        os2.replace(0, 2, magic);
+        EXPECT_CONTAINS(read_error(dir.write("os2.bmp", os2)), "RLE-compressed BMP declares");
+    }
 
     // An uncompressed BMP reads, and its pixels count against the allocation limit first.
     std::string path = dir.write("ok.bmp", "");

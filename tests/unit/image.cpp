@@ -394,6 +394,19 @@ TEST_F(ImageIO, ReadsItsFormatsByContentsAndNoOthers) {
         ASSERT_EQ(back.width, 4) << name;
         EXPECT_EQ(back.data, png.data) << name;
     }
+    // A file its contents name but cannot be read: that reader's error, not the extension's.
+    {
+        const std::string bytes = file_bytes(path("a.png"));
+        std::ofstream(path("cut"), std::ios::binary) << bytes.substr(0, 20);
+        try {
+            read_image(path("cut"));
+            FAIL() << "expected an error";
+        } catch (const Error &e) {
+            EXPECT_NE(std::string(e.what()).find("read as png (by its contents)"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
     // A format OpenImageIO reads but facet does not: refused by name, whatever reads it.
     {
         auto out = OIIO::ImageOutput::create(path("a.gif"));
