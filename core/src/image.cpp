@@ -627,7 +627,7 @@ void check_exr_headers(const std::string &path) {
         double sampled_bytes = 0.0; // per pixel, for channels stored at 1/(xs ys) of the pixels
         int compression = 3;        // OpenEXR's default header has ZIP
         bool deep = deep_file && !multipart;
-        int64_t tile_pixels = 0;
+        uint64_t tile_pixels = 0; // up to (2^32 - 1)^2
         for (;;) {
             if (!have(pos + 1)) return;
             if (buf[pos] == 0) {
@@ -697,7 +697,7 @@ void check_exr_headers(const std::string &path) {
                 deep = value == "deepscanline" || value == "deeptile";
             }
             if (type == "tiledesc" && name == "tiles")
-                tile_pixels = int64_t(uint32_t(int32_at(pos))) * uint32_t(int32_at(pos + 4));
+                tile_pixels = uint64_t(uint32_t(int32_at(pos))) * uint32_t(int32_at(pos + 4));
             if (type == "box2i" && name == "dataWindow") {
                 width = int64_t(int32_at(pos + 8)) - int32_at(pos) + 1;
                 height = int64_t(int32_at(pos + 12)) - int32_at(pos + 4) + 1;
@@ -713,7 +713,7 @@ void check_exr_headers(const std::string &path) {
             // OpenEXR and OpenImageIO allocate whole tiles; beyond the image they hold padding.
             if (tile_pixels > 0) {
                 allocation_bytes(size_t(tile_pixels), size_t(pixel_bytes), path, "EXR tile");
-                if (uint64_t(tile_pixels) > std::max<uint64_t>(4 * uint64_t(pixels), 65536))
+                if (tile_pixels > std::max<uint64_t>(4 * uint64_t(pixels), 65536))
                     FACET_THROW("cannot read image \"{}\": its tiles of {} pixels are larger "
                                 "than 256x256 and 4 times its {}x{}-pixel data window",
                                 path, tile_pixels, width, height);
