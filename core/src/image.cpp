@@ -736,7 +736,8 @@ void check_exr_headers(const std::string &path) {
  * 1.9 GB and 2 s before any size could be checked. So the header is read here first: the
  * pixels must pass allocation_bytes() (as floats, as read_image() will hold them), and an RLE
  * image may have at most 256 pixels per byte of the file (a run of 255 pixels takes two bytes;
- * only pixels the file leaves undefined can make an image sparser).
+ * only pixels the file leaves undefined can make an image sparser) and must have the depth of
+ * its RLE kind.
  */
 void check_bmp_header(const std::string &path) {
     std::FILE *f = std::fopen(path.c_str(), "rb");
@@ -775,6 +776,13 @@ void check_bmp_header(const std::string &path) {
         FACET_THROW("cannot read image \"{}\": the RLE-compressed BMP declares {}x{} pixels, more "
                     "than 256 per byte of its {}-byte file",
                     path, width, height, file_size);
+    // RLE8 codes 8-bit and RLE4 4-bit palette indices: OpenImageIO decodes any other depth with
+    // them out of bounds (a 24-bit RLE8 file crashed it).
+    const int bits = h[28] | h[29] << 8;
+    if (rle && bits != (compression == 1 ? 8 : 4))
+        FACET_THROW("cannot read image \"{}\": the BMP is RLE{}-compressed with {} bits per pixel "
+                    "instead of {}",
+                    path, compression == 1 ? 8 : 4, bits, compression == 1 ? 8 : 4);
 }
 
 /// The image formats facet reads: Mitsuba 3's (OpenEXR, PNG, JPEG, Radiance RGBE, PFM and the

@@ -542,6 +542,15 @@ TEST(HostileImages, BmpHeadersAreCheckedBeforeOpenImageIODecodes) {
     std::string msg = read_error(dir.write("rle.bmp", std::string(rle, rle + sizeof rle)));
     EXPECT_CONTAINS(msg, "rle.bmp");
     EXPECT_CONTAINS(msg, "RLE-compressed BMP declares 603979780x3 pixels");
+    // Found by the image fuzz target: RLE8 with 24 bits per pixel crashed OpenImageIO (a
+    // segmentation fault reading the rows). The header alone says so; the pixel data is junk.
+    std::string deep(rle, rle + 54);
+    deep[21] = 0; // 4 pixels wide
+    deep[30] = 1; // RLE8
+    deep += std::string(64, '\1');
+    msg = read_error(dir.write("rle8.bmp", deep));
+    EXPECT_CONTAINS(msg, "rle8.bmp");
+    EXPECT_CONTAINS(msg, "RLE8-compressed with 24 bits per pixel instead of 8");
     // The OS/2 magics OpenImageIO's reader also takes.
     for (const char *magic : {"BA", "CI", "CP", "PT"}) {
         std::string os2(rle, rle + sizeof rle);
