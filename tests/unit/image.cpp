@@ -395,14 +395,16 @@ TEST_F(ImageIO, ReadsItsFormatsByContentsAndNoOthers) {
         EXPECT_EQ(back.data, png.data) << name;
     }
     // A file its contents name but cannot be read: that reader's error, not the extension's.
+    // (An EXR: a cut PNG makes OpenImageIO's PNG reader leak its error string, .ci/lsan.supp.)
     {
-        const std::string bytes = file_bytes(path("a.png"));
+        write_image(path("a.exr"), img);
+        const std::string bytes = file_bytes(path("a.exr"));
         std::ofstream(path("cut"), std::ios::binary) << bytes.substr(0, 20);
         try {
             read_image(path("cut"));
             FAIL() << "expected an error";
         } catch (const Error &e) {
-            EXPECT_NE(std::string(e.what()).find("read as png (by its contents)"),
+            EXPECT_NE(std::string(e.what()).find("read as openexr (by its contents)"),
                       std::string::npos)
                 << e.what();
         }
