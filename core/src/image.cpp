@@ -831,9 +831,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path) {
     FACET_THROW("cannot read image \"{}\": {}", path, error);
 }
 
-} // namespace
-
-Image read_image(const std::string &path) {
+Image read_pixels(const std::string &path) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec))
         FACET_THROW("cannot read image \"{}\": {}", path,
@@ -865,6 +863,15 @@ Image read_image(const std::string &path) {
             !checked_mul(tile_values, size_t(spec.nchannels), tile_values))
             tile_values = std::numeric_limits<size_t>::max();
         allocation_bytes(tile_values, sizeof(float), path, "a row of image tiles");
+    }
+    // A TIFF strip of rows, read whole by OpenImageIO's TIFF reader (in the file's own layout).
+    if (const int rows = spec.get_int_attribute("tiff:RowsPerStrip", 0); rows > 0) {
+        size_t strip_values = 0;
+        const size_t strip_rows = size_t(std::min(rows, spec.height));
+        if (!checked_mul(row, strip_rows, strip_values))
+            strip_values = std::numeric_limits<size_t>::max();
+        allocation_bytes(strip_values, std::max<size_t>(spec.format.size(), 1), path,
+                         "a TIFF strip");
     }
 
     Image img;
@@ -915,6 +922,20 @@ Image read_image(const std::string &path) {
     in->close();
     if (!ok) FACET_THROW("cannot read image \"{}\": {}", path, err.empty() ? "read error" : err);
     return img;
+}
+
+} // namespace
+
+Image read_image(const std::string &path) {
+    // A size that passed every check can still be more than the machine has (a compressed
+    // strip's byte count, say, which OpenImageIO allocates as the file gives it).
+    try {
+        return read_pixels(path);
+    } catch (const std::bad_alloc &) {
+        FACET_THROW("cannot read image \"{}\": out of memory (a size the file gives is more "
+                    "than this machine can allocate)",
+                    path);
+    }
 }
 
 std::string ocio_config_path(const std::string &explicit_path) {
