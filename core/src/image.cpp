@@ -864,15 +864,6 @@ Image read_pixels(const std::string &path) {
             tile_values = std::numeric_limits<size_t>::max();
         allocation_bytes(tile_values, sizeof(float), path, "a row of image tiles");
     }
-    // A TIFF strip of rows, read whole by OpenImageIO's TIFF reader (in the file's own layout).
-    if (const int rows = spec.get_int_attribute("tiff:RowsPerStrip", 0); rows > 0) {
-        size_t strip_values = 0;
-        const size_t strip_rows = size_t(std::min(rows, spec.height));
-        if (!checked_mul(row, strip_rows, strip_values))
-            strip_values = std::numeric_limits<size_t>::max();
-        allocation_bytes(strip_values, std::max<size_t>(spec.format.size(), 1), path,
-                         "a TIFF strip");
-    }
 
     Image img;
     img.width = spec.width;

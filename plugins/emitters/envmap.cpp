@@ -2,8 +2,8 @@ static const char *DOC = R"DOC(
 # envmap: environment map
 
 Light from infinitely far away, given by a latitude-longitude image (EXR, HDR, PNG, ... any
-format the bitmap texture reads; 8-bit images are decoded from sRGB), with Mitsuba 3's conventions. A
-direction d (in the map's frame, after the inverse of `to_world`) has u = atan2(d.x, -d.z)/2π
+format the bitmap texture reads; 8-bit images are decoded from sRGB), with Mitsuba 3's
+conventions. A direction d (in the map's frame, after the inverse of `to_world`) has u = atan2(d.x, -d.z)/2π
 (wrapped to [0, 1); the u = 0 seam lies towards -Z, u = 1/4 towards +X) and v = acos(d.y)/π.
 Longitude is texel-centred and wraps: column i sits at u = (i + ½)/W and the lookup blends
 across the seam. Latitude is corner-aligned: row j sits at v = j/(H - 1), so the first row is
