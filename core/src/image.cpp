@@ -785,6 +785,80 @@ void check_bmp_header(const std::string &path) {
                     path, compression == 1 ? 8 : 4, bits, compression == 1 ? 8 : 4);
 }
 
+/**
+ * The RowsPerStrip of a TIFF's first image, as libtiff reads it (one value of an integer type;
+ * any other entry is ignored, and the strip is the whole image), or 0 when the file has none or
+ * is not a TIFF. OpenImageIO (2.4) keeps it in an int and reads a band of whole strips through
+ * buffers of width x channels x RowsPerStrip values computed in int, not clamped to the image's
+ * rows: values from 2^31 on became a negative strip height and corrupted the heap (a 300x50
+ * image, release build), and a 217-byte file made it ask for 5.6e15 bytes.
+ */
+uint64_t tiff_rows_per_strip(const std::string &path) {
+    std::unique_ptr<std::FILE, int (*)(std::FILE *)> file(std::fopen(path.c_str(), "rb"),
+                                                          &std::fclose);
+    if (!file) return 0;
+    std::FILE *f = file.get();
+    auto read_at = [&](uint64_t at, unsigned char *out, size_t n) {
+        return at <= uint64_t(std::numeric_limits<long>::max()) &&
+               std::fseek(f, long(at), SEEK_SET) == 0 && std::fread(out, 1, n, f) == n;
+    };
+    unsigned char h[16];
+    if (!read_at(0, h, 8)) return 0;
+    const bool little = h[0] == 'I' && h[1] == 'I';
+    if (!little && !(h[0] == 'M' && h[1] == 'M')) return 0;
+    auto uint = [&](const unsigned char *b, int n) {
+        uint64_t v = 0;
+        for (int i = 0; i < n; ++i) v |= uint64_t(b[little ? i : n - 1 - i]) << (8 * i);
+        return v;
+    };
+    const uint64_t version = uint(h + 2, 2);
+    const bool big = version == 43; // BigTIFF: 8-byte counts and offsets
+    if (version != 42 && !(big && read_at(0, h, 16))) return 0;
+    const uint64_t ifd = big ? uint(h + 8, 8) : uint(h + 4, 4);
+    const int count_bytes = big ? 8 : 2, entry_bytes = big ? 20 : 12, value_bytes = big ? 8 : 4;
+    unsigned char e[20];
+    if (!read_at(ifd, e, size_t(count_bytes))) return 0;
+    const uint64_t entries = uint(e, count_bytes);
+    for (uint64_t i = 0; i < std::min<uint64_t>(entries, 65536); ++i) {
+        if (!read_at(ifd + uint64_t(count_bytes) + i * uint64_t(entry_bytes), e,
+                     size_t(entry_bytes)))
+            return 0;
+        if (uint(e, 2) != 278) continue; // RowsPerStrip
+        const uint64_t type = uint(e + 2, 2), count = uint(e + 4, big ? 8 : 4);
+        const unsigned char *value = e + 4 + (big ? 8 : 4);
+        // BYTE, SHORT, LONG, LONG8 and their signed kinds (negative values are ignored).
+        const int size = type == 1 || type == 6     ? 1
+                         : type == 3 || type == 8   ? 2
+                         : type == 4 || type == 9   ? 4
+                         : type == 16 || type == 17 ? 8
+                                                    : 0;
+        if (count != 1 || size == 0 || size > value_bytes) return 0;
+        const uint64_t v = uint(value, size);
+        const bool is_signed = type == 6 || type == 8 || type == 9 || type == 17;
+        if (is_signed && (v >> (8 * size - 1)) != 0) return 0;
+        return v <= 0xffffffffu ? v : 0; // libtiff ignores what a uint32 cannot hold
+    }
+    return 0;
+}
+
+/**
+ * A TIFF's strips as OpenImageIO will buffer them (tiff_rows_per_strip()): a RowsPerStrip that
+ * does not fit its int (2^32 - 1, TIFF's "the whole image", becomes -1, which it handles), a strip
+ * whose values overflow its int, and a strip over the allocation limit are refused.
+ */
+void check_tiff_strips(const std::string &path, const OIIO::ImageSpec &spec) {
+    const uint64_t rows = tiff_rows_per_strip(path);
+    if (rows == 0 || rows == 0xffffffffu) return;
+    constexpr uint64_t int_max = uint64_t(std::numeric_limits<int>::max());
+    uint64_t values = 0;
+    if (rows > int_max || !checked_mul(uint64_t(spec.width), uint64_t(spec.nchannels), values) ||
+        !checked_mul(values, rows, values) || values > int_max)
+        FACET_THROW("cannot read image \"{}\": its RowsPerStrip of {} for rows of {} pixels of {} "
+                    "channels is more than the TIFF reader can address",
+                    path, rows, spec.width, spec.nchannels);
+    allocation_bytes(size_t(values), spec.format.size(), path, "a TIFF strip");
+}
+
 /// The image formats facet reads: Mitsuba 3's (OpenEXR, PNG, JPEG, Radiance RGBE, PFM and the
 /// other PNM formats, Targa, BMP) and TIFF, by OpenImageIO's names for its readers.
 constexpr const char *ReadableFormats[] = {"openexr", "png",   "jpeg", "hdr",
@@ -853,6 +927,8 @@ Image read_pixels(const std::string &path) {
         !checked_mul(row, size_t(spec.height), values))
         values = std::numeric_limits<size_t>::max();
     allocation_bytes(values, sizeof(float), path, "image pixels");
+    if (spec.tile_width <= 0 && in->format_name() == std::string("tiff"))
+        check_tiff_strips(path, spec);
     // A band of whole tiles, converted to float by OpenImageIO in a buffer of its own.
     if (spec.tile_width > 0) {
         size_t tiles_x = 0, tile_values = 0;
@@ -918,8 +994,8 @@ Image read_pixels(const std::string &path) {
 } // namespace
 
 Image read_image(const std::string &path) {
-    // A size that passed every check can still be more than the machine has (a compressed
-    // strip's byte count, say, which OpenImageIO allocates as the file gives it).
+    // A size that passed every check can still be more than the machine has (a TIFF strip of
+    // many more rows than the image, say, which OpenImageIO buffers whole).
     try {
         return read_pixels(path);
     } catch (const std::bad_alloc &) {

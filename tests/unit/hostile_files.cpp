@@ -10,7 +10,9 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -574,17 +576,76 @@ TEST(HostileImages, BmpHeadersAreCheckedBeforeOpenImageIODecodes) {
     EXPECT_CONTAINS(msg, "BMP pixels: 1200 items of 4 bytes");
 }
 
-TEST(HostileImages, AllocationFailuresInsideTheImageLibraryAreErrors) {
-#if defined(__SANITIZE_ADDRESS__)
-    GTEST_SKIP() << "AddressSanitizer reports the failed allocation itself instead of throwing";
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-    GTEST_SKIP() << "AddressSanitizer reports the failed allocation itself instead of throwing";
-#endif
-#endif
-    // Found by the image fuzz target: a 217-byte TIFF whose strip byte count makes OpenImageIO
-    // ask for 5.6e15 bytes; std::bad_alloc left read_image() and ended the process.
+namespace {
+
+/// A deflate-compressed RGB TIFF of one strip (8-bit pixels; BigTIFF when `big`) whose
+/// RowsPerStrip says `rows_per_strip`.
+std::string deflate_tiff(int width, int height, uint64_t rows_per_strip, bool big = false) {
+    std::string pixels;
+    for (int i = 0; i < width * height * 3; ++i) pixels += char((i * 37) & 255);
+    uLongf packed_size = compressBound(uLong(pixels.size()));
+    std::string packed(packed_size, '\0');
+    compress(reinterpret_cast<Bytef *>(packed.data()), &packed_size,
+             reinterpret_cast<const Bytef *>(pixels.data()), uLong(pixels.size()));
+    packed.resize(packed_size);
+    struct Entry {
+        uint16_t tag, type;
+        uint64_t value;
+    };
+    const int entry_count = 9;
+    const uint64_t data_at = big ? 16 + 8 + 20 * entry_count + 8 : 8 + 2 + 12 * entry_count + 4;
+    const Entry entries[entry_count] = {
+        {256, 4, uint64_t(width)},
+        {257, 4, uint64_t(height)},
+        {258, 3, 8},
+        {259, 3, 8},
+        {262, 3, 2},
+        {273, 4, data_at},
+        {277, 3, 3},
+        {278, 4, rows_per_strip},
+        {279, 4, packed.size()},
+    };
+    std::string f = big ? std::string("II+\0", 4) : std::string("II*\0", 4);
+    if (big) {
+        put<uint16_t>(f, 8);
+        put<uint16_t>(f, 0);
+        put<uint64_t>(f, 16);
+        put<uint64_t>(f, entry_count);
+    } else {
+        put<uint32_t>(f, 8);
+        put<uint16_t>(f, entry_count);
+    }
+    for (const Entry &e : entries) {
+        put<uint16_t>(f, e.tag);
+        put<uint16_t>(f, e.type);
+        if (big) {
+            put<uint64_t>(f, 1);
+            if (e.type == 3)
+                put<uint16_t>(f, uint16_t(e.value)), f.append(6, '\0');
+            else
+                put<uint32_t>(f, uint32_t(e.value)), f.append(4, '\0');
+        } else {
+            put<uint32_t>(f, 1);
+            if (e.type == 3)
+                put<uint16_t>(f, uint16_t(e.value)), f.append(2, '\0');
+            else
+                put<uint32_t>(f, uint32_t(e.value));
+        }
+    }
+    if (big)
+        put<uint64_t>(f, 0);
+    else
+        put<uint32_t>(f, 0);
+    return f + packed;
+}
+
+} // namespace
+
+TEST(HostileImages, TiffStripsAreCheckedBeforeOpenImageIOBuffersThem) {
     TempDir dir;
+    // OpenImageIO keeps RowsPerStrip in an int and sizes its strip buffers by it, not by the
+    // image's rows. Found by the image fuzz target: a 217-byte TIFF whose 65,056 rows per strip
+    // of 65,284 x 3 values overflowed that int, and OpenImageIO asked for 5.6e15 bytes.
     const unsigned char tif[] = {
         0x49, 0x49, 0x2a, 0x00, 0x08, 0x00, 0x00, 0x00, 0x0e, 0x00, 0x00, 0x01, 0x03, 0x00, 0x01,
         0x00, 0x00, 0x00, 0x04, 0xff, 0xff, 0x00, 0x01, 0x01, 0x03, 0x00, 0x01, 0x00, 0x00, 0x00,
@@ -602,9 +663,76 @@ TEST(HostileImages, AllocationFailuresInsideTheImageLibraryAreErrors) {
         0x30, 0x32, 0x36, 0x3a, 0x31, 0x32, 0x3a, 0x30, 0x31, 0x20, 0x71, 0x01, 0xe2, 0xd5, 0x93,
         0x6a, 0x32, 0x00, 0xb7, 0x25, 0x12, 0x01,
     };
-    const std::string msg = read_error(dir.write("strip.tif", std::string(tif, tif + sizeof tif)));
+    std::string msg = read_error(dir.write("strip.tif", std::string(tif, tif + sizeof tif)));
     EXPECT_CONTAINS(msg, "strip.tif");
-    EXPECT_CONTAINS(msg, "out of memory");
+    EXPECT_CONTAINS(msg, "more than the TIFF reader can address");
+    // 2^31 rows per strip is a negative strip height there: a 300 x 50 image corrupted the heap.
+    for (bool big : {false, true}) {
+        SCOPED_TRACE(big ? "BigTIFF" : "TIFF");
+        msg = read_error(dir.write("negative.tif", deflate_tiff(300, 50, uint64_t(1) << 31, big)));
+        EXPECT_CONTAINS(msg, "more than the TIFF reader can address");
+    }
+    // A strip over the allocation limit, however few of its rows the image has.
+    {
+        LimitGuard guard;
+        set_allocation_limit(size_t(1) << 20);
+        msg = read_error(dir.write("tall.tif", deflate_tiff(1000, 2, 1000)));
+        EXPECT_CONTAINS(msg, "a TIFF strip");
+    }
+    // Valid strips read the same pixels: the image's own rows, more rows than the image has
+    // (within the limit), and 2^32 - 1, TIFF's "the whole image in one strip".
+    const Image plain = read_image(dir.write("plain.tif", deflate_tiff(30, 7, 7)));
+    ASSERT_EQ(plain.width, 30);
+    ASSERT_EQ(plain.height, 7);
+    for (uint64_t rows : {uint64_t(64), uint64_t(0xffffffffu)})
+        for (bool big : {false, true}) {
+            SCOPED_TRACE(fmt::format("{} rows per strip, {}", rows, big ? "BigTIFF" : "TIFF"));
+            const Image same = read_image(dir.write("same.tif", deflate_tiff(30, 7, rows, big)));
+            EXPECT_EQ(same.data, plain.data);
+        }
+}
+
+namespace {
+
+/// In a death test's child: reads `big` with 512 MiB of address space beyond what the process
+/// has after reading `small` (which loads the image library); exits 0 when that ends in an
+/// out-of-memory facet::Error naming the file.
+[[noreturn]] void read_with_512_mib_more(const std::string &small, const std::string &big) {
+    read_image(small);
+    long pages = 0;
+    std::ifstream("/proc/self/statm") >> pages;
+    const rlim_t limit = rlim_t(pages) * rlim_t(::sysconf(_SC_PAGESIZE)) + (rlim_t(512) << 20);
+    const rlimit r{limit, limit};
+    if (::setrlimit(RLIMIT_AS, &r) != 0) std::_Exit(2);
+    try {
+        read_image(big);
+    } catch (const Error &e) {
+        std::fprintf(stderr, "%s\n", e.what());
+        const bool named = std::strstr(e.what(), fs::path(big).filename().c_str()) != nullptr;
+        std::_Exit(named && std::strstr(e.what(), "out of memory") ? 0 : 3);
+    }
+    std::_Exit(4);
+}
+
+} // namespace
+
+TEST(HostileImages, AllocationFailuresInsideTheImageLibraryAreErrors) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+    GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it";
+#endif
+#endif
+    // A size that passes every check can still be more than the machine has: std::bad_alloc from
+    // inside OpenImageIO once ended the process. A valid TIFF of 3 rows in strips of 8,000 rows
+    // of 60,000 RGB pixels makes OpenImageIO allocate a 1.4 GB strip buffer; in a child process
+    // limited to 512 MiB more address space, that allocation fails.
+    TempDir dir;
+    const std::string small = dir.write("small.tif", deflate_tiff(4, 2, 2));
+    const std::string tall = dir.write("tall.tif", deflate_tiff(60000, 3, 8000));
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_EXIT(read_with_512_mib_more(small, tall), ::testing::ExitedWithCode(0), "");
 }
 
 TEST(HostileImages, ValidImagesStillRead) {
