@@ -633,9 +633,10 @@ void check_exr_headers(const std::string &path) {
     std::string name, type, channel;
     for (int header = 0; have(pos + 1); ++header) {
         if (buf[pos] == 0) break; // an empty header ends the list of a multi-part file
-        int64_t width = 0, height = 0, pixel_bytes = -1;
+        // OpenEXR reads a header over its default one: a 64x64 data window, ZIP, no channels.
+        int64_t width = 64, height = 64, pixel_bytes = -1;
         double sampled_bytes = 0.0; // per pixel, for channels stored at 1/(xs ys) of the pixels
-        int compression = 3;        // OpenEXR's default header has ZIP
+        int compression = 3;        // ZIP
         bool deep = deep_file && !multipart;
         uint64_t tile_pixels = 0; // up to (2^32 - 1)^2
         for (;;) {
