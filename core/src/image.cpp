@@ -966,8 +966,17 @@ Image read_pixels(const std::string &path) {
     // Read in bands of rows (whole tile rows for tiled files), growing the buffer as rows
     // arrive: a header that claims gigabytes of pixels in a small, truncated file fails at its
     // first missing row instead of after the whole buffer has been zeroed.
-    const int band = spec.tile_width > 0
-                         ? std::max(spec.tile_height, 1)
+    // OpenImageIO 2.4 inverts a MinIsWhite TIFF strip it decompresses itself (deflate, 8 or 16
+    // bits, contiguous channels) over channels x its values, writing past the buffer when there
+    // is more than one channel (a valid 16x64 grey + alpha file aborted the process). It reads
+    // a single row through libtiff and inverts that row's values only: such files are read row
+    // by row.
+    const bool miniswhite_strips =
+        spec.tile_width <= 0 && spec.nchannels > 1 && in->format_name() == std::string("tiff") &&
+        spec.get_int_attribute("tiff:PhotometricInterpretation", -1) == 0;
+    const int band = spec.tile_width > 0 ? std::max(spec.tile_height, 1)
+                     : miniswhite_strips
+                         ? 1
                          : int(std::clamp<size_t>((size_t(1) << 22) / row, 1, 4096));
     // Scanlines of one type are read in the file's own layout (all channels of spec.format) and
     // converted here, band by band: asked for any other layout, OpenImageIO converts through a

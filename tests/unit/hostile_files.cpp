@@ -614,11 +614,14 @@ TEST(HostileImages, BmpHeadersAreCheckedBeforeOpenImageIODecodes) {
 
 namespace {
 
-/// A deflate-compressed RGB TIFF of one strip (8-bit pixels; BigTIFF when `big`) whose
-/// RowsPerStrip says `rows_per_strip`.
-std::string deflate_tiff(int width, int height, uint64_t rows_per_strip, bool big = false) {
+/// A deflate-compressed TIFF of one strip (8-bit pixels; BigTIFF when `big`) whose
+/// RowsPerStrip says `rows_per_strip`: RGB, or `channels` of the given photometric
+/// interpretation (0 MinIsWhite, 1 MinIsBlack, 2 RGB), its bytes negated when `negative`.
+std::string deflate_tiff(int width, int height, uint64_t rows_per_strip, bool big = false,
+                         int channels = 3, int photometric = 2, bool negative = false) {
     std::string pixels;
-    for (int i = 0; i < width * height * 3; ++i) pixels += char((i * 37) & 255);
+    for (int i = 0; i < width * height * channels; ++i)
+        pixels += char(negative ? 255 - ((i * 37) & 255) : (i * 37) & 255);
     uLongf packed_size = compressBound(uLong(pixels.size()));
     std::string packed(packed_size, '\0');
     compress(reinterpret_cast<Bytef *>(packed.data()), &packed_size,
@@ -635,9 +638,9 @@ std::string deflate_tiff(int width, int height, uint64_t rows_per_strip, bool bi
         {257, 4, uint64_t(height)},
         {258, 3, 8},
         {259, 3, 8},
-        {262, 3, 2},
+        {262, 3, uint64_t(photometric)},
         {273, 4, data_at},
-        {277, 3, 3},
+        {277, 3, uint64_t(channels)},
         {278, 4, rows_per_strip},
         {279, 4, packed.size()},
     };
@@ -751,6 +754,23 @@ namespace {
 }
 
 } // namespace
+
+TEST(HostileImages, MinIsWhiteTiffsOfSeveralChannelsRead) {
+    // Found by the image fuzz target: OpenImageIO 2.4 inverts a MinIsWhite strip it decompresses
+    // itself over channels x its values, past the end of the buffer; a valid 16x64 grey + alpha
+    // file aborted the process ("munmap_chunk(): invalid pointer"). The same pixels stored
+    // negated as MinIsBlack are what it must read.
+    TempDir dir;
+    for (int channels : {2, 4, 11}) {
+        SCOPED_TRACE(fmt::format("{} channels", channels));
+        const Image white =
+            read_image(dir.write("white.tif", deflate_tiff(16, 64, 64, false, channels, 0, false)));
+        const Image black =
+            read_image(dir.write("black.tif", deflate_tiff(16, 64, 64, false, channels, 1, true)));
+        ASSERT_EQ(white.channels, channels);
+        EXPECT_EQ(white.data, black.data);
+    }
+}
 
 TEST(HostileImages, AllocationFailuresInsideTheImageLibraryAreErrors) {
 #if defined(__SANITIZE_ADDRESS__)
