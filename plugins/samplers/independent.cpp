@@ -34,7 +34,11 @@ public:
 
     void seed(uint64_t seed_value) override {
         m_pixel_seed = seed_value;
-        set_sample_index(0);
+        // Sample 0's stream is hashed when it is first drawn from, not here: the render loop
+        // moves to the sample it takes right after seeding, which hashes anyway. Until then the
+        // draws go through next_1d() and next_2d(), which hash first.
+        Sampler::set_sample_index(0);
+        m_stream = nullptr;
     }
 
     void set_sample_index(uint32_t index) override {
@@ -46,15 +50,18 @@ public:
         uint32_t base_lo = uint32_t(m_base_seed), base_hi = uint32_t(m_base_seed >> 32);
         auto [state, stream] = tea_hash_pair(lo ^ base_hi, base_lo, hi, base_lo ^ 0x6a09e667u, 8);
         m_rng.seed(state, stream ^ v);
+        m_stream = &m_rng;
     }
 
     // Sampler::draw_1d() and draw_2d() draw from m_rng directly, as these do.
     float next_1d() override {
+        if (!m_stream) set_sample_index(m_sample_index); // seeded, not yet hashed
         ++m_dimension;
         return m_rng.next_float();
     }
 
     Point2f next_2d() override {
+        if (!m_stream) set_sample_index(m_sample_index);
         m_dimension += 2;
         float x = m_rng.next_float();
         float y = m_rng.next_float();
@@ -68,7 +75,7 @@ public:
 private:
     Independent(const Independent &other)
         : Sampler(other), m_rng(other.m_rng), m_pixel_seed(other.m_pixel_seed) {
-        m_stream = &m_rng; // not the original's generator
+        m_stream = other.m_stream ? &m_rng : nullptr; // not the original's generator
     }
     Independent &operator=(const Independent &) = delete;
     PCG32 m_rng;
