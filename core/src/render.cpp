@@ -478,7 +478,8 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                             needs_aperture ? sampler->draw_2d() : Point2f(0.5f, 0.5f);
                         auto [ray, weight] = sensor.sample_ray(0.f, pos * inv_film_size, aperture);
                         // Integrators need not write every AOV for every sample (e.g. on a miss).
-                        std::fill(aovs->begin(), aovs->end(), 0.f);
+                        // (The buffer's extra float only keeps data() valid: nothing reads it.)
+                        if (aov_count > 0) std::fill_n(aovs->data(), aov_count, 0.f);
                         Color3f L = sample(scene, *sampler, ray, aovs->data()) * weight;
                         bool valid = L.is_finite();
                         for (int k = 0; k < aov_count; ++k)
