@@ -111,6 +111,25 @@ TEST(TeaHash, PairIsTwoHashesBitForBit) {
         }
 }
 
+TEST(TeaHash, FourAreFourHashesBitForBit) {
+    // tea_hash4 runs four hashes in the lanes of one SSE register (the independent sampler
+    // hashes two samples at once): each lane must be exactly tea_hash's words.
+    PCG32 rng(13, 17);
+    for (int rounds : {1, 4, 8, 16})
+        for (int i = 0; i < 2000; ++i) {
+            uint32_t v0[4], v1[4];
+            for (int k = 0; k < 4; ++k) {
+                v0[k] = i == 0 ? 0u : i == 1 ? 0xffffffffu : rng.next_uint32();
+                v1[k] = i == 0 ? 0u : i == 1 ? 0xffffffffu : rng.next_uint32();
+            }
+            uint64_t out[4];
+            tea_hash4(v0, v1, out, rounds);
+            for (int k = 0; k < 4; ++k)
+                ASSERT_EQ(out[k], tea_hash(v0[k], v1[k], rounds))
+                    << "rounds " << rounds << ", case " << i << ", lane " << k;
+        }
+}
+
 TEST(IndependentSampler, DrawsEqualTheVirtualCallsAndClonesOwnTheirStream) {
     // draw_1d()/draw_2d() take the sampler's PCG32 directly: the values must be next_1d()'s and
     // next_2d()'s, and a clone must draw from its own generator, not the original's.

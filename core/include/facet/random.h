@@ -65,13 +65,13 @@ inline uint64_t tea_hash(uint32_t v0, uint32_t v1, int rounds = 4) {
     return (uint64_t(v1) << 32) | v0;
 }
 
-/// Two TEA hashes at once: {tea_hash(a0, a1, rounds), tea_hash(b0, b1, rounds)}, bit for bit.
-/// With SSE2 both run in the lanes of one register (half the instructions of two calls).
-inline std::pair<uint64_t, uint64_t> tea_hash_pair(uint32_t a0, uint32_t a1, uint32_t b0,
-                                                   uint32_t b1, int rounds = 4) {
+/// Four TEA hashes at once: out[i] = tea_hash(v0[i], v1[i], rounds), bit for bit. With SSE2 the
+/// four run in the lanes of one register, for the instructions of one scalar hash.
+inline void tea_hash4(const uint32_t (&v0_in)[4], const uint32_t (&v1_in)[4], uint64_t (&out)[4],
+                      int rounds = 4) {
 #if defined(__SSE2__)
-    __m128i v0 = _mm_set_epi32(0, 0, int(b0), int(a0));
-    __m128i v1 = _mm_set_epi32(0, 0, int(b1), int(a1));
+    __m128i v0 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(v0_in));
+    __m128i v1 = _mm_loadu_si128(reinterpret_cast<const __m128i *>(v1_in));
     const __m128i k0 = _mm_set1_epi32(int(0xa341316cu)), k1 = _mm_set1_epi32(int(0xc8013ea4u)),
                   k2 = _mm_set1_epi32(int(0xad90777du)), k3 = _mm_set1_epi32(int(0x7e95761eu)),
                   delta = _mm_set1_epi32(int(0x9e3779b9u));
@@ -85,14 +85,21 @@ inline std::pair<uint64_t, uint64_t> tea_hash_pair(uint32_t a0, uint32_t a1, uin
                                                            _mm_add_epi32(v0, sum)),
                                              _mm_add_epi32(_mm_srli_epi32(v0, 5), k3)));
     }
-    // Lanes 0 and 1 of the interleaved (v0, v1) pairs: a's and b's 64-bit results.
-    const __m128i ab = _mm_unpacklo_epi32(v0, v1); // a0 a1 b0 b1
-    alignas(16) uint64_t out[2];
-    _mm_store_si128(reinterpret_cast<__m128i *>(out), ab);
-    return {out[0], out[1]};
+    // Interleave the (v0, v1) pairs: the 64-bit results (v1 << 32) | v0 of lanes 0-1 and 2-3.
+    _mm_storeu_si128(reinterpret_cast<__m128i *>(out), _mm_unpacklo_epi32(v0, v1));
+    _mm_storeu_si128(reinterpret_cast<__m128i *>(out + 2), _mm_unpackhi_epi32(v0, v1));
 #else
-    return {tea_hash(a0, a1, rounds), tea_hash(b0, b1, rounds)};
+    for (int i = 0; i < 4; ++i) out[i] = tea_hash(v0_in[i], v1_in[i], rounds);
 #endif
+}
+
+/// Two TEA hashes at once: {tea_hash(a0, a1, rounds), tea_hash(b0, b1, rounds)}, bit for bit.
+inline std::pair<uint64_t, uint64_t> tea_hash_pair(uint32_t a0, uint32_t a1, uint32_t b0,
+                                                   uint32_t b1, int rounds = 4) {
+    const uint32_t v0[4] = {a0, b0, 0, 0}, v1[4] = {a1, b1, 0, 0};
+    uint64_t out[4];
+    tea_hash4(v0, v1, out, rounds);
+    return {out[0], out[1]};
 }
 
 } // namespace facet
