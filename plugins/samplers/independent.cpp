@@ -67,13 +67,11 @@ public:
     // Sampler::draw_1d() and draw_2d() draw from m_rng directly, as these do.
     float next_1d() override {
         if (!m_stream) set_sample_index(m_sample_index); // seeded, not yet hashed
-        ++m_dimension;
         return m_rng.next_float();
     }
 
     Point2f next_2d() override {
         if (!m_stream) set_sample_index(m_sample_index);
-        m_dimension += 2;
         float x = m_rng.next_float();
         float y = m_rng.next_float();
         return {x, y};

@@ -37,15 +37,14 @@ public:
     virtual Point2f next_2d() = 0;
     /// next_1d() and next_2d() for the hot paths (the render loop, the integrators): the same
     /// values, without a virtual call when the sampler is one PCG32 stream per sample (it then
-    /// points m_stream at it, and its next_1d() and next_2d() must be these).
+    /// points m_stream at it, and its next_1d() and next_2d() must be these). The values of such
+    /// a sampler do not depend on the dimension, which these leave as it is.
     float draw_1d() {
         if (!m_stream) return next_1d();
-        ++m_dimension;
         return m_stream->next_float();
     }
     Point2f draw_2d() {
         if (!m_stream) return next_2d();
-        m_dimension += 2;
         float x = m_stream->next_float();
         float y = m_stream->next_float();
         return {x, y};
