@@ -97,6 +97,23 @@ uint64_t sample_stream_seed(uint64_t seed, uint64_t index) {
     return h ^ (uint64_t(uint32_t(seed >> 32)) << 32);
 }
 
+namespace {
+
+/// sample_stream_seed() of indices first .. first + 3, bit for bit, for the instructions of one
+/// (the four hashes run in the lanes of one register).
+void sample_stream_seeds4(uint64_t seed, uint64_t first, uint64_t (&out)[4]) {
+    uint32_t v0[4], v1[4];
+    for (int k = 0; k < 4; ++k) {
+        const uint64_t index = first + uint64_t(k);
+        v0[k] = uint32_t(index);
+        v1[k] = uint32_t(seed) ^ uint32_t(index >> 32);
+    }
+    tea_hash4(v0, v1, out);
+    for (uint64_t &h : out) h ^= uint64_t(uint32_t(seed >> 32)) << 32;
+}
+
+} // namespace
+
 // ---------------------------------------------------------------------------------------------
 // BlockMerger
 
@@ -458,10 +475,12 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
 
             uint64_t invalid = 0;
             uint32_t until_check = 1;
+            uint64_t pixel_seeds[4]; // of the row's pixels x0 + 4i .. x0 + 4i + 3
             for (int y = y0; y < y1; ++y) {
                 for (int x = x0; x < x1; ++x) {
                     const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
-                    sampler->seed(sample_stream_seed(seed, pixel_index));
+                    if ((x - x0) % 4 == 0) sample_stream_seeds4(seed, pixel_index, pixel_seeds);
+                    sampler->seed(pixel_seeds[(x - x0) % 4]);
                     for (uint32_t s = first; s < last; ++s) {
                         // A stop abandons the unit (its pass is incomplete and is dropped).
                         if (--until_check == 0) {
