@@ -95,37 +95,61 @@ inline void add_sample(float *p, float w, const Color3f &L, const float *aovs, i
     p[3 + aov_count] += w;
 }
 
+/// The storage pixels [x0, x1] x [y0, y1] that a box-filtered sample at film position `pos`
+/// reaches (at most two per axis: footprint()'s pixels, computed in place without its tables),
+/// for a block whose storage pixel (0, 0) is film pixel `origin` and whose storage is `size`.
+struct BoxReach {
+    float px, py; ///< the sample's position in film pixels, minus the half pixel
+    int ox, oy, x0, x1, y0, y1;
+};
+inline BoxReach box_reach(const Point2f &pos, const Point2i &origin, const Point2i &size) {
+    BoxReach r;
+    r.px = pos.x - 0.5f;
+    r.py = pos.y - 0.5f;
+    r.ox = origin.x;
+    r.oy = origin.y;
+    r.x0 = std::max(0, ceil_to_int(r.px - 0.5f) - r.ox);
+    r.x1 = std::min(size.x - 1, floor_to_int(r.px + 0.5f) - r.ox);
+    r.y0 = std::max(0, ceil_to_int(r.py - 0.5f) - r.oy);
+    r.y1 = std::min(size.y - 1, floor_to_int(r.py + 0.5f) - r.oy);
+    return r;
+}
+
 } // namespace
 
 void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
                      const ReconstructionFilter &filter) {
+    if (filter.is_box() && std::abs(pos.x) < 1e9f && std::abs(pos.y) < 1e9f) {
+        const Point2i s = storage_size();
+        const BoxReach r = box_reach(pos, m_offset - Point2i(m_border, m_border), s);
+        if (r.x0 == r.x1 && r.y0 == r.y1) {
+            // One candidate pixel (the sample is not on a pixel boundary): put_footprint()'s
+            // loops without their set-up.
+            const float w = ReconstructionFilter::box_eval(r.px - float(r.ox + r.x0)) *
+                            ReconstructionFilter::box_eval(r.py - float(r.oy + r.y0));
+            const int nc = channel_count();
+            if (w != 0.f)
+                add_sample(m_data.data() + size_t(r.y0) * size_t(s.x) * nc + size_t(r.x0) * nc, w,
+                           L, aovs, m_aov_count);
+            return;
+        }
+    }
+    put_footprint(pos, L, aovs, filter);
+}
+
+__attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, const Color3f &L,
+                                                         const float *aovs,
+                                                         const ReconstructionFilter &filter) {
     const Point2i s = storage_size();
     const int nc = channel_count();
     if (filter.is_box() && std::abs(pos.x) < 1e9f && std::abs(pos.y) < 1e9f) {
-        // The box (radius 0.5) reaches at most two pixels per axis: footprint()'s pixels and
-        // weights, computed in place without its tables (the same floats, so the same sums).
-        const float px = pos.x - 0.5f, py = pos.y - 0.5f;
-        const int ox = m_offset.x - m_border, oy = m_offset.y - m_border;
-        const int x0 = std::max(0, ceil_to_int(px - 0.5f) - ox);
-        const int x1 = std::min(s.x - 1, floor_to_int(px + 0.5f) - ox);
-        const int y0 = std::max(0, ceil_to_int(py - 0.5f) - oy);
-        const int y1 = std::min(s.y - 1, floor_to_int(py + 0.5f) - oy);
-        if (x0 == x1 && y0 == y1) {
-            // One candidate pixel (the sample is not on a pixel boundary): the loops below
-            // without their set-up.
-            const float w = ReconstructionFilter::box_eval(px - float(ox + x0)) *
-                            ReconstructionFilter::box_eval(py - float(oy + y0));
-            if (w != 0.f)
-                add_sample(m_data.data() + size_t(y0) * size_t(s.x) * nc + size_t(x0) * nc, w, L,
-                           aovs, m_aov_count);
-            return;
-        }
-        for (int y = y0; y <= y1; ++y) {
-            const float wy = ReconstructionFilter::box_eval(py - float(oy + y));
+        const BoxReach r = box_reach(pos, m_offset - Point2i(m_border, m_border), s);
+        for (int y = r.y0; y <= r.y1; ++y) {
+            const float wy = ReconstructionFilter::box_eval(r.py - float(r.oy + y));
             if (wy == 0.f) continue;
             float *row = m_data.data() + size_t(y) * size_t(s.x) * nc;
-            for (int x = x0; x <= x1; ++x) {
-                const float w = ReconstructionFilter::box_eval(px - float(ox + x)) * wy;
+            for (int x = r.x0; x <= r.x1; ++x) {
+                const float w = ReconstructionFilter::box_eval(r.px - float(r.ox + x)) * wy;
                 if (w != 0.f) add_sample(row + size_t(x) * nc, w, L, aovs, m_aov_count);
             }
         }

@@ -67,6 +67,10 @@ private:
     };
     /// False when the sample (non-finite, or outside the block) reaches no pixel.
     bool footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp);
+    /// put() of a sample that reaches more than one pixel, or of another filter than the box:
+    /// out of line, so that put()'s usual case (one box pixel) saves no registers.
+    void put_footprint(const Point2f &pos, const Color3f &L, const float *aovs,
+                       const ReconstructionFilter &filter);
 
     std::vector<float> m_wx, m_wy; ///< scratch filter weights, reused
 };
