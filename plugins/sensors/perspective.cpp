@@ -76,6 +76,10 @@ public:
                            m_to_world.to_string());
         m_origin = m_to_world.apply_point(Point3f(0.f));
         m_world_to_local = m_to_world.inverse();
+        for (int i = 0; i < 3; ++i) {
+            const auto &row = m_to_world.matrix.m[i];
+            m_rotation[i] = Vector3f(row[0], row[1], row[2]);
+        }
     }
 
     std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
@@ -85,8 +89,10 @@ public:
         const Vector3f local =
             normalize(Vector3f((1.f - 2.f * u) * m_tan_x, (1.f - 2.f * v) * m_tan_y, 1.f));
         const float inv_z = 1.f / local.z;
-        Ray ray(m_origin, normalize(m_to_world.apply_vector(local)), m_near_clip * inv_z,
-                m_far_clip * inv_z);
+        // m_to_world.apply_vector(local), inline (the same products summed in the same order).
+        const Vector3f d(dot(m_rotation[0], local), dot(m_rotation[1], local),
+                         dot(m_rotation[2], local));
+        Ray ray(m_origin, normalize(d), m_near_clip * inv_z, m_far_clip * inv_z);
         ray.time = time;
         return {ray, Color3f(1.f)};
     }
@@ -140,6 +146,7 @@ private:
     float m_tan_x = 1.f, m_tan_y = 1.f;
     Point2f m_principal_offset;
     Point3f m_origin;
+    Vector3f m_rotation[3]; ///< the rows of m_to_world's upper 3x3 block, for sample_ray()
     Transform m_world_to_local;
 };
 
