@@ -1,7 +1,8 @@
 # Fuzz targets (tests/fuzz/<target>.cpp, each an LLVMFuzzerTestOneInput) and their replays.
 # In every build: fuzz_<target>_replay runs the entry point over the seed corpus
-# (tests/fuzz/corpus/<target>/) and over every input that once crashed it
-# (tests/fuzz/regressions/<target>/), as the ctest fuzz.<target> (label fuzz).
+# (tests/fuzz/corpus/<target>/), over the inputs a longer campaign found (tests/fuzz/grown/
+# <target>/, minimised with -merge=1; the next campaign starts from them) and over every input
+# that once crashed it (tests/fuzz/regressions/<target>/), as the ctest fuzz.<target> (label fuzz).
 # With -DFACET_FUZZ=ON (clang; implies FACET_SANITIZE): the libFuzzer executables
 # fuzz_<target>, run as README.md describes.
 set(FACET_FUZZ_TARGETS xml obj ply serialized image)
@@ -14,11 +15,14 @@ foreach(t ${FACET_FUZZ_TARGETS})
     target_link_libraries(fuzz_${t}_entry PRIVATE ${_libs})
     add_executable(fuzz_${t}_replay $<TARGET_OBJECTS:fuzz_${t}_entry> ${_fuzz_dir}/replay.cpp)
     target_link_libraries(fuzz_${t}_replay PRIVATE ${_libs})
-    add_dependencies(fuzz_${t}_replay facet_plugins)
+    # The plugins and the image library are loaded at run time, not linked.
+    add_dependencies(fuzz_${t}_replay facet_plugins facet_image)
     set(_inputs ${_fuzz_dir}/corpus/${t})
-    if(EXISTS ${_fuzz_dir}/regressions/${t})
-        list(APPEND _inputs ${_fuzz_dir}/regressions/${t})
-    endif()
+    foreach(_more grown regressions)
+        if(EXISTS ${_fuzz_dir}/${_more}/${t})
+            list(APPEND _inputs ${_fuzz_dir}/${_more}/${t})
+        endif()
+    endforeach()
     add_test(NAME fuzz.${t} COMMAND fuzz_${t}_replay ${_inputs}
              WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})
     set_tests_properties(fuzz.${t} PROPERTIES LABELS fuzz TIMEOUT 300)
@@ -34,6 +38,6 @@ foreach(t ${FACET_FUZZ_TARGETS})
         add_executable(fuzz_${t} $<TARGET_OBJECTS:fuzz_${t}_entry>)
         target_link_options(fuzz_${t} PRIVATE -fsanitize=fuzzer)
         target_link_libraries(fuzz_${t} PRIVATE ${_libs})
-        add_dependencies(fuzz_${t} facet_plugins)
+        add_dependencies(fuzz_${t} facet_plugins facet_image)
     endif()
 endforeach()
