@@ -938,8 +938,10 @@ Image read_pixels(const std::string &path) {
         !checked_mul(row, size_t(spec.height), values))
         values = std::numeric_limits<size_t>::max();
     allocation_bytes(values, sizeof(float), path, "image pixels");
-    if (spec.tile_width <= 0 && in->format_name() == std::string("tiff"))
-        check_tiff_strips(path, spec);
+    // OpenImageIO's TIFF reader buffers whole strips (check_tiff_strips(), and the row-by-row
+    // reading of MinIsWhite files below).
+    const bool tiff_strips = spec.tile_width <= 0 && in->format_name() == std::string("tiff");
+    if (tiff_strips) check_tiff_strips(path, spec);
     // A band of whole tiles, converted to float by OpenImageIO in a buffer of its own.
     if (spec.tile_width > 0) {
         size_t tiles_x = 0, tile_values = 0;
@@ -972,7 +974,7 @@ Image read_pixels(const std::string &path) {
     // a single row through libtiff and inverts that row's values only: such files are read row
     // by row.
     const bool miniswhite_strips =
-        spec.tile_width <= 0 && spec.nchannels > 1 && in->format_name() == std::string("tiff") &&
+        tiff_strips && spec.nchannels > 1 &&
         spec.get_int_attribute("tiff:PhotometricInterpretation", -1) == 0;
     const int band = spec.tile_width > 0 ? std::max(spec.tile_height, 1)
                      : miniswhite_strips
