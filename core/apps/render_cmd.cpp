@@ -255,8 +255,8 @@ int render_main(int argc, char **argv) {
     cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
                                   film.crop_size().x, film.crop_size().y, range.count));
     RenderResult result;
-    // The image library (for the write) loads while the render runs, from its first pixels on.
-    ropts.on_first_block = [] { preload_image_library(); };
+    // The module that writes the output loads while the render runs, from its first pixels on.
+    ropts.on_first_block = [out] { preload_image_writer(out); };
     try {
         result = render(*scene, sensor, ropts);
         result.load_seconds = load_seconds;

@@ -1,3 +1,4 @@
+#include "file_output.h"
 #include "image_library.h"
 
 #include <facet/checked.h>
@@ -10,20 +11,17 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <dlfcn.h>
-#include <fcntl.h>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <tuple>
-#include <unistd.h>
 
 namespace OCIO = OCIO_NAMESPACE;
 namespace fs = std::filesystem;
@@ -42,28 +40,6 @@ std::string lower_extension(const std::string &path) {
 /// Formats that keep scene-linear floating-point values.
 bool is_linear_format(const std::string &ext) {
     return ext == ".exr" || ext == ".hdr" || ext == ".rgbe" || ext == ".pfm";
-}
-
-/// The channels of a developed film's colour (and alpha), as opposed to AOV channels.
-bool is_colour_channel(const std::string &name) {
-    return name == "R" || name == "G" || name == "B" || name == "A" || name == "X" || name == "Y" ||
-           name == "Z";
-}
-
-/// Typed attributes of an EXR: the caller's ints, floats and matrices, and the chromaticities
-/// of linear Rec.709 (the space facet renders in) for RGB and luminance images.
-void add_exr_metadata(OIIO::ImageSpec &spec, const ImageWriteOptions &opts) {
-    for (const auto &[key, value] : opts.int_metadata) spec.attribute(key, value);
-    for (const auto &[key, value] : opts.float_metadata) spec.attribute(key, value);
-    for (const auto &[key, value] : opts.matrix_metadata)
-        spec.attribute(key, OIIO::TypeMatrix44, &value.m[0][0]);
-    const bool xyz = spec.nchannels >= 3 && spec.channelnames[0] == "X" &&
-                     spec.channelnames[1] == "Y" && spec.channelnames[2] == "Z";
-    if (!xyz) {
-        // Red, green, blue and white (D65) xy, as OpenEXR's chromaticities attribute orders them.
-        static const float rec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
-        spec.attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8), rec709);
-    }
 }
 
 /// The parsed config at `config_path`, read once.
@@ -207,22 +183,6 @@ std::vector<uint8_t> to_display_8bit(const Image &image, const std::vector<int> 
     return out;
 }
 
-std::string temp_path_for(const std::string &path) {
-    fs::path p(path);
-    fs::path dir = p.parent_path();
-    std::string name = "." + p.filename().string() + ".tmp-" + std::to_string(::getpid());
-    return dir.empty() ? name : (dir / name).string();
-}
-
-/// Removes the temporary file when the write does not complete.
-struct TempFileGuard {
-    std::string path;
-    bool armed = true;
-    ~TempFileGuard() {
-        if (armed) std::remove(path.c_str());
-    }
-};
-
 /// The PFM header encode_pfm() writes.
 std::string pfm_header(int width, int height, int channels) {
     return fmt::format("{}\n{} {}\n-1.0\n", channels == 1 ? "Pf" : "PF", width, height);
@@ -242,42 +202,12 @@ std::vector<unsigned char> encode_pfm(const float *pixels, int width, int height
     return bytes;
 }
 
-/// Writes `bytes` to the new file `file`, checking every write, the flush to the disk and the
-/// close: on a full disk one of them fails (with stdio or an image library's own buffering, the
-/// failure can go unnoticed). Returns "" or the reason.
-std::string write_bytes(const std::string &file, const std::vector<unsigned char> &bytes) {
-    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0) return std::strerror(errno);
-    std::string err;
-    size_t done = 0;
-    while (err.empty() && done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n > 0)
-            done += size_t(n);
-        else if (n < 0 && errno == EINTR)
-            continue;
-        else
-            err = n < 0 ? std::strerror(errno) : "no space left";
-    }
-    // Some file systems (NFS, quotas, delayed allocation) report a full disk only here.
-    if (err.empty() && ::fdatasync(fd) != 0 && errno != EINVAL && errno != EROFS)
-        err = std::strerror(errno);
-    if (::close(fd) != 0 && err.empty()) err = std::strerror(errno);
-    return err;
-}
-
-/// Checks that the temporary file `file` really holds the image just encoded, before it
-/// replaces anything: its size is that of the encoded bytes, and OpenImageIO reads it back
+/// Checks that the temporary file `file` (of the expected size, see replace_image_file()) really
+/// holds the image just encoded, before it replaces anything: OpenImageIO reads it back
 /// completely with the expected size and channel count; a PNG's or PFM's pixels must equal the
 /// ones written. Returns "" or what is wrong.
-std::string verify_written(const std::string &file, uintmax_t expected_size,
-                           const OIIO::ImageSpec &spec, const std::string &ext,
-                           const void *pixels) {
-    std::error_code ec;
-    const uintmax_t size = fs::file_size(file, ec);
-    if (ec) return fmt::format("cannot stat the written file: {}", ec.message());
-    if (size != expected_size)
-        return fmt::format("the written file has {} bytes instead of {}", size, expected_size);
+std::string verify_written(const std::string &file, const OIIO::ImageSpec &spec,
+                           const std::string &ext, const void *pixels) {
     // The temporary file's name has no image extension: the reader is chosen by the output's.
     auto in = ext.size() > 1 ? OIIO::ImageInput::create(ext.substr(1), /*do_open=*/false) : nullptr;
     OIIO::ImageSpec back;
@@ -319,13 +249,8 @@ void check_image_path(const std::string &path) {
     }
 }
 
+/// write_image() of every format but EXR (exr.cpp): the caller has checked the image and the path.
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts) {
-    if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
-        image.data.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
-        FACET_THROW("cannot write image \"{}\": invalid image ({}x{}, {} channels, {} values)",
-                    path, image.width, image.height, image.channels, image.data.size());
-    check_image_path(path);
-
     const std::string ext = lower_extension(path);
     const bool pfm = ext == ".pfm";
     // The plugin is chosen by the target's extension; the data goes to a temporary file first.
@@ -334,69 +259,31 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         FACET_THROW("cannot write image \"{}\": no image format for the extension \"{}\" ({})",
                     path, ext, OIIO::geterror());
 
-    const bool linear = is_linear_format(ext);
     std::vector<float> linear_pixels;
     std::vector<uint8_t> display_pixels;
     OIIO::ImageSpec spec;
     const void *pixels = nullptr;
     OIIO::TypeDesc pixel_type;
-
-    if (ext == ".exr") {
-        spec = OIIO::ImageSpec(image.width, image.height, image.channels,
-                               opts.half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
-        for (int c = 0; c < image.channels; ++c) {
-            std::string name = c < int(image.channel_names.size()) ? image.channel_names[c] : "";
-            if (name.empty())
-                name = image.channels == 1
-                           ? "Y"
-                           : (c < 4 ? std::string(1, "RGBA"[c]) : fmt::format("channel{}", c));
-            spec.channelnames[c] = name;
-        }
-        spec.alpha_channel = -1;
-        for (int c = 0; c < image.channels; ++c)
-            if (spec.channelnames[c] == "A") spec.alpha_channel = c;
-        if (opts.half) {
-            // Only the leading colour channels are half; AOVs after them stay float32.
-            int colour = 0;
-            while (colour < image.channels && is_colour_channel(spec.channelnames[colour]))
-                ++colour;
-            if (colour < image.channels) {
-                spec.channelformats.assign(size_t(image.channels), OIIO::TypeDesc::FLOAT);
-                for (int c = 0; c < colour; ++c) spec.channelformats[c] = OIIO::TypeDesc::HALF;
-            }
-        }
-        spec.attribute("compression", "zip");
-        // A crop window: data window at (x, y) inside the full display window.
-        spec.x = image.x;
-        spec.y = image.y;
-        spec.full_x = spec.full_y = 0;
-        spec.full_width = image.full_width > 0 ? image.full_width : image.x + image.width;
-        spec.full_height = image.full_height > 0 ? image.full_height : image.y + image.height;
-        add_exr_metadata(spec, opts);
-        pixels = image.data.data();
+    std::vector<int> ch = output_channels(image, path);
+    const int n = int(ch.size());
+    if (is_linear_format(ext)) {
+        // RGBE and PFM hold grey or RGB floats only.
+        const int nout = n <= 2 ? 1 : 3;
+        linear_pixels.resize(size_t(image.width) * image.height * nout);
+        for (size_t i = 0, np = size_t(image.width) * image.height; i < np; ++i)
+            for (int c = 0; c < nout; ++c)
+                linear_pixels[i * nout + c] = image.data[i * image.channels + ch[c]];
+        spec = OIIO::ImageSpec(image.width, image.height, nout, OIIO::TypeDesc::FLOAT);
+        pixels = linear_pixels.data();
         pixel_type = OIIO::TypeDesc::FLOAT;
     } else {
-        std::vector<int> ch = output_channels(image, path);
-        const int n = int(ch.size());
-        if (linear) {
-            // RGBE and PFM hold grey or RGB floats only.
-            const int nout = n <= 2 ? 1 : 3;
-            linear_pixels.resize(size_t(image.width) * image.height * nout);
-            for (size_t i = 0, np = size_t(image.width) * image.height; i < np; ++i)
-                for (int c = 0; c < nout; ++c)
-                    linear_pixels[i * nout + c] = image.data[i * image.channels + ch[c]];
-            spec = OIIO::ImageSpec(image.width, image.height, nout, OIIO::TypeDesc::FLOAT);
-            pixels = linear_pixels.data();
-            pixel_type = OIIO::TypeDesc::FLOAT;
-        } else {
-            display_pixels = to_display_8bit(image, ch, opts);
-            spec = OIIO::ImageSpec(image.width, image.height, n, OIIO::TypeDesc::UINT8);
-            if (n == 2 || n == 4) spec.alpha_channel = n - 1;
-            if (ext == ".jpg" || ext == ".jpeg") spec.attribute("compression", "jpeg:95");
-            spec.attribute("oiio:ColorSpace", "sRGB");
-            pixels = display_pixels.data();
-            pixel_type = OIIO::TypeDesc::UINT8;
-        }
+        display_pixels = to_display_8bit(image, ch, opts);
+        spec = OIIO::ImageSpec(image.width, image.height, n, OIIO::TypeDesc::UINT8);
+        if (n == 2 || n == 4) spec.alpha_channel = n - 1;
+        if (ext == ".jpg" || ext == ".jpeg") spec.attribute("compression", "jpeg:95");
+        spec.attribute("oiio:ColorSpace", "sRGB");
+        pixels = display_pixels.data();
+        pixel_type = OIIO::TypeDesc::UINT8;
     }
     for (const auto &[key, value] : opts.metadata) spec.attribute(key, value);
 
@@ -419,18 +306,9 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         out.reset();
         if (!ok) FACET_THROW("cannot write image \"{}\": {}", path, err);
     }
-    const std::string tmp = temp_path_for(path);
-    TempFileGuard guard{tmp};
-    const char *kept = fs::exists(path) ? "the existing file is unchanged" : "nothing was written";
-    if (std::string err = write_bytes(tmp, bytes); !err.empty())
-        FACET_THROW("cannot write image \"{}\": {}; {}", path, err, kept);
-    // Nothing replaces the old file unless the new one reads back complete.
-    if (std::string bad = verify_written(tmp, bytes.size(), spec, ext, pixels); !bad.empty())
-        FACET_THROW("cannot write image \"{}\": {} (disk full?); {}", path, bad, kept);
-    if (std::rename(tmp.c_str(), path.c_str()) != 0)
-        FACET_THROW("cannot write image \"{}\": renaming the temporary file failed: {}", path,
-                    std::strerror(errno));
-    guard.armed = false;
+    detail::replace_image_file(path, bytes, [&](const std::string &file) {
+        return verify_written(file, spec, ext, pixels);
+    });
 }
 
 OcioDisplays ocio_displays(const std::string &explicit_path) {

@@ -20,34 +20,62 @@ namespace facet {
 
 namespace {
 
-std::atomic<const detail::ImageLibrary *> g_library{nullptr};
+/// A module of libfacet's, loaded with dlopen() on first use and never unloaded.
+struct Module {
+    const char *file;  ///< installed next to libfacet
+    const char *env;   ///< names another path
+    const char *entry; ///< the one symbol it exports: a function returning its table
+    int version;       ///< of the table's layout
+    const char *what;  ///< for messages
+};
 
-const detail::ImageLibrary &library() {
-    if (const detail::ImageLibrary *lib = g_library.load(std::memory_order_acquire)) return *lib;
+const Module ImageModule{"libfacet_image.so", "FACET_IMAGE_LIBRARY", FACET_IMAGE_LIBRARY_ENTRY,
+                         FACET_IMAGE_LIBRARY_VERSION,
+                         "image library (OpenImageIO and OpenColorIO, needed to read and write "
+                         "images)"};
+const Module ExrModule{"libfacet_exr.so", "FACET_EXR_LIBRARY", FACET_EXR_LIBRARY_ENTRY,
+                       FACET_EXR_LIBRARY_VERSION,
+                       "EXR writer (OpenEXR, needed to write .exr images)"};
+
+std::string module_path(const Module &module) {
+    if (const char *env = std::getenv(module.env); env && *env) return env;
+    Dl_info info;
+    if (dladdr(reinterpret_cast<void *>(&module_path), &info) && info.dli_fname)
+        return (fs::absolute(fs::path(info.dli_fname)).parent_path() / module.file).string();
+    return module.file; // the dynamic loader's search
+}
+
+template <typename Table>
+const Table &load(const Module &module, std::atomic<const Table *> &slot) {
+    if (const Table *table = slot.load(std::memory_order_acquire)) return *table;
     static std::mutex mutex;
     std::lock_guard<std::mutex> lock(mutex);
-    if (const detail::ImageLibrary *lib = g_library.load(std::memory_order_relaxed)) return *lib;
-    const std::string path = image_library_path();
-    // RTLD_LOCAL: OpenImageIO's and OpenColorIO's symbols stay out of the global scope, which
-    // plugins loaded later resolve against.
+    if (const Table *table = slot.load(std::memory_order_relaxed)) return *table;
+    const std::string path = module_path(module);
+    // RTLD_LOCAL: the image libraries' symbols stay out of the global scope, which plugins
+    // loaded later resolve against.
     void *handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!handle)
-        FACET_THROW("cannot load facet's image library (OpenImageIO and OpenColorIO, needed to "
-                    "read and write images): {}; it is installed next to libfacet, or "
-                    "$FACET_IMAGE_LIBRARY names it",
-                    dlerror());
-    using Entry = const detail::ImageLibrary *(*)();
-    auto entry = reinterpret_cast<Entry>(dlsym(handle, FACET_IMAGE_LIBRARY_ENTRY));
-    const detail::ImageLibrary *lib = entry ? entry() : nullptr;
-    if (!lib || lib->version != FACET_IMAGE_LIBRARY_VERSION)
-        FACET_THROW("\"{}\" is not the image library of this facet (expected the entry point "
-                    "{} of version {}{})",
-                    path, FACET_IMAGE_LIBRARY_ENTRY, FACET_IMAGE_LIBRARY_VERSION,
-                    lib ? fmt::format(", found version {}", lib->version) : "");
-    FACET_LOG(Debug, "loaded the image library {} ({})", path, lib->versions());
-    g_library.store(lib, std::memory_order_release); // never unloaded
-    return *lib;
+        FACET_THROW("cannot load facet's {}: {}; it is installed next to libfacet, or ${} names it",
+                    module.what, dlerror(), module.env);
+    using Entry = const Table *(*)();
+    auto entry = reinterpret_cast<Entry>(dlsym(handle, module.entry));
+    const Table *table = entry ? entry() : nullptr;
+    if (!table || table->version != module.version)
+        FACET_THROW("\"{}\" is not the {} of this facet (expected the entry point {} of version "
+                    "{}{})",
+                    path, module.file, module.entry, module.version,
+                    table ? fmt::format(", found version {}", table->version) : "");
+    FACET_LOG(Debug, "loaded {} ({})", path, table->versions());
+    slot.store(table, std::memory_order_release);
+    return *table;
 }
+
+std::atomic<const detail::ImageLibrary *> g_library{nullptr};
+std::atomic<const detail::ExrLibrary *> g_exr{nullptr};
+
+const detail::ImageLibrary &library() { return load(ImageModule, g_library); }
+const detail::ExrLibrary &exr_library() { return load(ExrModule, g_exr); }
 
 std::string lower_extension(const std::string &path) {
     std::string ext = fs::path(path).extension().string();
@@ -58,18 +86,14 @@ std::string lower_extension(const std::string &path) {
 
 } // namespace
 
-std::string image_library_path() {
-    if (const char *env = std::getenv("FACET_IMAGE_LIBRARY"); env && *env) return env;
-    Dl_info info;
-    if (dladdr(reinterpret_cast<void *>(&image_library_path), &info) && info.dli_fname)
-        return (fs::absolute(fs::path(info.dli_fname)).parent_path() / "libfacet_image.so")
-            .string();
-    return "libfacet_image.so"; // the dynamic loader's search
-}
+std::string image_library_path() { return module_path(ImageModule); }
 
 bool image_library_loaded() { return g_library.load(std::memory_order_acquire) != nullptr; }
 
-void preload_image_library() {
+namespace {
+
+/// Loads `load()`'s module on a background thread, once per module.
+template <typename Load> void preload(Load load) {
     // Joined at exit: a process that ends early (a failed render) does not unload the
     // libraries under the loading thread.
     struct Preloader {
@@ -78,23 +102,44 @@ void preload_image_library() {
             if (thread.joinable()) thread.join();
         }
     };
-    static Preloader preloader{std::thread([] {
+    static Preloader preloader{std::thread([load] {
         try {
-            library();
+            load();
         } catch (const std::exception &) {
             // Reported by the first function that needs the library.
         }
     })};
 }
 
+} // namespace
+
+void preload_image_library() {
+    preload([] { library(); });
+}
+
+void preload_image_writer(const std::string &path) {
+    if (lower_extension(path) == ".exr")
+        preload([] { exr_library(); });
+    else
+        preload_image_library();
+}
+
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts) {
-    library().write_image(path, image, opts);
+    if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+        image.data.size() != size_t(image.width) * size_t(image.height) * size_t(image.channels))
+        FACET_THROW("cannot write image \"{}\": invalid image ({}x{}, {} channels, {} values)",
+                    path, image.width, image.height, image.channels, image.data.size());
+    check_image_path(path);
+    if (lower_extension(path) == ".exr")
+        exr_library().write_exr(path, image, opts);
+    else
+        library().write_image(path, image, opts);
 }
 
 void check_image_path(const std::string &path) {
     // The formats facet documents are known without loading the image library, so that a
     // render checks its output name before the first pixel without paying for it; only the
-    // library's presence is checked. Other extensions ask OpenImageIO.
+    // presence of the module that writes it is checked. Other extensions ask OpenImageIO.
     const std::string ext = lower_extension(path);
     static const char *const known[] = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"};
     if (ext == ".pfm" || std::find(std::begin(known), std::end(known), ext) != std::end(known)) {
@@ -104,12 +149,13 @@ void check_image_path(const std::string &path) {
             FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path,
                         dir.string());
         if (ext == ".pfm") return; // written by facet itself
-        const std::string lib = image_library_path();
+        const Module &module = ext == ".exr" ? ExrModule : ImageModule;
+        const std::string lib = module_path(module);
         if (lib.find('/') != std::string::npos && !fs::is_regular_file(lib, ec))
-            FACET_THROW("cannot write image \"{}\": facet's image library \"{}\" (OpenImageIO "
-                        "and OpenColorIO) is missing; it is installed next to libfacet, or "
-                        "$FACET_IMAGE_LIBRARY names it",
-                        path, lib);
+            FACET_THROW("cannot write image \"{}\": facet's {} \"{}\" ({}) is missing; it is "
+                        "installed next to libfacet, or ${} names it",
+                        path, ext == ".exr" ? "EXR writer" : "image library", lib,
+                        ext == ".exr" ? "OpenEXR" : "OpenImageIO and OpenColorIO", module.env);
         return;
     }
     library().check_image_path(path);

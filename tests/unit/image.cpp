@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <unistd.h>
 
 using namespace facet;
@@ -496,6 +498,55 @@ TEST_F(ImageIO, ExrTypedMetadataAndRec709Chromaticities) {
     in = OIIO::ImageInput::open(path("xyz.exr"));
     ASSERT_TRUE(in);
     EXPECT_FALSE(in->spec().find_attribute("chromaticities"));
+}
+
+TEST_F(ImageIO, ExrKeepsItsCropWindowAndStoresHalfsRoundedToNearest) {
+    // A crop: 6x4 pixels at (5, 3) of a 20x10 image, half colour and a float AOV.
+    Image img = gradient(6, 4, 4);
+    img.channel_names = {"R", "G", "B", "depth"};
+    img.x = 5;
+    img.y = 3;
+    img.full_width = 20;
+    img.full_height = 10;
+    img.at(0, 0, 0) = std::numeric_limits<float>::quiet_NaN();
+    img.at(1, 0, 0) = std::numeric_limits<float>::infinity();
+    img.at(2, 0, 0) = 70000.f;            // past the largest half: infinity
+    img.at(3, 0, 0) = 1.f + 1.f / 2048.f; // halfway between two halfs: to the even one, 1
+    img.at(4, 0, 0) = 1.f + 3.f / 2048.f; // to the even one above, 1 + 2/1024
+    img.at(5, 0, 0) = -1e-8f;             // below the smallest half: -0
+    ImageWriteOptions opts;
+    opts.half = true;
+    write_image(path("crop.exr"), img, opts);
+
+    auto in = OIIO::ImageInput::open(path("crop.exr"));
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec &spec = in->spec();
+    EXPECT_EQ(spec.x, 5);
+    EXPECT_EQ(spec.y, 3);
+    EXPECT_EQ(spec.width, 6);
+    EXPECT_EQ(spec.height, 4);
+    EXPECT_EQ(spec.full_x, 0);
+    EXPECT_EQ(spec.full_y, 0);
+    EXPECT_EQ(spec.full_width, 20);
+    EXPECT_EQ(spec.full_height, 10);
+    in->close();
+    Image back = read_image(path("crop.exr"));
+    ASSERT_EQ(back.channels, 4);
+    EXPECT_EQ(back.channel_names, img.channel_names);
+    EXPECT_TRUE(std::isnan(back.at(0, 0, 0)));
+    EXPECT_EQ(back.at(1, 0, 0), std::numeric_limits<float>::infinity());
+    EXPECT_EQ(back.at(2, 0, 0), std::numeric_limits<float>::infinity());
+    EXPECT_EQ(back.at(3, 0, 0), 1.f);
+    EXPECT_EQ(back.at(4, 0, 0), 1.f + 2.f / 1024.f);
+    EXPECT_EQ(back.at(5, 0, 0), 0.f);
+    EXPECT_TRUE(std::signbit(back.at(5, 0, 0)));
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 6; ++x) EXPECT_EQ(back.at(x, y, 3), img.at(x, y, 3)); // float32
+
+    // Two channels of one name cannot both be stored: refused, nothing written.
+    img.channel_names = {"R", "G", "B", "G"};
+    EXPECT_THROW(write_image(path("twice.exr"), img, opts), Error);
+    EXPECT_EQ(listing(), std::vector<std::string>{"crop.exr"});
 }
 
 TEST_F(ImageIO, HalfExrKeepsAovChannelsFloat32) {

@@ -1,6 +1,8 @@
-// libfacet_image (OpenImageIO, OpenColorIO) is loaded the first time an image file is touched,
-// not before: loading a scene and rendering it leave it unloaded, and the first image write or
-// read loads it. One process per unit executable: this file's tests are its only ones, in order.
+// libfacet_image (OpenImageIO, OpenColorIO) is loaded the first time an image file other than an
+// EXR output is touched, not before: loading a scene, rendering it and writing the render to
+// .exr (libfacet_exr, OpenEXR alone) leave it unloaded, and the first image read or write of
+// another format loads it. One process per unit executable: this file's tests are its only ones,
+// in order.
 
 #include <facet/image.h>
 #include <facet/render.h>
@@ -37,7 +39,7 @@ fs::path scratch() {
 
 } // namespace
 
-TEST(ImageLibrary, ARenderLoadsItOnlyToWriteItsImage) {
+TEST(ImageLibrary, ARenderToExrNeverLoadsIt) {
     ASSERT_FALSE(image_library_loaded()) << "loaded before anything touched an image";
     auto scene = std::dynamic_pointer_cast<Scene>(load_string(kScene));
     ASSERT_TRUE(scene);
@@ -50,8 +52,9 @@ TEST(ImageLibrary, ARenderLoadsItOnlyToWriteItsImage) {
     RenderResult r = render(*scene, *scene->sensors().front(), opts);
     EXPECT_FALSE(image_library_loaded()) << "loaded by loading or rendering the scene";
     scene->sensors().front()->film().write(r.image, out.string(), {});
-    EXPECT_TRUE(image_library_loaded());
+    EXPECT_FALSE(image_library_loaded()) << "loaded to write an EXR";
     Image back = read_image(out.string());
+    EXPECT_TRUE(image_library_loaded());
     EXPECT_EQ(back.width, 8);
     EXPECT_EQ(back.height, 8);
     fs::remove_all(out.parent_path());
@@ -75,5 +78,20 @@ TEST(ImageLibrary, AMissingLibraryIsAClearErrorBeforeTheRender) {
             << e.what();
     }
     ::unsetenv("FACET_IMAGE_LIBRARY");
+    fs::remove_all(scratch());
+}
+
+TEST(ImageLibrary, AMissingExrWriterIsAClearErrorBeforeTheRender) {
+    ::setenv("FACET_EXR_LIBRARY", "/nonexistent/libfacet_exr.so", 1);
+    try {
+        check_image_path((scratch() / "x.exr").string());
+        ADD_FAILURE() << "no error for a missing EXR writer";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find("EXR writer \"/nonexistent/libfacet_exr.so\" "
+                                             "(OpenEXR) is missing"),
+                  std::string::npos)
+            << e.what();
+    }
+    ::unsetenv("FACET_EXR_LIBRARY");
     fs::remove_all(scratch());
 }

@@ -49,9 +49,10 @@ struct ImageWriteOptions {
     std::map<std::string, Matrix4f> matrix_metadata;
 };
 
-/// Writes with OpenImageIO (PFM: facet's own writer) to a temporary file next to `path`, checks
-/// that file (read back; see verify_written in image.cpp), then renames it over `path`: a failed
-/// write throws and leaves an existing `path` untouched. .exr/.hdr/.pfm stay scene-linear (an RGB
+/// Writes with OpenEXR (.exr), OpenImageIO (other formats) or facet's own writer (PFM) to a
+/// temporary file next to `path`, checks that file (read back; see verify_written in exr.cpp and
+/// image.cpp), then renames it over `path`: a failed write throws and leaves an existing `path`
+/// untouched. .exr/.hdr/.pfm stay scene-linear (an RGB
 /// EXR is tagged with the Rec.709 chromaticities); 8-bit formats (.png, .jpg, ...) go through
 /// the OpenColorIO display/view transform of the chosen config.
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts = {});
@@ -113,6 +114,10 @@ bool image_library_loaded();
 /// the render instead of delaying the first sample, and an interrupted render writes its image
 /// without waiting for the libraries.
 void preload_image_library();
+/// Starts loading, on a background thread, the module write_image(`path`) needs: libfacet_exr
+/// (OpenEXR only, a few MiB) for .exr, else libfacet_image. A render to .exr thus never loads
+/// OpenImageIO and OpenColorIO (unless its scene reads an image).
+void preload_image_writer(const std::string &path);
 /// Path of the OCIO config facet uses: `explicit_path`, else $OCIO, else the installed one.
 std::string ocio_config_path(const std::string &explicit_path = "");
 
