@@ -9,6 +9,8 @@
 #include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -256,6 +258,40 @@ TEST(Warp, UniformDiskConcentric) {
     Point2f c = warp::square_to_uniform_disk_concentric({0.5f, 0.5f});
     EXPECT_EQ(c.x, 0.f);
     EXPECT_EQ(c.y, 0.f);
+}
+
+TEST(Warp, ConcentricMapIsTheExactMapToWithinFloatRounding) {
+    // sin_cos_quarter_pi() against the double-precision functions over the whole range, and
+    // the map against the double-precision map on a grid that includes the wedge boundaries
+    // (|x| = |y|) and the corners: within 3e-7 (a few ulps of 1), and never outside the disk.
+    double worst_trig = 0.0;
+    for (int i = -1000; i <= 1000; ++i) {
+        const float a = float(Pi / 4.0 * i / 1000.0);
+        float s, c;
+        warp::sin_cos_quarter_pi(a, s, c);
+        worst_trig = std::max({worst_trig, std::abs(double(s) - std::sin(double(a))),
+                               std::abs(double(c) - std::cos(double(a)))});
+    }
+    EXPECT_LT(worst_trig, 1.2e-7);
+    double worst_map = 0.0;
+    for (int i = 0; i <= 256; ++i)
+        for (int j = 0; j <= 256; ++j) {
+            const Point2f u(std::min(i / 256.f, OneMinusEpsilon),
+                            std::min(j / 256.f, OneMinusEpsilon));
+            const Point2f p = warp::square_to_uniform_disk_concentric(u);
+            const double x = 2.0 * double(u.x) - 1.0, y = 2.0 * double(u.y) - 1.0;
+            double ex = 0.0, ey = 0.0;
+            if (std::abs(x) > std::abs(y)) {
+                ex = x * std::cos(M_PI / 4 * (y / x));
+                ey = x * std::sin(M_PI / 4 * (y / x));
+            } else if (y != 0.0) {
+                ex = y * std::cos(M_PI / 2 - M_PI / 4 * (x / y));
+                ey = y * std::sin(M_PI / 2 - M_PI / 4 * (x / y));
+            }
+            worst_map = std::max({worst_map, std::abs(p.x - ex), std::abs(p.y - ey)});
+            EXPECT_LE(p.x * p.x + p.y * p.y, 1.f + 2e-7f) << u.x << ", " << u.y;
+        }
+    EXPECT_LT(worst_map, 3e-7);
 }
 
 TEST(Warp, UniformTriangle) {
