@@ -44,23 +44,13 @@ public:
     void set_sample_index(uint32_t index) override {
         Sampler::set_sample_index(index);
         // The sample index moves the pixel seed along a Weyl sequence (sample 0 keeps it); two
-        // TEA hashes decorrelate neighbouring values, the second one picks the stream. Samples
-        // are mostly taken in order: the hashes of the next index run in the same register's
-        // other two lanes (free) and are kept for the next call.
-        if (!(index == m_next.index && m_pixel_seed == m_next.pixel_seed &&
-              m_base_seed == m_next.base_seed && m_next.valid)) {
-            const uint64_t v = weyl(index), w = weyl(index + 1);
-            const uint32_t base_lo = uint32_t(m_base_seed), base_hi = uint32_t(m_base_seed >> 32);
-            const uint32_t v0[4] = {uint32_t(v) ^ base_hi, uint32_t(v >> 32), uint32_t(w) ^ base_hi,
-                                    uint32_t(w >> 32)};
-            const uint32_t v1[4] = {base_lo, base_lo ^ 0x6a09e667u, base_lo, base_lo ^ 0x6a09e667u};
-            uint64_t h[4];
-            tea_hash4(v0, v1, h, 8);
-            m_rng.seed(h[0], h[1] ^ v);
-            m_next = {h[2], h[3] ^ w, m_pixel_seed, m_base_seed, index + 1, true};
-        } else {
-            m_rng.seed(m_next.state, m_next.seq);
-        }
+        // 64-bit mixes of it with the sampler's seed, told apart by a constant, give PCG32 its
+        // state and its stream, decorrelated from those of the neighbouring indices and pixels.
+        // The seed is multiplied first: the render loop's pixel seeds hold its high word as
+        // is, which a plain XOR would cancel.
+        const uint64_t v = m_pixel_seed ^ (uint64_t(index) * 0x9e3779b97f4a7c15ull) ^
+                           (m_base_seed * 0xd1b54a32d192ed03ull);
+        m_rng.seed(mix64(v), mix64(v ^ 0x6a09e667f3bcc908ull));
         m_stream = &m_rng;
     }
 
@@ -83,23 +73,12 @@ public:
 
 private:
     Independent(const Independent &other)
-        : Sampler(other), m_rng(other.m_rng), m_pixel_seed(other.m_pixel_seed),
-          m_next(other.m_next) {
+        : Sampler(other), m_rng(other.m_rng), m_pixel_seed(other.m_pixel_seed) {
         m_stream = other.m_stream ? &m_rng : nullptr; // not the original's generator
     }
     Independent &operator=(const Independent &) = delete;
-    uint64_t weyl(uint32_t index) const {
-        return m_pixel_seed ^ (uint64_t(index) * 0x9e3779b97f4a7c15ull);
-    }
     PCG32 m_rng;
     uint64_t m_pixel_seed = 0;
-    /// The seed of sample `index` (PCG32::seed's arguments), hashed with the previous one, for
-    /// the pixel and base seeds it was hashed from.
-    struct {
-        uint64_t state = 0, seq = 0, pixel_seed = 0, base_seed = 0;
-        uint32_t index = 0;
-        bool valid = false;
-    } m_next;
 };
 
 } // namespace facet

@@ -203,6 +203,18 @@ TEST(RenderLoop, SeedSelectsTheNoise) {
     EXPECT_NEAR(ma / mc, 1.0, 0.1);
 }
 
+TEST(RenderLoop, EveryBitOfTheSamplersSeedSelectsTheNoise) {
+    // The sampler's seed enters both the pixel seeds and each sample's stream: its high 32
+    // bits must not cancel between the two.
+    const std::string xml = scene_xml(PATH, 16, 4, "<rfilter type=\"box\"/>");
+    const std::string seed3 = R"(<integer name="seed" value="3"/>)";
+    ASSERT_NE(xml.find(seed3), std::string::npos);
+    std::string high = xml;
+    high.replace(high.find(seed3), seed3.size(), R"(<integer name="seed" value="4294967299"/>)");
+    auto a = load_temp_scene("seed-low", xml), b = load_temp_scene("seed-high", high);
+    EXPECT_FALSE(identical(render_with(*a, 2).image, render_with(*b, 2).image));
+}
+
 TEST(RenderLoop, SppOverride) {
     auto scene = load_temp_scene("spp", scene_xml(PATH, 8, 4, ""));
     RenderOptions opts;

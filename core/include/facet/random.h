@@ -54,6 +54,14 @@ private:
     uint64_t m_state, m_inc;
 };
 
+/// A 64-bit bijective mixer with full avalanche: the finaliser of SplitMix64 (Stafford's
+/// "Mix13" constants). Two multiplications: cheap enough to hash a seed at every sample.
+inline uint64_t mix64(uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
 /// Tiny Encryption Algorithm as a hash of two words (used to decorrelate seeds).
 inline uint64_t tea_hash(uint32_t v0, uint32_t v1, int rounds = 4) {
     uint32_t sum = 0;
