@@ -119,20 +119,19 @@ inline BoxReach box_reach(const Point2f &pos, const Point2i &origin, const Point
 
 void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
                      const ReconstructionFilter &filter) {
-    if (filter.is_box() && std::abs(pos.x) < 1e9f && std::abs(pos.y) < 1e9f) {
+    // The box filter at film positions in [0, 2^22) (every sample of a film, short of absurd
+    // sizes): there pos - 0.5 and its offset from any pixel are exact in float, so the one
+    // pixel box_eval() gives weight 1 is floor(pos), the pixel the sample lies in.
+    // put_footprint() takes the rest, with the same rule in box_reach() and box_eval().
+    if (filter.is_box() && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
         const Point2i s = storage_size();
-        const BoxReach r = box_reach(pos, m_offset - Point2i(m_border, m_border), s);
-        if (r.x0 == r.x1 && r.y0 == r.y1) {
-            // One candidate pixel (the sample is not on a pixel boundary): put_footprint()'s
-            // loops without their set-up.
-            const float w = ReconstructionFilter::box_eval(r.px - float(r.ox + r.x0)) *
-                            ReconstructionFilter::box_eval(r.py - float(r.oy + r.y0));
-            const int nc = channel_count();
-            if (w != 0.f)
-                add_sample(m_data.data() + size_t(r.y0) * size_t(s.x) * nc + size_t(r.x0) * nc, w,
-                           L, aovs, m_aov_count);
-            return;
-        }
+        const int x = int(pos.x) - (m_offset.x - m_border),
+                  y = int(pos.y) - (m_offset.y - m_border);
+        if (x >= 0 && x < s.x && y >= 0 && y < s.y)
+            add_sample(m_data.data() +
+                           (size_t(y) * size_t(s.x) + size_t(x)) * size_t(channel_count()),
+                       1.f, L, aovs, m_aov_count);
+        return;
     }
     put_footprint(pos, L, aovs, filter);
 }

@@ -116,6 +116,53 @@ TEST(ImageBlock, BoxSampleLandsInOnePixel) {
     EXPECT_EQ(p[2], 3.f);
 }
 
+/// The box filter's weights through the general footprint code (not marked as the box).
+class UnmarkedBox final : public ReconstructionFilter {
+public:
+    float eval(float x) const override { return box_eval(x); }
+    std::string to_string() const override { return "UnmarkedBox"; }
+};
+
+TEST(ImageBlock, BoxShortcutPutsEverySampleWhereTheFootprintDoes) {
+    // put() sends a box sample straight to the pixel it lies in; the general footprint code,
+    // with the same weights, must agree bit for bit: on pixel edges, just below them, at 0, at
+    // the block's edges (border included), beyond the block, and past 2^23 (where pos - 0.5
+    // is rounded, so the pixel is no longer floor(pos)).
+    auto box = make_filter("box");
+    const UnmarkedBox unmarked;
+    std::vector<float> coords = {0.f,         1e-30f,    0.25f,     0.5f,     3.f,
+                                 4194303.75f, 4194304.f, 4194305.f, 8388609.f};
+    for (int i = 6; i <= 30; ++i) {
+        const float v = 0.25f * float(i);
+        coords.push_back(v);
+        coords.push_back(std::nextafter(v, 0.f));
+        coords.push_back(std::nextafter(v, 100.f));
+    }
+    for (Point2i offset :
+         {Point2i(0, 0), Point2i(3, 4), Point2i(4194300, 4194301), Point2i(8388609, 8388609)}) {
+        std::vector<float> shifted;
+        for (float c : coords) shifted.push_back(c + float(offset.x));
+        ImageBlock fast, general;
+        fast.reset(offset, {3, 3}, ImageBlock::border_for(*box));
+        general.reset(offset, {3, 3}, ImageBlock::border_for(unmarked));
+        float value = 1.f;
+        for (float x : shifted)
+            for (float y : shifted) {
+                const Point2f pos(x, y + float(offset.y - offset.x));
+                fast.put(pos, Color3f(value, 2.f * value, 0.5f), *box);
+                general.put(pos, Color3f(value, 2.f * value, 0.5f), unmarked);
+                value += 1.f;
+            }
+        ASSERT_EQ(fast.data().size(), general.data().size());
+        float total = 0.f;
+        for (size_t k = 0; k < fast.data().size(); ++k) {
+            EXPECT_EQ(fast.data()[k], general.data()[k]) << "offset " << offset.x << ", " << k;
+            total += fast.data()[k];
+        }
+        EXPECT_GT(total, 0.f) << "offset " << offset.x; // some samples landed
+    }
+}
+
 TEST(ImageBlock, GaussianSpreadsSymmetricallyAndDevelopsToTheSample) {
     auto g = make_filter("gaussian");
     ImageBlock block;
