@@ -27,7 +27,9 @@ void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, i
 }
 
 bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp) {
-    if (!std::isfinite(pos.x) || !std::isfinite(pos.y)) return false;
+    // Non-finite positions, and positions far beyond any film (whose pixel indices would not
+    // fit an int), reach no pixel.
+    if (!(std::abs(pos.x) < 1e9f) || !(std::abs(pos.y) < 1e9f)) return false;
     const float radius = filter.radius();
     const Point2i s = storage_size();
     // Continuous position in film pixels, with pixel centres at integers, and the film pixel of
@@ -75,16 +77,6 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
 
 namespace {
 
-/// floor() and ceil() of a float well inside the int range (|v| < 2^30), as ints.
-inline int floor_to_int(float v) {
-    const int i = int(v); // towards zero
-    return float(i) > v ? i - 1 : i;
-}
-inline int ceil_to_int(float v) {
-    const int i = int(v);
-    return float(i) < v ? i + 1 : i;
-}
-
 /// Adds a sample of weight w to pixel p: r, g, b, the AOVs (when given), then the weight.
 inline void add_sample(float *p, float w, const Color3f &L, const float *aovs, int aov_count) {
     p[0] += w * L.r;
@@ -95,26 +87,6 @@ inline void add_sample(float *p, float w, const Color3f &L, const float *aovs, i
     p[3 + aov_count] += w;
 }
 
-/// The storage pixels [x0, x1] x [y0, y1] that a box-filtered sample at film position `pos`
-/// reaches (at most two per axis: footprint()'s pixels, computed in place without its tables),
-/// for a block whose storage pixel (0, 0) is film pixel `origin` and whose storage is `size`.
-struct BoxReach {
-    float px, py; ///< the sample's position in film pixels, minus the half pixel
-    int ox, oy, x0, x1, y0, y1;
-};
-inline BoxReach box_reach(const Point2f &pos, const Point2i &origin, const Point2i &size) {
-    BoxReach r;
-    r.px = pos.x - 0.5f;
-    r.py = pos.y - 0.5f;
-    r.ox = origin.x;
-    r.oy = origin.y;
-    r.x0 = std::max(0, ceil_to_int(r.px - 0.5f) - r.ox);
-    r.x1 = std::min(size.x - 1, floor_to_int(r.px + 0.5f) - r.ox);
-    r.y0 = std::max(0, ceil_to_int(r.py - 0.5f) - r.oy);
-    r.y1 = std::min(size.y - 1, floor_to_int(r.py + 0.5f) - r.oy);
-    return r;
-}
-
 } // namespace
 
 void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
@@ -122,7 +94,7 @@ void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
     // The box filter at film positions in [0, 2^22) (every sample of a film, short of absurd
     // sizes): there pos - 0.5 and its offset from any pixel are exact in float, so the one
     // pixel box_eval() gives weight 1 is floor(pos), the pixel the sample lies in.
-    // put_footprint() takes the rest, with the same rule in box_reach() and box_eval().
+    // put_footprint() takes the rest, with the same rule in footprint() and box_eval().
     if (filter.is_box() && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
         const Point2i s = storage_size();
         const int x = int(pos.x) - (m_offset.x - m_border),
@@ -141,19 +113,6 @@ __attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, con
                                                          const ReconstructionFilter &filter) {
     const Point2i s = storage_size();
     const int nc = channel_count();
-    if (filter.is_box() && std::abs(pos.x) < 1e9f && std::abs(pos.y) < 1e9f) {
-        const BoxReach r = box_reach(pos, m_offset - Point2i(m_border, m_border), s);
-        for (int y = r.y0; y <= r.y1; ++y) {
-            const float wy = ReconstructionFilter::box_eval(r.py - float(r.oy + y));
-            if (wy == 0.f) continue;
-            float *row = m_data.data() + size_t(y) * size_t(s.x) * nc;
-            for (int x = r.x0; x <= r.x1; ++x) {
-                const float w = ReconstructionFilter::box_eval(r.px - float(r.ox + x)) * wy;
-                if (w != 0.f) add_sample(row + size_t(x) * nc, w, L, aovs, m_aov_count);
-            }
-        }
-        return;
-    }
     Footprint fp;
     if (!footprint(pos, filter, fp)) return;
     for (size_t j = 0; j < fp.ny; ++j) {

@@ -65,10 +65,11 @@ private:
         int ox = 0, oy = 0;
         int ux0 = 0, ux1 = 0, uy0 = 0, uy1 = 0;
     };
-    /// False when the sample (non-finite, or outside the block) reaches no pixel.
+    /// False when the sample (non-finite, beyond 1e9 pixels, or outside the block) reaches no
+    /// pixel.
     bool footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp);
-    /// put() of a sample that reaches more than one pixel, or of another filter than the box:
-    /// out of line, so that put()'s usual case (one box pixel) saves no registers.
+    /// put() of another filter than the box, or of a box sample outside put()'s shortcut: out
+    /// of line, so that put()'s usual case (one box pixel) saves no registers.
     void put_footprint(const Point2f &pos, const Color3f &L, const float *aovs,
                        const ReconstructionFilter &filter);
 
