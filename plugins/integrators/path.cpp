@@ -96,9 +96,20 @@ public:
             const BSDF *bsdf = shape ? shape->bsdf() : nullptr;
             if (!bsdf) break;
 
+            // The samples are drawn in the dimension order emitter (2D), BSDF (1D, 2D), but the
+            // BSDF is sampled first: its result is needed only for the next ray, so its chain of
+            // dependent arithmetic runs while the emitter sample is built and traced.
+            const bool sample_emitter = has_flag(bsdf->flags(), BSDFFlags::Smooth);
+            const Point2f emitter_sample = sample_emitter ? sampler.draw_2d() : Point2f();
+            float sample1 = sampler.draw_1d();
+            Point2f sample2 = sampler.draw_2d();
+            FACET_ASSERT(Frame::is_unit(si.wi));
+            auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);
+            FACET_ASSERT(bsdf_weight.is_finite());
+
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
-            if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.draw_2d(), true);
+            if (sample_emitter) {
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, emitter_sample, true);
                 FACET_ASSERT(ds.pdf >= 0.f && em_weight.is_finite());
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);
@@ -113,11 +124,6 @@ public:
             }
 
             // ---- BSDF sampling: the next segment of the path ----
-            float sample1 = sampler.draw_1d();
-            Point2f sample2 = sampler.draw_2d();
-            FACET_ASSERT(Frame::is_unit(si.wi));
-            auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);
-            FACET_ASSERT(bsdf_weight.is_finite());
             if (bsdf_weight.is_black()) break;
             FACET_ASSERT(bs.pdf >= 0.f && Frame::is_unit(bs.wo));
 
