@@ -412,11 +412,12 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     if (!ds.delta) ds.pdf /= float(count);
     weight *= float(count);
 
-    if (test_visibility) {
-        Ray shadow = std::isfinite(ds.dist) ? ref.spawn_ray_to(ds.p) : ref.spawn_ray(ds.d);
-        if (occluded(shadow)) weight = Color3f(0.f);
-    }
+    if (test_visibility && !emitter_visible(ref, ds)) weight = Color3f(0.f);
     return result;
+}
+
+bool Scene::emitter_visible(const Interaction &ref, const DirectionSample &ds) const {
+    return !occluded(std::isfinite(ds.dist) ? ref.spawn_ray_to(ds.p) : ref.spawn_ray(ds.d));
 }
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {

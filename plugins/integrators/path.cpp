@@ -108,15 +108,17 @@ public:
             FACET_ASSERT(bsdf_weight.is_finite());
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
+            // The shadow ray comes last: a sample the BSDF gives no weight (an emitter behind
+            // the surface) costs none.
             if (sample_emitter) {
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, emitter_sample, true);
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, emitter_sample, false);
                 FACET_ASSERT(ds.pdf >= 0.f && em_weight.is_finite());
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);
                     FACET_ASSERT(Frame::is_unit(wo) && Frame::is_unit(si.wi));
                     auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
                     FACET_ASSERT(bsdf_pdf >= 0.f && f.is_finite());
-                    if (!f.is_black()) {
+                    if (!f.is_black() && scene.emitter_visible(si, ds)) {
                         float w = ds.delta ? 1.f : mis_weight(ds.pdf, bsdf_pdf);
                         result += throughput * f * em_weight * w;
                     }

@@ -367,6 +367,46 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
     EXPECT_FALSE(weight2.is_black());
 }
 
+TEST(SceneEmitters, EmitterVisibleIsTheSamplesOwnShadowTest) {
+    // The path tracer samples emitters without the visibility test and asks emitter_visible()
+    // once the BSDF has weighted the sample: that must be exactly the test that
+    // sample_emitter_direction(..., true) applies. Floor points around and under the ball, lit
+    // by the ball itself, a point lamp and a slanted directional light (a sample at infinity).
+    Properties props = rect_and_sphere(area_light(Color3f(1.f)));
+    Properties point;
+    point.set_vector("position", Vector3f(0.3f, -0.2f, 4.f));
+    props.set_object("lamp", create(ObjectType::Emitter, "point", point));
+    Properties sun;
+    sun.set_vector("direction", Vector3f(0.2f, 0.1f, -1.f));
+    props.set_object("sun", create(ObjectType::Emitter, "directional", sun));
+    Scene scene(props);
+    ASSERT_EQ(scene.emitters().size(), 3u);
+    PCG32 rng(5);
+    int blocked[3] = {0, 0, 0}, clear[3] = {0, 0, 0};
+    for (int i = 0; i < 3000; ++i) {
+        const Point3f o(1.6f * rng.next_float() - 0.8f, 1.6f * rng.next_float() - 0.8f, 1.f);
+        SurfaceInteraction ref;
+        ASSERT_TRUE(scene.ray_intersect(Ray(o, Vector3f(0, 0, -1)), ref));
+        const Point2f u = next_point2f(rng);
+        auto [ds, weight] = scene.sample_emitter_direction(ref, u, false);
+        auto [tested, tested_weight] = scene.sample_emitter_direction(ref, u, true);
+        if (weight.is_black()) {
+            EXPECT_TRUE(tested_weight.is_black());
+            continue;
+        }
+        const bool visible = scene.emitter_visible(ref, ds);
+        EXPECT_EQ(tested_weight.is_black(), !visible) << o.x << ", " << o.y << "; " << u.x;
+        int kind = 0; // the ball
+        if (ds.emitter != scene.shapes()[1]->emitter()) kind = std::isfinite(ds.dist) ? 1 : 2;
+        (visible ? clear : blocked)[kind]++;
+    }
+    // The ball is only ever hidden by itself (how often depends on how it samples its surface);
+    // the lamp and the sun are hidden by the ball from the points in its shadow.
+    for (int kind = 0; kind < 3; ++kind) EXPECT_GT(clear[kind], 50) << kind;
+    EXPECT_GT(blocked[1], 10);
+    EXPECT_GT(blocked[2], 10);
+}
+
 TEST(SceneEmitters, TriangleLightsMatchTheirEmitter) {
     // A constant area light on a mesh (a tilted rectangle of two triangles) is sampled by the
     // scene's own non-virtual path: the same points, pdfs and weights as the emitter's virtual

@@ -49,6 +49,10 @@ public:
     /// selection probability; with `test_visibility` an occluded sample gets weight zero.
     std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
                                                                  bool test_visibility) const;
+    /// The visibility test of sample_emitter_direction() on its own: true when nothing blocks
+    /// the segment from ref to the emitter sample ds (or the ray towards it, for an emitter at
+    /// infinity). For callers that test later, once the BSDF has given the sample a weight.
+    bool emitter_visible(const Interaction &ref, const DirectionSample &ds) const;
     /// Density of sample_emitter_direction() for ds (selection probability included).
     float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const;
 
