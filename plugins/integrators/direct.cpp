@@ -93,11 +93,12 @@ public:
         // ---- Emitter sampling ----
         if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
             for (uint32_t i = 0; i < m_emitter_samples; ++i) {
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), true);
+                // The shadow ray last: a sample the BSDF gives no weight costs none.
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), false);
                 if (ds.pdf == 0.f || em_weight.is_black()) continue;
                 Vector3f wo = si.to_local(ds.d);
                 auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
-                if (f.is_black()) continue;
+                if (f.is_black() || !scene.emitter_visible(si, ds)) continue;
                 // Densities of the two strategies scaled by their share of the samples.
                 float w =
                     ds.delta ? 1.f : mis_weight(ds.pdf * m_frac_emitter, bsdf_pdf * m_frac_bsdf);
