@@ -89,14 +89,13 @@ inline bool embree_can_trace(__m128 a, __m128 b) {
 }
 
 /// The first eight floats of `ray`, (o.x, o.y, o.z, d.x) and (d.y, d.z, mint, maxt), in two
-/// registers: the check and the Embree ray are built from them.
+/// registers: the check and the Embree ray are built from them. Read float by float: the ray
+/// was just written float by float (or is still in registers), and a 16-byte load of four
+/// separate 4-byte stores cannot be forwarded from the store buffer; it would wait for them to
+/// reach the cache, on the critical path of every ray.
 inline void ray_words(const Ray &ray, __m128 &a, __m128 &b) {
-    static_assert(offsetof(Ray, o) == 0 && offsetof(Ray, d) == 12 && offsetof(Ray, mint) == 24 &&
-                      offsetof(Ray, maxt) == 28,
-                  "Ray: o, d, mint, maxt are eight consecutive floats");
-    const float *f = reinterpret_cast<const float *>(&ray);
-    a = _mm_loadu_ps(f);
-    b = _mm_loadu_ps(f + 4);
+    a = _mm_setr_ps(ray.o.x, ray.o.y, ray.o.z, ray.d.x);
+    b = _mm_setr_ps(ray.d.y, ray.d.z, ray.mint, ray.maxt);
 }
 
 /// Fills the ray part of an Embree ray (RTCRay, the first part of RTCRayHit) from ray_words():

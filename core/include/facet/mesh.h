@@ -5,6 +5,7 @@
 #include <facet/warp.h>
 
 #include <algorithm>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -126,14 +127,14 @@ inline void Mesh::flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceIntera
     si.prim_index = prim_index;
     // Interpolating the vertices is more accurate than ray(t) far from the ray origin.
     si.p = p0 * b0 + p1 * b1 + p2 * b2;
-    // Normals and the shading frame of the face were computed at load.
+    // Normals and the shading frame of the face were computed at load. They are copied from
+    // the table, not from registers: spilled and copied back as 8-byte words, the floats
+    // would be read before their 4-byte stores had reached the cache (a stall on every hit).
     const float *f = &m_face_table[9 * size_t(prim_index)];
-    si.n = Normal3f(f[0], f[1], f[2]);
-    const Normal3f ns(f[3], f[4], f[5]);
-    const Vector3f s(f[6], f[7], f[8]);
-    si.sh_frame.s = s;
-    si.sh_frame.t = cross(ns, s);
-    si.sh_frame.n = ns;
+    std::memcpy(static_cast<void *>(&si.n), f, sizeof(Normal3f));
+    std::memcpy(static_cast<void *>(&si.sh_frame.n), f + 3, sizeof(Normal3f));
+    std::memcpy(static_cast<void *>(&si.sh_frame.s), f + 6, sizeof(Vector3f));
+    si.sh_frame.t = cross(Normal3f(f[3], f[4], f[5]), Vector3f(f[6], f[7], f[8]));
     si.uv = Point2f(b1, b2);
     si.dp_du = p1 - p0;
     si.dp_dv = p2 - p0;
@@ -165,7 +166,10 @@ inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
     } else {
         ps.n = face_normal(f);
     }
-    ps.uv = has_uvs() ? face_uv(f, b) : b;
+    // b goes to ps.uv first: kept aside across the face_uv() call instead, it was copied from
+    // the stack as one 8-byte word over two fresh 4-byte stores (a store-forwarding stall).
+    ps.uv = b;
+    if (has_uvs()) ps.uv = face_uv(f, ps.uv);
     ps.pdf = 1.f / m_area;
     ps.delta = false;
 }
