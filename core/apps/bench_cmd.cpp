@@ -1,5 +1,5 @@
-// `facet bench`: how fast the scene's integrator renders, and how that compares with Embree
-// tracing the same number of rays with no shading at all.
+// `facet bench`: how fast the scene's integrator renders, and how much of that time Embree's own
+// work takes.
 //
 // Time is CPU time (user + system of the whole process around the render, i.e. of every render
 // thread), not wall clock, which on a shared machine mostly measures the other processes.
@@ -11,35 +11,29 @@
 //
 // Rays of the render are counted exactly: Scene::ray_count() sums per-thread counts of every
 // ray_intersect() and ray_test() call (plain thread-local increments, no locks or atomics in the
-// hot path). The plain Embree loop then traces that many incoherent rays through the same RTCScene
-// on the same number of threads: origins at the primary hit points of a pixel grid, directions
-// cosine-distributed about the hit's geometric normal, one rtcIntersect1 each (closest hit; the
-// render's mix also has rtcOccluded1 shadow rays, which are cheaper).
+// hot path). Embree's share is measured, not attributed by a profiler: a second render, at fewer
+// samples, records the queries it sends to Embree (Scene::start_ray_recording()), and they are
+// sent again, on one thread with nothing else around them. Their CPU time per ray, times the
+// render's rays, is Embree's own work in the render; the rest of the render's CPU time is facet's.
 
 #include "commands.h"
 
-#include <facet/frame.h>
-#include <facet/interaction.h>
 #include <facet/logger.h>
-#include <facet/random.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
-#include <facet/warp.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <linux/perf_event.h>
 #include <sys/syscall.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <dirent.h>
 #include <unistd.h>
 #include <vector>
@@ -47,30 +41,6 @@
 namespace {
 
 using namespace facet;
-
-struct Hit {
-    Point3f p;
-    Normal3f n; ///< geometric normal, facing the camera
-};
-
-/// Primary hits of a grid of up to 256x256 camera rays through pixel centres.
-std::vector<Hit> primary_hits(const Scene &scene, const Sensor &sensor) {
-    Point2i size = sensor.film().size();
-    int nx = std::min(size.x, 256), ny = std::min(size.y, 256);
-    std::vector<Hit> hits;
-    hits.reserve(size_t(nx) * size_t(ny));
-    for (int y = 0; y < ny; ++y) {
-        for (int x = 0; x < nx; ++x) {
-            Point2f film_pos((x + 0.5f) / float(nx), (y + 0.5f) / float(ny));
-            Ray ray = sensor.sample_ray(0.f, film_pos, Point2f(0.5f, 0.5f)).first;
-            SurfaceInteraction si;
-            if (!scene.ray_intersect(ray, si)) continue;
-            Normal3f n = dot(si.n, ray.d) > 0.f ? -si.n : si.n;
-            hits.push_back({si.p, n});
-        }
-    }
-    return hits;
-}
 
 /// User-space instructions retired by every thread of the process (those alive when started
 /// and, through `inherit`, those they create), from Linux perf events. available() is false
@@ -159,68 +129,11 @@ double rmse(const Image &image, const Image &reference) {
     return std::sqrt(sum / double(3 * n));
 }
 
-struct EmbreeLoop {
-    double seconds = 0.0;
-    uint64_t hits = 0;
-};
-
-/// Traces `count` rays from the hit points with cosine-distributed directions on `threads` threads.
-EmbreeLoop embree_loop(const Scene &scene, const std::vector<Hit> &hits, uint64_t count,
-                       int threads) {
-    constexpr uint64_t Chunk = 4096;
-    RTCScene rtc = scene.embree_scene();
-    uint64_t chunks = (count + Chunk - 1) / Chunk;
-    tbb::task_arena arena(threads);
-    auto start = std::chrono::steady_clock::now();
-    uint64_t hit_count = arena.execute([&] {
-        return tbb::parallel_reduce(
-            tbb::blocked_range<uint64_t>(0, chunks), uint64_t(0),
-            [&](const tbb::blocked_range<uint64_t> &range, uint64_t found) {
-                RTCIntersectContext context;
-                for (uint64_t chunk = range.begin(); chunk != range.end(); ++chunk) {
-                    PCG32 rng(chunk, 0x6a09e667f3bcc909ULL);
-                    uint64_t end = std::min(count, (chunk + 1) * Chunk);
-                    for (uint64_t i = chunk * Chunk; i < end; ++i) {
-                        const Hit &hit = hits[rng.next_uint32(uint32_t(hits.size()))];
-                        const float ux = rng.next_float(); // one draw per statement: a set
-                        const float uy = rng.next_float(); // order whatever the compiler
-                        Point2f u(ux, uy);
-                        Vector3f d = Frame(hit.n).to_world(warp::square_to_cosine_hemisphere(u));
-                        Interaction it;
-                        it.p = hit.p;
-                        it.n = hit.n;
-                        it.t = 0.f;
-                        Ray ray = it.spawn_ray(d);
-
-                        RTCRayHit rh;
-                        rh.ray.org_x = ray.o.x;
-                        rh.ray.org_y = ray.o.y;
-                        rh.ray.org_z = ray.o.z;
-                        rh.ray.dir_x = ray.d.x;
-                        rh.ray.dir_y = ray.d.y;
-                        rh.ray.dir_z = ray.d.z;
-                        rh.ray.tnear = ray.mint;
-                        rh.ray.tfar = ray.maxt;
-                        rh.ray.time = 0.f;
-                        rh.ray.mask = uint32_t(-1);
-                        rh.ray.id = 0;
-                        rh.ray.flags = 0;
-                        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-                        rtcInitIntersectContext(&context);
-                        rtcIntersect1(rtc, &context, &rh);
-                        found += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-                    }
-                }
-                return found;
-            },
-            [](uint64_t a, uint64_t b) { return a + b; });
-    });
-    EmbreeLoop result;
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    result.hits = hit_count;
-    return result;
+/// CPU seconds of the calling thread.
+double thread_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 std::string mega(double v) { return fmt::format("{:.3f} M", v * 1e-6); }
@@ -234,9 +147,9 @@ int bench_main(int argc, char **argv) {
     std::string reference;
     int rounds = 6;
     double target_rmse = 0.0;
-    CLI::App app("Measure samples and rays per CPU second of the scene's integrator against a "
-                 "plain Embree loop tracing the same number of rays; with --reference, the error "
-                 "against a reference image as a function of CPU time",
+    CLI::App app("Measure samples and rays per CPU second of the scene's integrator and the share "
+                 "of its CPU time that is Embree's own work; with --reference, the error against "
+                 "a reference image as a function of CPU time",
                  "facet bench");
     cli::add_scene_options(app, opts);
     app.add_option("--spp", spp,
@@ -355,25 +268,59 @@ int bench_main(int argc, char **argv) {
                        extrapolated ? "extrapolated with RMSE ~ 1/sqrt(time)" : "interpolated");
         }
     }
-    uninstall_interrupt_handler();
-
-    std::vector<Hit> hits = primary_hits(*scene, sensor);
-    if (hits.empty() || rays == 0) {
-        fmt::print("embree loop : skipped (no camera ray hits the scene)\n");
+    if (rays == 0) {
+        uninstall_interrupt_handler();
+        fmt::print("embree alone: skipped (the render sent no ray to Embree)\n");
         return 0;
     }
-    double loop_cpu_before = process_cpu_seconds();
-    EmbreeLoop loop = embree_loop(*scene, hits, rays, threads);
-    double loop_cpu = std::max(process_cpu_seconds() - loop_cpu_before, 1e-9);
-    double render_rays_per_cpu_s = double(rays) / cpu;
-    double loop_rays_per_cpu_s = double(rays) / loop_cpu;
-    fmt::print("embree loop : {}rays in {:.3f} CPU-s (wall {:.3f} s) = {}rays per CPU-s "
-               "(rtcIntersect1 only, no shading; origins at {} primary hits, cosine directions; "
-               "{:.1f}% hit)\n",
-               mega(double(rays)), loop_cpu, loop.seconds, mega(loop_rays_per_cpu_s), hits.size(),
-               100.0 * double(loop.hits) / double(rays));
-    fmt::print("ratio       : the render traces rays at {:.1f}% of the plain Embree rate (per "
-               "CPU-s)\n",
-               100.0 * render_rays_per_cpu_s / loop_rays_per_cpu_s);
+    // Embree alone: the queries of a render at fewer samples, at most RecordBudget of them (36
+    // bytes each), sent to Embree again.
+    constexpr size_t RecordBudget = size_t(1) << 20;
+    RenderOptions record = ropts;
+    record.spp =
+        int(std::clamp(double(spp) * double(RecordBudget) / double(rays), 1.0, double(spp)));
+    Scene::start_ray_recording(RecordBudget);
+    RenderResult recorded = render(*scene, sensor, record);
+    Scene::stop_ray_recording();
+    uninstall_interrupt_handler();
+    if (recorded.cancelled) {
+        Scene::discard_recorded_rays();
+        FACET_THROW("interrupted");
+    }
+    // A first pass counts the rays (and warms the caches, as the render had them); the timed
+    // passes send as many rays as the render traced (at most 64 passes), for a CPU time long
+    // enough to measure.
+    const Scene::RayReplay first = scene->replay_recorded_rays();
+    const uint64_t passes =
+        first.rays == 0 ? 0 : std::clamp<uint64_t>((rays + first.rays - 1) / first.rays, 1, 64);
+    Scene::RayReplay replay;
+    const double replay_before = thread_cpu_seconds();
+    for (uint64_t i = 0; i < passes; ++i) {
+        const Scene::RayReplay pass = scene->replay_recorded_rays();
+        replay.rays += pass.rays;
+        replay.differing += pass.differing;
+    }
+    const double replay_cpu = thread_cpu_seconds() - replay_before;
+    replay.differing += first.differing;
+    Scene::discard_recorded_rays();
+    if (replay.rays == 0) {
+        fmt::print("embree alone: skipped (no ray recorded)\n");
+        return 0;
+    }
+    const double per_ray = replay_cpu / double(replay.rays);
+    const double embree_cpu = per_ray * double(rays);
+    fmt::print("embree alone: {}rays from a {}-spp render sent again to Embree {}, on one "
+               "thread with nothing around them: {}rays in {:.3f} CPU-s = {:.1f} CPU-ns per ray "
+               "({})\n",
+               mega(double(first.rays)), record.spp,
+               passes == 1 ? std::string("once") : fmt::format("{} times", passes),
+               mega(double(replay.rays)), replay_cpu, 1e9 * per_ray,
+               replay.differing == 0
+                   ? std::string("every answer as in the render")
+                   : fmt::format("{} answers differ from the render's", replay.differing));
+    fmt::print("share       : Embree's own work is {:.1f}% of the render's CPU time ({}rays at "
+               "{:.1f} CPU-ns); the rest, {:.1f} CPU-ns per sample, is facet's\n",
+               100.0 * embree_cpu / cpu, mega(double(rays)), 1e9 * per_ray,
+               1e9 * std::max(cpu - embree_cpu, 0.0) / samples);
     return 0;
 }

@@ -30,7 +30,7 @@ Usage:
   facet render <scene.xml> [options]   render a scene (see `facet render --help`)
   facet <scene.xml> [options]          the same
   facet plugins [kind|name]            list the plugins, or print one plugin's parameters
-  facet bench <scene.xml> [options]    path tracer samples/s and rays/s against plain Embree
+  facet bench <scene.xml> [options]    samples/s, rays/s and Embree's share of the CPU
   facet merge parts... -o out.exr      merge the parts of a render split by --crop and --pass
   facet compare ours.exr ref_mean.exr ref_var_xyz.exr --spp N
                                        statistical comparison with a reference render
