@@ -61,16 +61,19 @@ bool g_recording = false;
 std::vector<RayLog *> *g_ray_logs = new std::vector<RayLog *>();
 std::atomic<size_t> g_record_budget{0};
 
+/// Gives thread slot `c` a log of its own (under g_ray_counter_mutex, while recording).
+void attach_ray_log(RayCounter &c) {
+    g_ray_logs->push_back(new RayLog());
+    c.log.store(g_ray_logs->back(), std::memory_order_relaxed);
+}
+
 inline RayCounter *count_ray() {
     RayCounter *c = t_ray_counter;
     if (!c) {
         c = t_ray_counter = new RayCounter();
         std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
         g_ray_counters->push_back(c);
-        if (g_recording) {
-            g_ray_logs->push_back(new RayLog());
-            c->log.store(g_ray_logs->back(), std::memory_order_relaxed);
-        }
+        if (g_recording) attach_ray_log(*c);
     }
     c->count.store(c->count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     return c;
@@ -78,7 +81,7 @@ inline RayCounter *count_ray() {
 
 /// Appends a query that Embree has answered to the thread's log, while the budget lasts. Out of
 /// line: only a recording render comes here. The budget is claimed 4096 rays at a time, one
-/// atomic operation per block.
+/// atomic operation per block; the log grows as vectors do.
 __attribute__((noinline)) void record_ray(RayLog &log, const Ray &ray, bool occlusion, bool hit) {
     if (log.room == 0) {
         size_t budget = g_record_budget.load(std::memory_order_relaxed), claim = 0;
@@ -87,8 +90,6 @@ __attribute__((noinline)) void record_ray(RayLog &log, const Ray &ray, bool occl
             if (claim == 0) return;
         } while (!g_record_budget.compare_exchange_weak(budget, budget - claim,
                                                         std::memory_order_relaxed));
-        if (log.rays.capacity() < log.rays.size() + claim)
-            log.rays.reserve(std::max(2 * log.rays.capacity(), log.rays.size() + claim));
         log.room = claim;
     }
     log.rays.push_back({{ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z, ray.mint, ray.maxt},
@@ -372,10 +373,7 @@ void Scene::start_ray_recording(size_t max_rays) {
     std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
     g_record_budget.store(max_rays, std::memory_order_relaxed);
     g_recording = true;
-    for (RayCounter *c : *g_ray_counters) {
-        g_ray_logs->push_back(new RayLog());
-        c->log.store(g_ray_logs->back(), std::memory_order_relaxed);
-    }
+    for (RayCounter *c : *g_ray_counters) attach_ray_log(*c);
 }
 
 void Scene::stop_ray_recording() {
