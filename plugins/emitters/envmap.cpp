@@ -137,13 +137,16 @@ public:
         // Density and radiance of the direction as pdf_direction() and eval() will see it, so
         // the three agree to the last bit even where rounding moves it across a cell border.
         local = normalize(m_to_world.inverse().apply_vector(ds.d));
-        ds.pdf = pdf_local(local);
+        const GridPoint g = grid_point(local); // one atan2 and acos for both
+        ds.pdf = pdf_local(local, g);
         if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
-        return {ds, lookup(local) / ds.pdf};
+        return {ds, lookup(g) / ds.pdf};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
-        return pdf_local(normalize(m_to_world.inverse().apply_vector(ds.d)));
+        if (!sampling_enabled()) return InvFourPi;
+        const Vector3f local = normalize(m_to_world.inverse().apply_vector(ds.d));
+        return pdf_local(local, grid_point(local));
     }
 
     /// A ray entering the bounding sphere (the particle tracer): the direction it comes from is
@@ -154,19 +157,20 @@ public:
                                             : warp::square_to_uniform_sphere(u_dir);
         const Vector3f from = normalize(m_to_world.apply_vector(local));
         local = normalize(m_to_world.inverse().apply_vector(from));
-        const float pdf = pdf_local(local);
+        const GridPoint g = grid_point(local);
+        const float pdf = pdf_local(local, g);
         if (!(pdf > 0.f)) return {Ray(), Color3f(0.f)};
         const float radius = m_radius * (1.f + RayEpsilon);
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
         const Frame frame(from);
         const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y + from) * radius;
-        return {Ray(o, -from), lookup(local) * (Pi * radius * radius / pdf)};
+        return {Ray(o, -from), lookup(g) * (Pi * radius * radius / pdf)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
         // si is the record of a ray that left the scene: wi points back along it (local frame).
         Vector3f local = normalize(m_to_world.inverse().apply_vector(-si.to_world(si.wi)));
-        return lookup(local);
+        return lookup(grid_point(local));
     }
 
     std::string to_string() const override {
@@ -187,17 +191,27 @@ private:
         return {std::sin(phi) * st, std::cos(theta), -std::cos(phi) * st};
     }
 
-    /// Grid position of uv: longitude texel-centred (column i at u = (i + ½)/W, wrapping),
-    /// latitude corner-aligned (row j at v = j/(H-1), the poles on the first and last rows).
-    /// Returns the lower grid indices (i ≤ W-1, j ≤ H-2) and the fractions towards the next.
-    void grid(const Point2f &uv, int &i, int &j, float &s, float &t) const {
+    /// Where a direction falls on the grid: the lower grid indices (i ≤ W-1, j ≤ H-2) and the
+    /// fractions (s, t) towards the next ones.
+    struct GridPoint {
+        int i, j;
+        float s, t;
+    };
+
+    /// Grid position of a local direction: longitude texel-centred (column i at u = (i + ½)/W,
+    /// wrapping), latitude corner-aligned (row j at v = j/(H-1), the poles on the first and
+    /// last rows). The radiance and the density of a direction share it.
+    GridPoint grid_point(const Vector3f &local) const {
+        const Point2f uv = direction_to_uv(local);
         float x = uv.x - 0.5f / float(m_width);
         x = (x - std::floor(x)) * float(m_width);
         float y = clamp(uv.y, 0.f, 1.f) * float(m_height - 1);
-        i = std::min(int(x), m_width - 1);
-        j = std::min(int(y), m_height - 2);
-        s = x - float(i);
-        t = y - float(j);
+        GridPoint g;
+        g.i = std::min(int(x), m_width - 1);
+        g.j = std::min(int(y), m_height - 2);
+        g.s = x - float(g.i);
+        g.t = y - float(g.j);
+        return g;
     }
 
     const Color3f &pixel(int x, int y) const {
@@ -205,10 +219,9 @@ private:
         return m_pixels[size_t(y) * m_width + x];
     }
 
-    Color3f lookup(const Vector3f &local) const {
-        int i, j;
-        float s, t;
-        grid(direction_to_uv(local), i, j, s, t);
+    Color3f lookup(const GridPoint &g) const {
+        const int i = g.i, j = g.j;
+        const float s = g.s, t = g.t;
         if (!m_bilinear) return pixel(s < 0.5f ? i : i + 1, t < 0.5f ? j : j + 1);
         return (pixel(i, j) * (1.f - s) + pixel(i + 1, j) * s) * (1.f - t) +
                (pixel(i, j + 1) * (1.f - s) + pixel(i + 1, j + 1) * s) * t;
@@ -246,11 +259,11 @@ private:
         return {std::min(uu, OneMinusEpsilon), (float(j) + t) / float(m_height - 1)};
     }
 
-    float pdf_local(const Vector3f &local) const {
+    /// Density of the local direction `local`, whose grid point is g.
+    float pdf_local(const Vector3f &local, const GridPoint &g) const {
         if (!sampling_enabled()) return InvFourPi;
-        int i, j;
-        float s, t;
-        grid(direction_to_uv(local), i, j, s, t);
+        const int i = g.i, j = g.j;
+        const float s = g.s, t = g.t;
         float value = (table(i, j) * (1.f - s) + table(i + 1, j) * s) * (1.f - t) +
                       (table(i, j + 1) * (1.f - s) + table(i + 1, j + 1) * s) * t;
         // sin θ straight from the direction (acos near the poles would lose precision),
