@@ -49,7 +49,7 @@ public:
 
     float next_1d() override {
         uint32_t p = qmc::hash_combine(m_pixel_seed, m_dimension++);
-        uint32_t s = qmc::permute(m_sample_index % m_sample_count, m_sample_count, p);
+        uint32_t s = qmc::permute(m_div_count.mod(m_sample_index), m_div_count, p);
         float j = m_jitter ? qmc::to_unit_float(qmc::hash_combine(p, s + 0x51633e2dU)) : 0.5f;
         return std::min((float(s) + j) / float(m_sample_count), OneMinusEpsilon);
     }
@@ -57,14 +57,16 @@ public:
     Point2f next_2d() override {
         // Cell (s % m, s / m) of the grid; the sub-cell offsets are shuffled per row and column.
         uint32_t p = qmc::hash_combine(m_pixel_seed, m_dimension++);
-        uint32_t N = m_sample_count;
-        uint32_t s = qmc::permute(m_sample_index % N, N, p * 0x51633e2dU);
-        uint32_t sx = qmc::permute(s % m_m, m_m, qmc::hash_combine(p * 0xa511e9b3U, s / m_m));
-        uint32_t sy = qmc::permute(s / m_m, m_n, qmc::hash_combine(p * 0x63d83595U, s % m_m));
+        // Divisions by N and the grid's sides are multiplications (qmc::Divisor): shorter than
+        // the processor's division on this chain of dependent hashes.
+        uint32_t s = qmc::permute(m_div_count.mod(m_sample_index), m_div_count, p * 0x51633e2dU);
+        const uint32_t col = m_div_m.mod(s), row = m_div_m.div(s);
+        uint32_t sx = qmc::permute(col, m_div_m, qmc::hash_combine(p * 0xa511e9b3U, row));
+        uint32_t sy = qmc::permute(row, m_div_n, qmc::hash_combine(p * 0x63d83595U, col));
         float jx = m_jitter ? qmc::to_unit_float(qmc::hash_combine(p * 0xa399d265U, s)) : 0.5f;
         float jy = m_jitter ? qmc::to_unit_float(qmc::hash_combine(p * 0x711ad6a5U, s)) : 0.5f;
-        float x = (float(s % m_m) + (float(sy) + jx) / float(m_n)) / float(m_m);
-        float y = (float(s / m_m) + (float(sx) + jy) / float(m_m)) / float(m_n);
+        float x = (float(col) + (float(sy) + jx) / float(m_n)) / float(m_m);
+        float y = (float(row) + (float(sx) + jy) / float(m_m)) / float(m_n);
         return {std::min(x, OneMinusEpsilon), std::min(y, OneMinusEpsilon)};
     }
 
@@ -79,10 +81,14 @@ private:
         m_m = uint32_t(std::sqrt(double(m_sample_count)));
         while (m_m > 1 && m_sample_count % m_m != 0) --m_m;
         m_n = m_sample_count / m_m;
+        m_div_count = qmc::Divisor(m_sample_count);
+        m_div_m = qmc::Divisor(m_m);
+        m_div_n = qmc::Divisor(m_n);
     }
 
     bool m_jitter = true;
     uint32_t m_m = 2, m_n = 2;
+    qmc::Divisor m_div_count, m_div_m, m_div_n; ///< N, m and n as divisors
     uint32_t m_pixel_seed = 0;
 };
 

@@ -2,11 +2,14 @@
 // the rate the sampler promises (N^-1/2 for independent sampling, about N^-1 or better for the
 // stratified and low-discrepancy ones on a smooth 2D integrand).
 #include <facet/plugin.h>
+#include <facet/qmc.h>
 #include <facet/sampler.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <random>
 #include <vector>
 
 using namespace facet;
@@ -207,6 +210,42 @@ TEST(Samplers, HugeSampleCounts) {
     mj->seed(5);
     p = mj->next_2d();
     EXPECT_TRUE(p.x >= 0.f && p.x < 1.f && p.y >= 0.f && p.y < 1.f);
+}
+
+// qmc::Divisor replaces the samplers' divisions by multiplications: it must give the quotient
+// and remainder of the processor's division for every 32-bit value, and permute() over a
+// Divisor the same element as over the plain count.
+TEST(Samplers, DivisorDividesExactly) {
+    const uint32_t big = 1u << 31;
+    std::vector<uint32_t> divisors = {65521u, 65536u, big - 1u, big, UINT32_MAX - 1u, UINT32_MAX};
+    for (uint32_t d = 1; d <= 1000; ++d) divisors.push_back(d);
+    std::mt19937 rng(17);
+    for (int i = 0; i < 200; ++i) divisors.push_back(uint32_t(rng()) >> (rng() % 32));
+    for (uint32_t d : divisors) {
+        if (d == 0) continue;
+        const qmc::Divisor div(d);
+        std::vector<uint32_t> xs = {0u,
+                                    1u,
+                                    d - 1u,
+                                    d,
+                                    d + 1u,
+                                    2u * d - 1u,
+                                    2u * d,
+                                    UINT32_MAX / d * d,
+                                    UINT32_MAX / d * d - 1u,
+                                    UINT32_MAX - 1u,
+                                    UINT32_MAX};
+        for (int i = 0; i < 300; ++i) xs.push_back(uint32_t(rng()));
+        for (uint32_t x : xs) {
+            ASSERT_EQ(div.div(x), x / d) << x << " / " << d;
+            ASSERT_EQ(div.mod(x), x % d) << x << " % " << d;
+        }
+    }
+    for (uint32_t n : {1u, 2u, 5u, 8u, 24u, 64u, 100u, 1000u, 4096u})
+        for (uint32_t seed : {0u, 1u, 0x9e3779b9u, 0xfffffffbu})
+            for (uint32_t i = 0; i < n; ++i)
+                ASSERT_EQ(qmc::permute(i, qmc::Divisor(n), seed), qmc::permute(i, n, seed))
+                    << "n " << n << " seed " << seed << " i " << i;
 }
 
 TEST(Samplers, MultijitterStratifiesGridAndProjections) {
