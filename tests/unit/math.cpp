@@ -356,6 +356,29 @@ TEST(Warp, Tent) {
     EXPECT_NEAR(warp::interval_to_tent(0.f), -1.f, 1e-6f);
 }
 
+TEST(Warp, IntervalToLinearInvertsTheLinearCdf) {
+    // CDF of the density ∝ lerp(x, v0, v1) on [0, 1]: (v0 x + (v1 - v0) x²/2) / ((v0 + v1)/2).
+    for (auto [v0, v1] : {std::pair{0.f, 1.f}, {1.f, 0.f}, {0.3f, 1.7f}, {2.f, 0.5f}, {1.f, 1.f}})
+        for (float u : {0.f, 0.1f, 0.5f, 0.9f, OneMinusEpsilon}) {
+            const float x = warp::interval_to_linear(v0, v1, u);
+            const double cdf = (double(v0) * x + (double(v1) - v0) * x * x / 2) / ((v0 + v1) / 2.);
+            EXPECT_NEAR(cdf, u, 2e-6) << "v0 " << v0 << " v1 " << v1 << " u " << u;
+        }
+}
+
+TEST(Warp, IntervalToLinearIsUniformWhereTheDensityIsDegenerate) {
+    // Both ends zero (a pole row of an environment map) was 0/0; not finite ends likewise.
+    for (auto [v0, v1] : {std::pair{0.f, 0.f}, {-0.f, 0.f}, {Infinity, 1.f}, {NAN, 1.f}})
+        for (float u : {0.f, 0.25f, OneMinusEpsilon})
+            EXPECT_EQ(warp::interval_to_linear(v0, v1, u), u) << "v0 " << v0 << " v1 " << v1;
+    // Whatever the ends, the point lies in [0, 1].
+    for (auto [v0, v1] : {std::pair{0.f, 1e-30f}, {1e-30f, 0.f}, {3e38f, 1.f}})
+        for (float u : {0.f, 0.5f, OneMinusEpsilon}) {
+            const float x = warp::interval_to_linear(v0, v1, u);
+            EXPECT_TRUE(x >= 0.f && x <= 1.f) << x;
+        }
+}
+
 TEST(Warp, WrongDensityIsDetected) {
     // The test harness itself must be able to fail: a uniform density for cosine samples.
     HistogramTest t = sphere_test();

@@ -58,4 +58,17 @@ float square_to_uniform_cone_pdf(const Vector3f &v, float cos_cutoff);
 /// 1D tent on [-1, 1].
 float interval_to_tent(float u);
 
+/// The point of [0, 1] for u in [0, 1] under the density proportional to the line from v0 at 0 to
+/// v1 at 1 (v0, v1 >= 0): the inverse of its CDF, x = (v0 - sqrt(lerp(u, v0², v1²))) / (v0 - v1).
+/// Always a point of [0, 1], never NaN: where the density is degenerate (both ends zero, as on
+/// an environment map's pole row, or not finite) or nearly constant it is uniform, and x = u.
+/// The ends should be of order one (a caller scales its table so): squares of tiny values lose
+/// their precision before the nearly-constant test catches them.
+inline float interval_to_linear(float v0, float v1, float u) {
+    if (!(v0 + v1 > 0.f) || !(v0 + v1 < Infinity)) return u;
+    if (std::abs(v0 - v1) < 1e-6f * std::max(v0, v1)) return u;
+    const float x = (v0 - safe_sqrt(lerp(u, v0 * v0, v1 * v1))) / (v0 - v1);
+    return x > 0.f ? std::min(x, 1.f) : 0.f; // NaN-safe clamp
+}
+
 } // namespace facet::warp
