@@ -205,7 +205,9 @@ private:
         const Point2f uv = direction_to_uv(local);
         float x = uv.x - 0.5f / float(m_width);
         x = (x - std::floor(x)) * float(m_width);
-        float y = clamp(uv.y, 0.f, 1.f) * float(m_height - 1);
+        // A direction that is not finite (no valid one gives it) still reads inside the grid.
+        if (!(x >= 0.f)) x = 0.f;
+        float y = uv.y > 0.f ? std::min(uv.y, 1.f) * float(m_height - 1) : 0.f;
         GridPoint g;
         g.i = std::min(int(x), m_width - 1);
         g.j = std::min(int(y), m_height - 2);
@@ -240,20 +242,15 @@ private:
 
     float table(int i, int j) const { return m_table[size_t(j) * size_t(m_width + 1) + size_t(i)]; }
 
-    /// Inverse CDF of the density on [0, 1] proportional to the line from v0 to v1.
-    static float sample_linear(float u, float v0, float v1) {
-        if (std::abs(v0 - v1) < 1e-6f * std::max(v0, v1)) return u;
-        float x = (v0 - safe_sqrt(lerp(u, v0 * v0, v1 * v1))) / (v0 - v1);
-        return clamp(x, 0.f, 1.f);
-    }
-
     Point2f sample_uv(Point2f u) const {
         float uc = u.x;
         size_t index = m_cells.sample_reuse(uc);
         int i = int(index % size_t(m_width)), j = int(index / size_t(m_width));
         float a = table(i, j), b = table(i + 1, j), c = table(i, j + 1), d = table(i + 1, j + 1);
-        float t = sample_linear(u.y, 0.5f * (a + b), 0.5f * (c + d));
-        float s = sample_linear(uc, lerp(t, a, c), lerp(t, b, d));
+        // A cell next to a pole has a zero row (sin θ = 0): at t = 0 both ends of the s line
+        // are zero, and interval_to_linear() samples it uniformly.
+        float t = warp::interval_to_linear(0.5f * (a + b), 0.5f * (c + d), u.y);
+        float s = warp::interval_to_linear(lerp(t, a, c), lerp(t, b, d), uc);
         float uu = (float(i) + s + 0.5f) / float(m_width);
         uu -= std::floor(uu);
         return {std::min(uu, OneMinusEpsilon), (float(j) + t) / float(m_height - 1)};
@@ -297,6 +294,15 @@ private:
             for (int i = 0; i <= W; ++i)
                 m_table[size_t(j) * size_t(W + 1) + size_t(i)] =
                     std::max(lum[size_t(j) * W + size_t(i % W)] - offset, 0.f) * sin_theta;
+        }
+        // Scaled by a power of two so that the largest entry lies in [1, 2): the density is
+        // unchanged to the last bit (every operation on the table scales exactly), and the
+        // sampling's squares neither underflow for a very dark map nor overflow for a very bright
+        // one, nor does the density's normalisation (cells / total) overflow.
+        const float max_entry = *std::max_element(m_table.begin(), m_table.end());
+        if (max_entry > 0.f && std::isfinite(max_entry)) {
+            const float to_unit = std::ldexp(1.f, -std::ilogb(max_entry));
+            for (float &v : m_table) v *= to_unit;
         }
         std::vector<float> cells(size_t(W) * size_t(H - 1));
         for (int j = 0; j + 1 < H; ++j)

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <vector>
 
 using namespace facet;
 namespace fs = std::filesystem;
@@ -224,3 +225,79 @@ TEST(EnvironmentMap, ScaleAndEvalMatchSampleWeight) {
 
 // Chi-square tests of its importance sampling (a single bright pixel, a constant map, a tiny 3x2
 // map, a rotated HDR sky, uniform sampling): the envmap lines of tests/chi2/configs.txt.
+
+namespace {
+/// A sky whose light is at the zenith: the cells next to the +Y pole carry most of the weight.
+Color3f bright_zenith(int, int y) { return y < 2 ? Color3f(50.f, 60.f, 70.f) : Color3f(0.1f); }
+
+/// Variates on the edges of the unit square and inside it: 0 exactly (which a sampler returns
+/// with probability 2^-24 per dimension), the smallest steps above it, the middle, 1 - ε.
+const std::vector<float> &edge_variates() {
+    static const std::vector<float> v = {0.f,   0x1p-149f, 0x1p-24f, 1e-7f,  0.001f,
+                                         0.25f, 0.5f,      0.75f,    0.999f, OneMinusEpsilon};
+    return v;
+}
+
+void expect_valid_direction_sample(const DirectionSample &ds, const Color3f &w, float ux,
+                                   float uy) {
+    SCOPED_TRACE(::testing::Message() << "u = (" << ux << ", " << uy << ")");
+    ASSERT_TRUE(std::isfinite(ds.d.x) && std::isfinite(ds.d.y) && std::isfinite(ds.d.z));
+    EXPECT_NEAR(norm(ds.d), 1.f, 1e-5f);
+    EXPECT_TRUE(std::isfinite(ds.pdf) && ds.pdf >= 0.f) << "pdf " << ds.pdf;
+    EXPECT_TRUE(w.is_finite()) << w.r << " " << w.g << " " << w.b;
+    // The pole itself has density zero (sin θ = 0 on the first row): a sample that lands on it
+    // is a failed one, with weight zero.
+    if (ds.pdf == 0.f) {
+        EXPECT_EQ(w, Color3f(0.f));
+    }
+}
+} // namespace
+
+TEST(EnvironmentMap, SamplesOnTheEdgesOfTheSquareAreValid) {
+    // u.y = 0 puts the sample on the first row of its cell; in a cell next to the pole that row
+    // has zero density, and the inverse CDF along it was 0/0 (a NaN direction, then a read
+    // outside the map). Every edge variate must give a unit direction, a finite positive pdf
+    // and a finite weight, for sample_direction() and sample_ray() alike.
+    for (bool bilinear : {true, false}) {
+        std::string map = write_map("zenith.exr", 16, 8, bright_zenith);
+        auto scene = load(
+            scene_with(map, bilinear ? "" : R"(<string name="filter_type" value="nearest"/>)"));
+        const Emitter &env = *scene->environment_emitters().at(0);
+        Interaction ref;
+        for (float ux : edge_variates())
+            for (float uy : edge_variates()) {
+                auto [ds, w] = env.sample_direction(ref, Point2f(ux, uy));
+                expect_valid_direction_sample(ds, w, ux, uy);
+                EXPECT_EQ(env.pdf_direction(ref, ds), ds.pdf);
+                auto [ray, power] = env.sample_ray(Point2f(0.5f, 0.5f), Point2f(ux, uy));
+                EXPECT_TRUE(std::isfinite(ray.d.x) && std::isfinite(ray.o.x));
+                EXPECT_TRUE(power.is_finite());
+            }
+    }
+}
+
+TEST(EnvironmentMap, VeryDarkAndVeryBrightMapsSampleLikeTheirUnitTwin) {
+    // Sampling depends on the map only up to a constant factor: a map scaled by 2^-84 (whose
+    // table values squared underflow) or by 2^84 (whose squares overflow) must pick the same
+    // directions with the same densities as the unscaled one, bit for bit (powers of two, so
+    // that the scaled pixels are exact).
+    std::string map = write_map("zenith-scaled.exr", 16, 8, bright_zenith);
+    auto unit = load(scene_with(map));
+    const Emitter &e1 = *unit->environment_emitters().at(0);
+    for (const char *scale :
+         {"5.1698788284564229679463043254372e-26", "19342813113834066795298816"}) {
+        SCOPED_TRACE(scale);
+        auto scaled =
+            load(scene_with(map, std::string(R"(<float name="scale" value=")") + scale + "\"/>"));
+        const Emitter &es = *scaled->environment_emitters().at(0);
+        Interaction ref;
+        for (float ux : edge_variates())
+            for (float uy : edge_variates()) {
+                auto [d1, w1] = e1.sample_direction(ref, Point2f(ux, uy));
+                auto [ds, ws] = es.sample_direction(ref, Point2f(ux, uy));
+                expect_valid_direction_sample(ds, ws, ux, uy);
+                EXPECT_EQ(ds.d, d1.d) << "u = (" << ux << ", " << uy << ")";
+                EXPECT_EQ(ds.pdf, d1.pdf) << "u = (" << ux << ", " << uy << ")";
+            }
+    }
+}
