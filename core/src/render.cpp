@@ -645,6 +645,7 @@ RenderResult Integrator::render(const Scene &, const Sensor &, const RenderOptio
 }
 
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts) {
+    const Scene::RenderLock lock(scene); // no update() of the scene while it renders
     if (!scene.integrator()) FACET_THROW("the scene has no integrator");
     const Integrator &integrator = *scene.integrator();
     Film &film = sensor.film();

@@ -209,7 +209,47 @@ RTCDevice embree_device(int threads) {
     return device;
 }
 
-Scene::Scene(const Properties &props) {
+Scene::Scene(const Properties &props) { build(props, nullptr); }
+
+Scene::RenderLock::RenderLock(const Scene &scene) : m_scene(scene) {
+    int n = scene.m_renders.load();
+    do {
+        if (n < 0) FACET_THROW("the scene is being updated: render it once update() has returned");
+    } while (!scene.m_renders.compare_exchange_weak(n, n + 1));
+}
+
+Scene::RenderLock::~RenderLock() { m_scene.m_renders.fetch_sub(1); }
+
+bool Scene::rebuild(const Properties &props) {
+    int idle = 0;
+    if (!m_renders.compare_exchange_strong(idle, -1)) {
+        if (idle < 0) FACET_THROW("cannot update the scene: another update of it is running");
+        FACET_THROW("cannot update the scene while a render of it is running: update it "
+                    "between renders");
+    }
+    struct Release {
+        std::atomic<int> &state;
+        ~Release() { state.store(0); }
+    } release{m_renders};
+    Scene next;
+    next.build(props, this);
+    // Everything that can fail has run: the new state becomes this scene's.
+    std::swap(m_shapes, next.m_shapes);
+    std::swap(m_emitters, next.m_emitters);
+    std::swap(m_environment, next.m_environment);
+    std::swap(m_sensors, next.m_sensors);
+    std::swap(m_integrator, next.m_integrator);
+    std::swap(m_emitter_table, next.m_emitter_table);
+    std::swap(m_geometries, next.m_geometries);
+    std::swap(m_bbox, next.m_bbox);
+    std::swap(m_accel_seconds, next.m_accel_seconds);
+    std::swap(m_device, next.m_device);
+    std::swap(m_rtc_scene, next.m_rtc_scene); // `next` releases the old one (or null)
+    std::swap(m_robust, next.m_robust);
+    return !next.m_accel_reused;
+}
+
+void Scene::build(const Properties &props, Scene *previous) {
     // Embree asks every thread that builds or traces to flush denormals; the caller's mode is
     // restored afterwards (render threads set their own).
     struct FlushDenormals {
@@ -313,11 +353,25 @@ Scene::Scene(const Properties &props) {
 
     m_device = facet::embree_device(); // the free function, not the accessor of the same name
     rtcRetainDevice(m_device);
-    const auto accel_start = std::chrono::steady_clock::now();
-    m_rtc_scene = rtcNewScene(m_device);
     // As in Mitsuba 3: Embree's fast triangle test unless the scene asks for the robust
     // (watertight, slower) one.
     m_robust = props.get_bool("embree_use_robust_intersections", false);
+    if (previous && previous->m_rtc_scene && previous->m_shapes == m_shapes &&
+        previous->m_robust == m_robust) {
+        // The same shapes (an update changed no geometry): the Embree scene is theirs.
+        m_geometries = previous->m_geometries;
+        m_bbox = previous->m_bbox;
+        m_accel_seconds = previous->m_accel_seconds;
+        for (auto &emitter : m_emitters) emitter->set_scene(*this);
+        for (auto &sensor : m_sensors)
+            if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
+                needs_scene->set_scene(*this);
+        std::swap(m_rtc_scene, previous->m_rtc_scene); // last: nothing can fail after it
+        m_accel_reused = true;
+        return;
+    }
+    const auto accel_start = std::chrono::steady_clock::now();
+    m_rtc_scene = rtcNewScene(m_device);
     rtcSetSceneFlags(m_rtc_scene, m_robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
     try {
@@ -349,9 +403,11 @@ Scene::Scene(const Properties &props) {
             if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
                 needs_scene->set_scene(*this);
     } catch (...) {
-        // The destructor does not run for a half-built object.
+        // The destructor does not run for a half-built object (nor twice for a rebuilt one).
         rtcReleaseScene(m_rtc_scene);
         rtcReleaseDevice(m_device);
+        m_rtc_scene = nullptr;
+        m_device = nullptr;
         throw;
     }
 }

@@ -81,6 +81,11 @@ float Shape::pdf_direction(const Interaction &ref, const DirectionSample &ds) co
     return pdf_position(ds) * ds.dist * ds.dist / cos_theta;
 }
 
+void Shape::set_emitter(std::shared_ptr<Emitter> emitter) {
+    m_emitter = std::move(emitter);
+    if (m_emitter) m_emitter->set_shape(this);
+}
+
 std::string Shape::emitter_label() const {
     if (!m_emitter) return "none";
     return m_emitter->id().empty() ? "attached" : "\"" + m_emitter->id() + "\"";

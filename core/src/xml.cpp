@@ -9,6 +9,8 @@
 //  3. instantiate: children first, each node once; then parameters_changed() on every object.
 // Every error is a facet::Error carrying the file:line:col of the element it concerns.
 
+#include "scene_description.h"
+
 #include <facet/frame.h>
 #include <facet/logger.h>
 #include <facet/plugin.h>
@@ -286,6 +288,7 @@ struct ObjectNode {
     std::unordered_map<std::string, Location> names; ///< entry names, for duplicate checks
     size_t arg_counter = 0;                          ///< next `_arg_N`
     std::shared_ptr<Object> instance;
+    std::vector<std::string> requested; ///< the names the plugin asked for
 
     Entry *find(const std::string &name) {
         for (Entry &e : entries)
@@ -389,7 +392,41 @@ private:
             }
         }
         check_shape_textures();
+        if (auto *scene = dynamic_cast<Scene *>(result.get()))
+            scene->set_description(describe(root));
         return result;
+    }
+
+    /// The descriptions of the instantiated objects, for traverse() (scene_description.h).
+    std::shared_ptr<SceneDescription> describe(size_t root) const {
+        auto d = std::make_shared<SceneDescription>();
+        d->lenient = m_opts.lenient;
+        d->resolver = file_resolver(); // this load's folders (the guard restores the caller's)
+        std::unordered_map<size_t, size_t> index; // m_nodes -> d->nodes
+        for (size_t i : m_created) {
+            const ObjectNode &node = m_nodes[i];
+            SceneDescription::Node out;
+            out.kind = node.kind;
+            out.plugin = node.plugin;
+            out.id = node.id;
+            out.location = node.location;
+            out.requested = node.requested;
+            if (i != root) out.instance = node.instance;
+            for (const Entry &e : node.entries) {
+                SceneDescription::Entry entry;
+                entry.name = e.name;
+                entry.location = e.location;
+                if (e.kind == Entry::Kind::Value)
+                    entry.value = e.value;
+                else
+                    entry.child = index.at(e.child);
+                out.entries.push_back(std::move(entry));
+            }
+            index[i] = d->nodes.size();
+            d->nodes.push_back(std::move(out));
+        }
+        d->root = index.at(root);
+        return d;
     }
 
     /// Lets every texture reached from a shape (through its BSDF, emitter and their nested
@@ -1105,6 +1142,7 @@ private:
             // The registry's errors already say which plugin failed, at the innermost location.
             obj = PluginRegistry::instance().create(node.kind, props, m_opts.lenient);
         }
+        node.requested = props.requested_names();
         if (!node.id.empty()) obj->set_id(node.id);
         node.instance = obj;
         m_created.push_back(index);

@@ -8,6 +8,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <atomic>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -22,8 +23,11 @@ public:
     virtual void set_scene(const Scene &scene) = 0;
 };
 
+struct SceneDescription;
+
 /// The scene: shapes in one Embree scene, emitters, sensors and the integrator.
-/// Immutable once built; every query is thread-safe.
+/// Immutable while it renders; every query is thread-safe. Only traverse() (facet/params.h)
+/// changes a built scene, between renders.
 class Scene : public Object {
 public:
     /// Collects the children of a <scene> and builds the Embree scene. Missing pieces get
@@ -90,7 +94,36 @@ public:
     bool robust_intersections() const { return m_robust; }
     std::string to_string() const override;
 
+    /// The object descriptions the loader built the scene from (for traverse()); null for a
+    /// scene built otherwise.
+    const std::shared_ptr<SceneDescription> &description() const { return m_description; }
+    void set_description(std::shared_ptr<SceneDescription> d) { m_description = std::move(d); }
+
+    /// Held by every render of the scene (facet::render takes one): while any is alive, rebuild()
+    /// refuses to run, and while rebuild() runs, taking one fails. Both are clear errors.
+    class RenderLock {
+    public:
+        explicit RenderLock(const Scene &scene);
+        ~RenderLock();
+        RenderLock(const RenderLock &) = delete;
+        RenderLock &operator=(const RenderLock &) = delete;
+
+    private:
+        const Scene &m_scene;
+    };
+
+    /// Rebuilds the scene in place from the children in `props` (the same properties as the
+    /// constructor's; unchanged objects are the same pointers). The Embree scene is kept when the
+    /// shapes are the same objects in the same order, else built again. On an error the scene is
+    /// left as it was. Fails when a render of the scene is running. Returns true when the
+    /// acceleration structure was built again.
+    bool rebuild(const Properties &props);
+
 private:
+    Scene() = default;
+    /// The constructor's body; with `previous`, takes over its Embree scene when the shapes
+    /// are the same.
+    void build(const Properties &props, Scene *previous);
     /// ray_test()'s body, inlined into the shadow ray of sample_emitter_direction().
     bool occluded(const Ray &ray) const;
 
@@ -121,6 +154,10 @@ private:
     RTCDevice m_device = nullptr;
     RTCScene m_rtc_scene = nullptr;
     bool m_robust = false;
+    std::shared_ptr<SceneDescription> m_description;
+    /// Renders running (> 0), or -1 while rebuild() runs.
+    mutable std::atomic<int> m_renders{0};
+    bool m_accel_reused = false; ///< set by build(): the Embree scene came from `previous`
 };
 
 /// Embree device shared by all scenes of the process; `threads` = 0 lets Embree decide.

@@ -68,6 +68,9 @@ public:
     std::shared_ptr<Emitter> emitter_ptr() const { return m_emitter; }
     /// The scene gives shapes without a BSDF a default diffuse one.
     void set_bsdf(std::shared_ptr<BSDF> bsdf) { m_bsdf = std::move(bsdf); }
+    /// Attaches an area emitter (traverse() relinks a re-created one); the emitter is told its
+    /// shape, as when the shape is constructed with it.
+    void set_emitter(std::shared_ptr<Emitter> emitter);
     virtual bool is_mesh() const { return false; }
     std::string to_string() const override;
 
