@@ -24,6 +24,8 @@ __all__ = [
     "Plugin",
     "load_file",
     "load_string",
+    "traverse",
+    "SceneParameters",
     "render",
     "write",
     "read",
@@ -61,6 +63,87 @@ def load_file(path, *, lenient=False, search_path=(), **params):
 def load_string(xml, *, lenient=False, search_path=(), **params):
     """Loads a scene given as XML text; locations in errors read ``string:line:col``."""
     return _facet.load_string(xml, _params(params), lenient, [_os.fspath(p) for p in search_path])
+
+
+class SceneParameters:
+    """The parameters of a loaded scene (``facet.traverse(scene)``), a mapping from keys such as
+    ``"red.reflectance"``, ``"sensor.to_world"`` or ``"shape_7.emitter.radiance"`` (the object's
+    id, or its place when it has none, then the parameter) to values: bools, ints, floats,
+    strings, rgb and point triples, spectra (a number or (wavelength, value) pairs) and 4x4
+    transforms (NumPy arrays).
+
+        params = facet.traverse(scene)
+        params["red.reflectance"] = (0.2, 0.3, 0.7)
+        params.update()                     # the scene changes in place
+        image = facet.render(scene)
+
+    Assigning checks the type; ``update()`` builds again only the objects that depend on the
+    changed values (a render afterwards equals a fresh load of the edited scene, bit for bit) and
+    returns what it rebuilt. A parameter the scene leaves at its default (a shape's
+    ``to_world``, say) is not among ``keys()`` but may be assigned."""
+
+    def __init__(self, native):
+        self._native = native
+
+    def keys(self):
+        return list(self._native.keys())
+
+    def __iter__(self):
+        return iter(self.keys())
+
+    def __len__(self):
+        return len(self._native.keys())
+
+    def __contains__(self, key):
+        return isinstance(key, str) and self._native.has(key) and self._native.is_set(key)
+
+    def __getitem__(self, key):
+        if not isinstance(key, str):
+            raise TypeError(f"scene parameter keys are strings, not {type(key).__name__}")
+        try:
+            return self._native.get(key)
+        except Error as e:
+            raise KeyError(str(e)) from None
+
+    def __setitem__(self, key, value):
+        if not isinstance(key, str):
+            raise TypeError(f"scene parameter keys are strings, not {type(key).__name__}")
+        try:
+            self._native.set(key, value)
+        except Error as e:
+            if "unknown scene parameter" in str(e):
+                raise KeyError(str(e)) from None
+            raise TypeError(str(e)) from None
+
+    def get(self, key, default=None):
+        return self[key] if key in self else default
+
+    def items(self):
+        return [(k, self[k]) for k in self.keys()]
+
+    def values(self):
+        return [self[k] for k in self.keys()]
+
+    def type(self, key):
+        """The parameter's type: "boolean", "integer", "float", "string", "vector", "rgb",
+        "spectrum" or "transform"."""
+        return self._native.type(key)
+
+    def update(self):
+        """Applies the assignments made since the last update; returns a dict saying what was
+        built again (objects_created, shapes_created, shapes_relinked, accel_rebuilt). Raises
+        ``facet.Error`` (the scene unchanged) when an object refuses a value or when a render of
+        the scene is running."""
+        return self._native.update()
+
+    def __repr__(self):
+        lines = [f"  {k!r}: {self.type(k)}," for k in self.keys()]
+        return "SceneParameters({\n" + "\n".join(lines) + "\n})"
+
+
+def traverse(scene):
+    """The parameters of ``scene`` as a ``SceneParameters`` mapping (see there)."""
+    return SceneParameters(_facet.traverse(scene))
 
 
 class Image(tuple):

@@ -9,6 +9,7 @@
 #include <facet/film.h>
 #include <facet/image.h>
 #include <facet/logger.h>
+#include <facet/params.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
 #include <facet/sampler.h>
@@ -44,7 +45,8 @@ struct PyScene {
     std::shared_ptr<Scene> scene;
     std::string path; ///< absolute file name; empty for load_string
     std::map<std::string, std::string> params;
-    std::string text; ///< the XML, for facet:scene_hash (as `facet render` computes it)
+    std::string text;  ///< the XML, for facet:scene_hash (as `facet render` computes it)
+    std::string edits; ///< the values traverse() changed, in order (also in facet:scene_hash)
     /// A render develops into the sensor's film: one render of a scene at a time.
     std::shared_ptr<std::mutex> render_mutex = std::make_shared<std::mutex>();
 };
@@ -164,6 +166,8 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
                     sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
     if (spp && *spp < 1) FACET_THROW("spp={}: expected a positive number of samples", *spp);
     if (threads && *threads < 1) FACET_THROW("threads={}: expected at least 1", *threads);
+    // Held until the render ends: no update() of the scene may free the sensor meanwhile.
+    auto lock = std::make_shared<Scene::RenderLock>(*s.scene);
     const Sensor &sensor = *sensors[size_t(sensor_index)];
 
     RenderOptions opts;
@@ -179,7 +183,7 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
 
     std::shared_ptr<Scene> keep = s.scene; // alive while the render thread runs
     std::shared_ptr<std::mutex> mutex = s.render_mutex;
-    RenderResult result = run_interruptible(cancel, [keep, mutex, &sensor, opts]() {
+    RenderResult result = run_interruptible(cancel, [keep, mutex, lock, &sensor, opts]() {
         std::lock_guard<std::mutex> lock(*mutex);
         return render(*keep, sensor, opts);
     });
@@ -187,7 +191,7 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     // The attributes `facet render` writes, so that parts from here and from the CLI merge.
     std::map<std::string, std::string> meta = render_metadata(result);
     meta["facet:scene_hash"] =
-        scene_identity(s.text, s.params, result.film_width, result.film_height);
+        scene_identity(s.text + s.edits, s.params, result.film_width, result.film_height);
     meta["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
     if (!s.path.empty()) meta["facet:scene"] = s.path;
     meta["facet:seed"] = std::to_string(seed);
@@ -306,6 +310,209 @@ py::array_t<double> histogram(const std::vector<double> &v, int rows, int cols) 
     return a;
 }
 
+// -- traverse(): scene parameters ----------------------------------------------------------------
+
+/// facet.traverse(scene): facet::SceneParameters and the Python scene whose renders it changes.
+struct PyParams {
+    PyScene *scene; ///< kept alive by the Python object (py::keep_alive)
+    SceneParameters params;
+};
+
+py::object value_to_py(const Properties::Value &v) {
+    return std::visit(
+        [](const auto &x) -> py::object {
+            using T = std::decay_t<decltype(x)>;
+            if constexpr (std::is_same_v<T, bool>)
+                return py::bool_(x);
+            else if constexpr (std::is_same_v<T, int64_t>)
+                return py::int_(x);
+            else if constexpr (std::is_same_v<T, double>)
+                return py::float_(x);
+            else if constexpr (std::is_same_v<T, std::string>)
+                return py::str(x);
+            else if constexpr (std::is_same_v<T, Vector3f>)
+                return py::make_tuple(x.x, x.y, x.z);
+            else if constexpr (std::is_same_v<T, Color3f>)
+                return py::make_tuple(x.r, x.g, x.b);
+            else if constexpr (std::is_same_v<T, SpectrumData>) {
+                if (x.uniform) return py::float_(x.value);
+                py::list pairs;
+                for (size_t i = 0; i < x.wavelengths.size(); ++i)
+                    pairs.append(py::make_tuple(x.wavelengths[i], x.values[i]));
+                return std::move(pairs);
+            } else if constexpr (std::is_same_v<T, Transform>) {
+                py::array_t<float> a({4, 4});
+                for (int r = 0; r < 4; ++r)
+                    for (int c = 0; c < 4; ++c) a.mutable_at(r, c) = x.matrix.m[r][c];
+                return std::move(a);
+            } else {
+                return py::none();
+            }
+        },
+        v);
+}
+
+bool is_number(const py::handle &h) {
+    if (py::isinstance<py::bool_>(h)) return false;
+    return py::isinstance<py::int_>(h) || py::isinstance<py::float_>(h) ||
+           py::isinstance(h, py::module_::import("numbers").attr("Real"));
+}
+
+double as_float(const py::handle &h) {
+    return py::float_(py::reinterpret_borrow<py::object>(h)).cast<double>();
+}
+
+int64_t as_int(const py::handle &h) {
+    return py::int_(py::reinterpret_borrow<py::object>(h)).cast<int64_t>();
+}
+
+/// A 4x4 matrix from nested sequences, a NumPy array or an object with a `matrix` attribute.
+std::optional<Transform> as_transform(const py::handle &h) {
+    py::object obj = py::reinterpret_borrow<py::object>(h);
+    if (py::hasattr(obj, "matrix")) obj = obj.attr("matrix");
+    if (py::isinstance<py::str>(obj) || is_number(obj)) return std::nullopt;
+    py::array_t<double, py::array::c_style | py::array::forcecast> a;
+    try {
+        a = obj.cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+    } catch (const py::cast_error &) {
+        return std::nullopt;
+    }
+    if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) return std::nullopt;
+    float rows[16];
+    for (int i = 0; i < 16; ++i) rows[i] = float(a.data()[i]);
+    Transform t(Matrix4f::from_rows(rows));
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            if (!std::isfinite(t.matrix.m[r][c]) || !std::isfinite(t.inverse_matrix.m[r][c]))
+                FACET_THROW("the matrix is not an invertible transform with finite entries");
+    return t;
+}
+
+std::optional<Vector3f> as_triple(const py::handle &h) {
+    if (py::isinstance<py::str>(h) || !py::isinstance<py::sequence>(h)) {
+        if (!py::hasattr(h, "__array__")) return std::nullopt;
+    }
+    std::vector<double> v;
+    try {
+        v = py::cast<std::vector<double>>(
+            py::module_::import("numpy").attr("asarray")(h, "float64").attr("ravel")());
+    } catch (const std::exception &) {
+        return std::nullopt;
+    }
+    if (v.size() != 3) return std::nullopt;
+    return Vector3f(float(v[0]), float(v[1]), float(v[2]));
+}
+
+/// The Python value as a value of type `want` (the parameter's), or of the type its form gives
+/// when the scene leaves the parameter at its default (`want` empty).
+Properties::Value value_from_py(const std::string &key, const py::handle &h,
+                                std::optional<Properties::Type> want) {
+    using T = Properties::Type;
+    auto wrong = [&](const char *expected) {
+        return Error(fmt::format("scene parameter \"{}\" expects {}, not {} {}", key, expected,
+                                 std::string(py::str(py::type::of(h).attr("__name__"))),
+                                 std::string(py::repr(h))));
+    };
+    if (!want) {
+        if (py::isinstance<py::bool_>(h)) return h.cast<bool>();
+        if (py::isinstance<py::int_>(h)) return h.cast<int64_t>();
+        if (is_number(h)) return h.cast<double>();
+        if (py::isinstance<py::str>(h)) return h.cast<std::string>();
+        if (auto t = as_transform(h)) return *t;
+        if (auto v = as_triple(h)) return Color3f(v->x, v->y, v->z);
+        throw wrong("a bool, a number, a string, an rgb triple or a 4x4 transform");
+    }
+    switch (*want) {
+    case T::Bool:
+        if (!py::isinstance<py::bool_>(h) &&
+            !py::isinstance(h, py::module_::import("numpy").attr("bool_")))
+            throw wrong("a bool");
+        return h.cast<bool>();
+    case T::Integer:
+        if (py::isinstance<py::bool_>(h) ||
+            !py::isinstance(h, py::module_::import("numbers").attr("Integral")))
+            throw wrong("an integer");
+        return as_int(h);
+    case T::Float:
+        if (!is_number(h)) throw wrong("a number");
+        return as_float(h);
+    case T::String:
+        if (!py::isinstance<py::str>(h)) throw wrong("a string");
+        return h.cast<std::string>();
+    case T::Vector:
+        if (auto v = as_triple(h)) return *v;
+        throw wrong("3 numbers");
+    case T::Color:
+        if (is_number(h)) return Color3f(float(as_float(h)));
+        if (auto v = as_triple(h)) return Color3f(v->x, v->y, v->z);
+        throw wrong("an rgb triple or a number");
+    case T::Spectrum: {
+        if (is_number(h)) return SpectrumData::constant(as_float(h));
+        SpectrumData s;
+        s.uniform = false;
+        try {
+            for (auto pair : h.cast<py::sequence>()) {
+                auto p = pair.cast<std::pair<double, double>>();
+                if (!s.wavelengths.empty() && !(p.first > s.wavelengths.back()))
+                    FACET_THROW("scene parameter \"{}\": wavelengths must increase", key);
+                s.wavelengths.push_back(p.first);
+                s.values.push_back(p.second);
+            }
+        } catch (const py::cast_error &) {
+            throw wrong("a number or (wavelength, value) pairs");
+        }
+        if (s.wavelengths.empty()) throw wrong("a number or (wavelength, value) pairs");
+        return s;
+    }
+    case T::Transform:
+        if (auto t = as_transform(h)) return *t;
+        throw wrong("a 4x4 matrix");
+    default:
+        throw wrong("a value");
+    }
+}
+
+void bind_params(py::module_ &m) {
+    py::class_<PyParams>(m, "SceneParameters")
+        .def("keys", [](const PyParams &p) { return p.params.keys(); })
+        .def("has", [](const PyParams &p, const std::string &k) { return p.params.has(k); })
+        .def("is_set", [](const PyParams &p, const std::string &k) { return p.params.is_set(k); })
+        .def("get",
+             [](const PyParams &p, const std::string &k) { return value_to_py(p.params.get(k)); })
+        .def("type",
+             [](const PyParams &p, const std::string &k) {
+                 return std::string(Properties::type_name(p.params.type(k)));
+             })
+        .def("set",
+             [](PyParams &p, const std::string &k, const py::handle &v) {
+                 std::optional<Properties::Type> want;
+                 if (p.params.is_set(k)) want = p.params.type(k);
+                 Properties::Value value = value_from_py(k, v, want);
+                 p.params.set(k, value);
+                 p.scene->edits += fmt::format("\n{}={}", k, std::string(py::repr(v)));
+             })
+        .def("pending", [](const PyParams &p) { return p.params.pending(); })
+        .def("update", [](PyParams &p) {
+            SceneUpdate u;
+            {
+                py::gil_scoped_release release;
+                u = p.params.update();
+            }
+            py::dict d;
+            d["objects_created"] = u.objects_created;
+            d["shapes_created"] = u.shapes_created;
+            d["shapes_relinked"] = u.shapes_relinked;
+            d["accel_rebuilt"] = u.accel_rebuilt;
+            return d;
+        });
+    m.def(
+        "traverse",
+        [](PyScene &s) {
+            return PyParams{&s, traverse(s.scene)};
+        },
+        py::arg("scene"), py::keep_alive<0, 1>());
+}
+
 /// The Python exception type for facet::Error (a RuntimeError with file, line and column).
 PyObject *g_error_type = nullptr;
 
@@ -348,6 +555,7 @@ PYBIND11_MODULE(_facet, m) {
             return fmt::format("<facet.Scene {}>", s.path.empty() ? "(from a string)" : s.path);
         });
 
+    bind_params(m);
     m.def("load_file", &load_file_py, py::arg("path"), py::arg("params"), py::arg("lenient"),
           py::arg("search_path"));
     m.def("load_string", &load_string_py, py::arg("xml"), py::arg("params"), py::arg("lenient"),
