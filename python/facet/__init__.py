@@ -24,6 +24,7 @@ __all__ = [
     "Plugin",
     "load_file",
     "load_string",
+    "load_dict",
     "traverse",
     "SceneParameters",
     "render",
@@ -144,6 +145,169 @@ class SceneParameters:
 def traverse(scene):
     """The parameters of ``scene`` as a ``SceneParameters`` mapping (see there)."""
     return SceneParameters(_facet.traverse(scene))
+
+
+def _xml_attr(value):
+    from xml.sax.saxutils import quoteattr
+
+    return quoteattr(str(value))
+
+
+def _xml_number(value):
+    return repr(float(value))
+
+
+def _is_number(value):
+    import numbers
+
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _matrix(value):
+    import numpy as np
+
+    value = getattr(value, "matrix", value)
+    if isinstance(value, (str, bytes)) or _is_number(value):
+        return None
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    return a if a.shape == (4, 4) else None
+
+
+def _dict_kinds():
+    kinds = {p.name: p.kind for p in plugins()}
+    kinds["scene"] = "scene"
+    return kinds
+
+
+def _dict_to_xml(d, kinds, path, name=None, id_=None, indent="    "):
+    """One object of Mitsuba's dictionary form as facet XML."""
+    plugin = d.get("type")
+    if not isinstance(plugin, str):
+        raise ValueError(f"{path or 'the scene'}: an object needs a 'type' (a plugin name)")
+    kind = kinds.get(plugin)
+    if kind is None:
+        import difflib
+
+        close = difflib.get_close_matches(plugin, list(kinds), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ValueError(f"{path or 'the scene'}: unknown plugin type {plugin!r}{hint}")
+    is_scene = kind == "scene"
+    attrs = ""
+    if not is_scene:
+        attrs = f" type={_xml_attr(plugin)}"
+    if "id" in d:
+        id_ = d["id"]
+    if id_ is not None:
+        attrs += f" id={_xml_attr(id_)}"
+    if name is not None and not is_scene:
+        attrs += f" name={_xml_attr(name)}"
+    if is_scene:
+        attrs += ' version="3.0.0"'
+    out = [f"{indent[4:]}<{kind}{attrs}>"]
+    for key, value in d.items():
+        if key in ("type", "id"):
+            continue
+        where = f"{path}.{key}" if path else key
+        out.append(_value_to_xml(key, value, kinds, where, indent, top=is_scene))
+    out.append(f"{indent[4:]}</{kind}>")
+    return "\n".join(out)
+
+
+def _value_to_xml(key, value, kinds, where, indent, top):
+    n = _xml_attr(key)
+    if isinstance(value, dict):
+        t = value.get("type")
+        if t == "ref":
+            if "id" not in value:
+                raise ValueError(f"{where}: a reference needs an 'id'")
+            return f"{indent}<ref name={n} id={_xml_attr(value['id'])}/>"
+        if t == "rgb":
+            v = value.get("value")
+            if _is_number(v):
+                v = [v] * 3
+            try:
+                text = ", ".join(_xml_number(x) for x in v)
+                assert len(list(v)) == 3
+            except (TypeError, AssertionError):
+                raise ValueError(f"{where}: an rgb value needs 3 numbers (or one)") from None
+            return f"{indent}<rgb name={n} value={_xml_attr(text)}/>"
+        if t == "spectrum":
+            if "filename" in value:
+                import os
+
+                return (f"{indent}<spectrum name={n} "
+                        f"filename={_xml_attr(os.fspath(value['filename']))}/>")
+            v = value.get("value")
+            if _is_number(v):
+                text = _xml_number(v)
+            else:
+                try:
+                    text = ", ".join(f"{_xml_number(w)}:{_xml_number(x)}" for w, x in v)
+                except (TypeError, ValueError):
+                    raise ValueError(f"{where}: a spectrum value is a number or (wavelength, "
+                                     "value) pairs") from None
+            return f"{indent}<spectrum name={n} value={_xml_attr(text)}/>"
+        # A nested object: at the top of a scene its key is its id (as in Mitsuba), inside
+        # an object its property name.
+        if top:
+            return _dict_to_xml(value, kinds, where, id_=key, indent=indent + "    ")
+        return _dict_to_xml(value, kinds, where, name=key, indent=indent + "    ")
+    if isinstance(value, bool):
+        return f"{indent}<boolean name={n} value=\"{'true' if value else 'false'}\"/>"
+    if isinstance(value, int) or type(value).__name__.startswith(("int", "uint")):
+        return f"{indent}<integer name={n} value=\"{int(value)}\"/>"
+    if _is_number(value):
+        return f"{indent}<float name={n} value=\"{_xml_number(value)}\"/>"
+    if isinstance(value, str) or isinstance(value, _os.PathLike):
+        return f"{indent}<string name={n} value={_xml_attr(_os.fspath(value))}/>"
+    m = _matrix(value)
+    if m is not None:
+        text = " ".join(_xml_number(x) for x in m.ravel())
+        return f"{indent}<transform name={n}><matrix value=\"{text}\"/></transform>"
+    try:
+        import numpy as np
+
+        v = np.asarray(value, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        v = None
+    if v is not None and v.size == 3:
+        text = ", ".join(_xml_number(x) for x in v)
+        return f"{indent}<point name={n} value=\"{text}\"/>"
+    raise ValueError(f"{where}: cannot use {type(value).__name__} {value!r} as a scene value "
+                     "(expected a bool, number, string, 3 numbers, a 4x4 transform or a dict)")
+
+
+def dict_to_xml(d):
+    """The XML text ``load_dict`` loads for the dictionary ``d``."""
+    if not isinstance(d, dict):
+        raise TypeError(f"load_dict expects a dict, not {type(d).__name__}")
+    return _dict_to_xml(d, _dict_kinds(), "", indent="    ")
+
+
+def load_dict(d, *, lenient=False, search_path=()):
+    """Builds a scene from Mitsuba's dictionary form::
+
+        scene = facet.load_dict({
+            "type": "scene",
+            "integrator": {"type": "path", "max_depth": 6},
+            "light": {"type": "point", "position": [0, 2, 0],
+                      "intensity": {"type": "rgb", "value": [5, 5, 5]}},
+            "red": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.6, 0.1, 0.1]}},
+            "ball": {"type": "sphere", "to_world": np.eye(4), "bsdf": {"type": "ref", "id": "red"}},
+        })
+
+    Every object is a dict with a ``type`` (a plugin name, or "scene"); the keys of the scene's
+    children are their ids, the keys inside an object are property names. Values: bools, ints,
+    floats, strings, 3 numbers (a point), 4x4 matrices (nested lists, NumPy arrays, or anything
+    with a ``matrix`` attribute) for transforms, ``{"type": "rgb", "value": ...}``,
+    ``{"type": "spectrum", "value": ...}`` (a number or (wavelength, value) pairs, or
+    ``"filename"``), ``{"type": "ref", "id": ...}`` and nested objects. The dict becomes the
+    XML text ``dict_to_xml`` returns and loads like ``load_string`` (relative file names are
+    found from the current folder and ``search_path``)."""
+    return load_string(dict_to_xml(d), lenient=lenient, search_path=search_path)
 
 
 class Image(tuple):

@@ -1,5 +1,5 @@
-"""Editing a loaded scene (facet.traverse / update): every result equals a fresh load of the
-edited XML, bit for bit."""
+"""Editing a loaded scene (facet.traverse / update) and building one from Mitsuba's dictionary
+form (facet.load_dict): every result equals a fresh load of the edited XML, bit for bit."""
 
 import time
 
@@ -198,3 +198,116 @@ def test_heavy_scene_updates_rebuild_only_what_changed(cornell, tmp_path):
     assert np.array_equal(moved, _render(_fresh(cornell, tmp_path, fresh_text, "h2.xml")))
     print(f"\nheavy scene: load {load * 1e3:.1f} ms, albedo+radiance update {t_values * 1e3:.2f} ms,"
           f" render {t_render * 1e3:.1f} ms, box transform update {t_move * 1e3:.1f} ms")
+
+
+DICT_TWIN_XML = """<scene version="3.0.0">
+    <integrator type="path" id="integrator"><integer name="max_depth" value="5"/>
+        <boolean name="hide_emitters" value="false"/></integrator>
+    <sensor type="perspective" id="sensor">
+        <float name="fov" value="40.0"/>
+        <transform name="to_world"><matrix value="-1 0 0 0  0 1 0 1  0 0 -1 4  0 0 0 1"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+        <film type="hdrfilm" name="film"><integer name="width" value="24"/>
+            <integer name="height" value="16"/><string name="pixel_format" value="rgb"/></film>
+    </sensor>
+    <bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.4, 0.5, 0.6"/></bsdf>
+    <shape type="sphere" id="ball"><point name="center" value="0.3, 0.5, 0"/>
+        <float name="radius" value="0.5"/><ref name="bsdf" id="grey"/></shape>
+    <shape type="rectangle" id="floor">
+        <transform name="to_world"><matrix value="2 0 0 0  0 0 2 0  0 -2 0 0  0 0 0 1"/></transform>
+        <bsdf type="roughconductor" name="bsdf"><string name="material" value="Au"/>
+            <float name="alpha" value="0.2"/></bsdf>
+    </shape>
+    <shape type="rectangle" id="lamp">
+        <transform name="to_world"><matrix value="0.5 0 0 0  0 0 -0.5 2  0 0.5 0 0  0 0 0 1"/></transform>
+        <emitter type="area" name="emitter">
+            <spectrum name="radiance" value="400:3, 500:6, 600:9, 700:5"/></emitter>
+    </shape>
+    <emitter type="constant" id="sky"><spectrum name="radiance" value="0.25"/></emitter>
+</scene>"""
+
+
+def _twin_dict(floor_matrix):
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 5, "hide_emitters": False},
+        "sensor": {
+            "type": "perspective",
+            "fov": 40.0,
+            "to_world": np.array([[-1, 0, 0, 0], [0, 1, 0, 1], [0, 0, -1, 4], [0, 0, 0, 1]]),
+            "sampler": {"type": "independent", "sample_count": 4},
+            "film": {"type": "hdrfilm", "width": 24, "height": 16, "pixel_format": "rgb"},
+        },
+        "grey": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.4, 0.5, 0.6]}},
+        "ball": {"type": "sphere", "center": [0.3, 0.5, 0], "radius": 0.5,
+                 "bsdf": {"type": "ref", "id": "grey"}},
+        "floor": {"type": "rectangle", "to_world": floor_matrix,
+                  "bsdf": {"type": "roughconductor", "material": "Au", "alpha": 0.2}},
+        "lamp": {"type": "rectangle",
+                 "to_world": [[0.5, 0, 0, 0], [0, 0, -0.5, 2], [0, 0.5, 0, 0], [0, 0, 0, 1]],
+                 "emitter": {"type": "area", "radiance": {
+                     "type": "spectrum", "value": [(400, 3), (500, 6), (600, 9), (700, 5)]}}},
+        "sky": {"type": "constant", "radiance": {"type": "spectrum", "value": 0.25}},
+    }
+
+
+class _Matrix:
+    """A transform type of one's own: anything with a 4x4 `matrix`."""
+
+    def __init__(self, m):
+        self.matrix = m
+
+
+def test_load_dict_equals_its_xml_twin():
+    xml_image = _render(facet.load_string(DICT_TWIN_XML))
+    floor = [[2, 0, 0, 0], [0, 0, 2, 0], [0, -2, 0, 0], [0, 0, 0, 1]]
+    for m in (floor, np.array(floor, np.float32), _Matrix(np.array(floor))):
+        scene = facet.load_dict(_twin_dict(m))
+        assert np.array_equal(_render(scene), xml_image)
+    # The ids of the scene's children are the dict's keys: traverse() names them so.
+    params = facet.traverse(scene)
+    assert params["grey.reflectance"] == pytest.approx((0.4, 0.5, 0.6))
+    assert params["ball.radius"] == 0.5
+    assert params["lamp.emitter.radiance"] == [(400, 3), (500, 6), (600, 9), (700, 5)]
+
+
+def test_load_dict_cornell_box_equals_the_xml(cornell, tmp_path):
+    mesh = cornell.parent / "meshes"
+    white = {"type": "ref", "id": "white"}
+    d = {"type": "scene",
+         "integrator": {"type": "path", "max_depth": 4},
+         "sensor": {"type": "perspective", "fov": 37.0,
+                    "to_world": [[-1, 0, 0, 0], [0, 1, 0, 1], [0, 0, -1, 4], [0, 0, 0, 1]],
+                    "sampler": {"type": "independent", "sample_count": 4},
+                    "film": {"type": "hdrfilm", "width": 32, "height": 32}},
+         "white": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.73, 0.72, 0.69]}},
+         "red": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.62, 0.06, 0.05]}},
+         "green": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.13, 0.44, 0.09]}}}
+    for name, bsdf in [("floor", white), ("ceiling", white), ("back", white),
+                       ("left", {"type": "ref", "id": "red"}),
+                       ("right", {"type": "ref", "id": "green"}), ("tall_box", white),
+                       ("short_box", white)]:
+        d[name] = {"type": "obj", "filename": str(mesh / f"{name}.obj"), "bsdf": bsdf}
+    d["light"] = {"type": "obj", "filename": str(mesh / "light.obj"),
+                  "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.78}},
+                  "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [17, 12, 4]}}}
+    # The repository's scene, with the camera's look-at written as the matrix it makes.
+    text = cornell.read_text().replace(
+        '<lookat origin="0, 1, 4" target="0, 1, 0" up="0, 1, 0"/>',
+        '<matrix value="-1 0 0 0  0 1 0 1  0 0 -1 4  0 0 0 1"/>')
+    path = tmp_path / "cornell.xml"
+    path.write_text(text)
+    xml_scene = facet.load_file(path, search_path=[cornell.parent], **SMALL)
+    assert np.array_equal(_render(facet.load_dict(d)), _render(xml_scene))
+
+
+def test_load_dict_errors():
+    with pytest.raises(ValueError, match="did you mean 'diffuse'"):
+        facet.load_dict({"type": "scene", "b": {"type": "difuse"}})
+    with pytest.raises(ValueError, match="b.bsdf: an object needs a 'type'"):
+        facet.load_dict({"type": "scene", "b": {"type": "sphere", "bsdf": {"reflectance": 1}}})
+    with pytest.raises(ValueError, match="s.center: cannot use"):
+        facet.load_dict({"type": "scene", "s": {"type": "sphere", "center": object()}})
+    with pytest.raises(facet.Error, match="reference to unknown id"):
+        facet.load_dict({"type": "scene", "s": {"type": "sphere",
+                                                "bsdf": {"type": "ref", "id": "nope"}}})
