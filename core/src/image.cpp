@@ -84,6 +84,88 @@ std::vector<std::string> look_names(const std::string &looks) {
     return names;
 }
 
+/// Names and aliases colour-management configs give scene-linear Rec.709 (sRGB primaries, D65
+/// white), facet's working space. "linear" alone comes last: Blender's configs mean Rec.709 by
+/// it, but the name says nothing about primaries, so a config's interchange roles go first.
+const char *const k_rec709_names[] = {"Linear Rec.709 (sRGB)",
+                                      "lin_rec709_srgb",
+                                      "Linear Rec.709",
+                                      "lin_rec709",
+                                      "Utility - Linear - sRGB",
+                                      "Utility - Linear - Rec.709",
+                                      "lin_srgb",
+                                      "Linear sRGB",
+                                      "srgb_linear",
+                                      "sRGB - Linear",
+                                      "Linear BT.709"};
+
+/// Scene-linear Rec.709 to CIE XYZ (D65), IEC 61966-2-1.
+OCIO::MatrixTransformRcPtr rec709_to_xyz() {
+    static const double m[16] = {0.4124564, 0.3575761, 0.1804375, 0,         0.2126729, 0.7151522,
+                                 0.0721750, 0,         0.0193339, 0.1191920, 0.9503041, 0,
+                                 0,         0,         0,         1};
+    OCIO::MatrixTransformRcPtr t = OCIO::MatrixTransform::Create();
+    t->setMatrix(m);
+    return t;
+}
+
+/// The colour space of `config` that facet's pixels are in, and the config to look it up in:
+/// a space named (or aliased) as linear Rec.709, else one facet adds to a copy of the config,
+/// defined through the config's scene interchange role (ACES2065-1 or CIE XYZ D65), else one
+/// named "linear". Throws when the config has none of these.
+std::pair<OCIO::ConstConfigRcPtr, std::string> working_space(OCIO::ConstConfigRcPtr config,
+                                                             const std::string &path) {
+    auto usable = [](const OCIO::ConstColorSpaceRcPtr &cs) {
+        return cs && !cs->isData() && cs->getReferenceSpaceType() == OCIO::REFERENCE_SPACE_SCENE;
+    };
+    for (const char *name : k_rec709_names) {
+        OCIO::ConstColorSpaceRcPtr cs = config->getColorSpace(name);
+        if (usable(cs)) return {config, cs->getName()};
+    }
+    // Rec.709 -> the interchange space, then that space's own way to the config's reference.
+    auto through = [&](const char *role,
+                       OCIO::ConstTransformRcPtr to_interchange) -> OCIO::ConstConfigRcPtr {
+        if (!config->hasRole(role)) return nullptr;
+        OCIO::ConstColorSpaceRcPtr cs = config->getColorSpace(role);
+        if (!usable(cs)) return nullptr;
+        OCIO::GroupTransformRcPtr to_reference = OCIO::GroupTransform::Create();
+        to_reference->appendTransform(to_interchange->createEditableCopy());
+        if (OCIO::ConstTransformRcPtr t = cs->getTransform(OCIO::COLORSPACE_DIR_TO_REFERENCE)) {
+            to_reference->appendTransform(t->createEditableCopy());
+        } else if (OCIO::ConstTransformRcPtr f =
+                       cs->getTransform(OCIO::COLORSPACE_DIR_FROM_REFERENCE)) {
+            OCIO::TransformRcPtr inv = f->createEditableCopy();
+            inv->setDirection(
+                OCIO::CombineTransformDirections(inv->getDirection(), OCIO::TRANSFORM_DIR_INVERSE));
+            to_reference->appendTransform(inv);
+        }
+        OCIO::ColorSpaceRcPtr working = OCIO::ColorSpace::Create(OCIO::REFERENCE_SPACE_SCENE);
+        working->setName("facet working space (linear Rec.709)");
+        working->setEncoding("scene-linear");
+        working->setTransform(to_reference, OCIO::COLORSPACE_DIR_TO_REFERENCE);
+        OCIO::ConfigRcPtr copy = config->createEditableCopy();
+        copy->addColorSpace(working);
+        return copy;
+    };
+    OCIO::GroupTransformRcPtr to_aces = OCIO::GroupTransform::Create();
+    to_aces->appendTransform(rec709_to_xyz());
+    OCIO::BuiltinTransformRcPtr xyz_to_aces = OCIO::BuiltinTransform::Create();
+    xyz_to_aces->setStyle("UTILITY - ACES-AP0_to_CIE-XYZ-D65_BFD");
+    xyz_to_aces->setDirection(OCIO::TRANSFORM_DIR_INVERSE);
+    to_aces->appendTransform(xyz_to_aces);
+    if (auto copy = through("aces_interchange", to_aces))
+        return {copy, "facet working space (linear Rec.709)"};
+    if (auto copy = through("cie_xyz_d65_interchange", rec709_to_xyz()))
+        return {copy, "facet working space (linear Rec.709)"};
+    if (OCIO::ConstColorSpaceRcPtr cs = config->getColorSpace("linear"); usable(cs))
+        return {config, cs->getName()};
+    FACET_THROW("the OpenColorIO config \"{}\" does not say which of its colour spaces is "
+                "linear Rec.709 (sRGB primaries), the space facet renders in: name or alias one "
+                "\"lin_rec709\", or give the config an aces_interchange or "
+                "cie_xyz_d65_interchange role",
+                path);
+}
+
 /// CPU processor for (config, display, view, looks), created once per combination.
 OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayView &dv) {
     static std::mutex mutex;
@@ -95,9 +177,10 @@ OCIO::ConstCPUProcessorRcPtr display_processor(const DisplayView &dv) {
     auto it = cache.find(key);
     if (it != cache.end()) return it->second;
     try {
-        OCIO::ConstConfigRcPtr config = load_ocio_config(dv.config);
+        // facet's pixels are linear Rec.709, whatever the config's scene_linear role is.
+        auto [config, source] = working_space(load_ocio_config(dv.config), dv.config);
         OCIO::DisplayViewTransformRcPtr dvt = OCIO::DisplayViewTransform::Create();
-        dvt->setSrc(OCIO::ROLE_SCENE_LINEAR);
+        dvt->setSrc(source.c_str());
         dvt->setDisplay(dv.display.c_str());
         dvt->setView(dv.view.c_str());
         OCIO::ConstProcessorRcPtr proc;
@@ -381,6 +464,7 @@ DisplayView resolve_display_view(const ImageWriteOptions &opts) {
         if (!config->getLook(look.c_str()))
             FACET_THROW("the OpenColorIO config \"{}\" has no look \"{}\"; its looks: {}",
                         all.config, look, join_names(all.looks));
+    working_space(config, all.config); // refuses a config that cannot say where Rec.709 is
     return dv;
 }
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <array>
 #include <cmath>
 #include <csignal>
 #include <cstring>
@@ -703,4 +704,105 @@ TEST_F(ImageIO, FacetConfigHasAFilmicView) {
     EXPECT_GT(a18, 60);
     EXPECT_LT(a18, 118);
     EXPECT_EQ(code(aces, 0.f), 0);
+}
+
+namespace {
+
+/// A studio config whose scene_linear role is ACEScg, with a Rec.1886 (gamma 2.4) display and a
+/// view without tone mapping, from OpenColorIO's built-in transforms. `extra_spaces` are added to
+/// its colour spaces and `interchange` is the aces_interchange role line (or nothing).
+std::string acescg_config(const std::string &interchange, const std::string &extra_spaces = "") {
+    return R"(ocio_profile_version: 2.1
+search_path: ""
+strictparsing: true
+roles:
+  default: ACEScg
+  scene_linear: ACEScg
+  reference: ACES2065-1
+  data: Raw
+)" + interchange +
+           R"(
+file_rules:
+  - !<Rule> {name: Default, colorspace: default}
+displays:
+  Rec.1886:
+    - !<View> {name: Plain, view_transform: Un-tone-mapped, display_colorspace: Rec.1886 - Display}
+active_displays: [Rec.1886]
+active_views: [Plain]
+view_transforms:
+  - !<ViewTransform>
+    name: Un-tone-mapped
+    from_scene_reference: !<BuiltinTransform> {style: "UTILITY - ACES-AP0_to_CIE-XYZ-D65_BFD"}
+display_colorspaces:
+  - !<ColorSpace>
+    name: Rec.1886 - Display
+    isdata: false
+    from_display_reference: !<BuiltinTransform> {style: "DISPLAY - CIE-XYZ-D65_to_REC.1886-REC.709"}
+colorspaces:
+  - !<ColorSpace>
+    name: ACES2065-1
+    isdata: false
+    encoding: scene-linear
+  - !<ColorSpace>
+    name: ACEScg
+    isdata: false
+    encoding: scene-linear
+    to_scene_reference: !<BuiltinTransform> {style: "ACEScg_to_ACES2065-1"}
+  - !<ColorSpace>
+    name: Raw
+    isdata: true
+)" + extra_spaces;
+}
+
+std::array<int, 3> png_rgb(const std::string &file, const std::string &config) {
+    Image img(1, 1, 3);
+    img.data = {0.2f, 0.5f, 0.2f};
+    img.channel_names = {"R", "G", "B"};
+    ImageWriteOptions opts;
+    opts.ocio_config = config;
+    write_image(file, img, opts);
+    Image back = read_image(file);
+    std::array<int, 3> out;
+    for (int c = 0; c < 3; ++c) out[size_t(c)] = int(std::lround(back.at(0, 0, c) * 255.f));
+    return out;
+}
+
+} // namespace
+
+TEST_F(ImageIO, PngConvertsFromLinearRec709NotTheConfigsSceneLinear) {
+    // facet's pixels are linear Rec.709: under a config whose scene_linear is ACEScg they must be
+    // converted from Rec.709 (found through the aces_interchange role), not read as ACEScg,
+    // which gives (42, 198, 119).
+    const std::array<int, 3> expected{{130, 191, 130}}; // 255 x^(1/2.4)
+    auto write_config = [&](const std::string &name, const std::string &text) {
+        std::ofstream(path(name)) << text;
+        return path(name);
+    };
+    const std::string aces =
+        write_config("aces.ocio", acescg_config("  aces_interchange: ACES2065-1\n"));
+    EXPECT_EQ(png_rgb(path("aces.png"), aces), expected);
+
+    // A space named as linear Rec.709 serves without any interchange role.
+    const std::string named = write_config("named.ocio", acescg_config("", R"(  - !<ColorSpace>
+    name: Linear Rec.709 (sRGB)
+    aliases: [lin_rec709]
+    isdata: false
+    encoding: scene-linear
+    to_scene_reference: !<GroupTransform>
+      children:
+        - !<MatrixTransform> {matrix: [0.4124564, 0.3575761, 0.1804375, 0, 0.2126729, 0.7151522, 0.0721750, 0, 0.0193339, 0.1191920, 0.9503041, 0, 0, 0, 0, 1]}
+        - !<BuiltinTransform> {style: "UTILITY - ACES-AP0_to_CIE-XYZ-D65_BFD", direction: inverse}
+)"));
+    EXPECT_EQ(png_rgb(path("named.png"), named), expected);
+
+    // A config that cannot say which space is Rec.709 is refused, clearly, before any write.
+    const std::string bare = write_config("bare.ocio", acescg_config(""));
+    try {
+        png_rgb(path("bare.png"), bare);
+        ADD_FAILURE() << "a config without linear Rec.709 was accepted";
+    } catch (const Error &e) {
+        EXPECT_NE(std::string(e.what()).find("linear Rec.709"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("aces_interchange"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(path("bare.png")));
 }
