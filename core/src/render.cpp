@@ -250,6 +250,8 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
             !monitor_cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return finished; })) {
             if (stop.cancelled()) announce_stop();
             if (!announced) progress.update(work_done.load(), work_total, seconds_since(start));
+            if (opts.on_progress && work_total > 0)
+                opts.on_progress(double(work_done.load()) / double(work_total));
         }
     });
 
@@ -296,6 +298,8 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
         finished = true;
         if (run.cancelled) announce_stop();
         if (!announced) progress.update(work_done.load(), work_total, run.seconds, true);
+        if (opts.on_progress && work_total > 0)
+            opts.on_progress(double(work_done.load()) / double(work_total));
     }
     monitor_cv.notify_all();
     monitor.join();
@@ -599,6 +603,10 @@ static RenderResult render_all_passes(const Scene &scene, const Sensor &sensor,
     for (int i = 0; i < opts.pass_count; ++i) {
         RenderOptions part = opts;
         part.pass_index = i;
+        if (opts.on_progress) // the fraction of the whole, not of the part
+            part.on_progress = [&opts, i](double f) {
+                opts.on_progress((double(i) + f) / double(opts.pass_count));
+            };
         RenderResult r = render(scene, sensor, part);
         const std::vector<std::string> &names = r.image.channel_names;
         if (names.size() < 3 || names[0] != "R" || names[1] != "G" || names[2] != "B")

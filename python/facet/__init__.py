@@ -3,7 +3,8 @@
     import facet
     scene = facet.load_file("scenes/cornell-box/scene.xml", spp=64)
     image = facet.render(scene, seed=1)
-    pixels, channels = image          # float32 (height, width, channels), ["R", "G", "B", ...]
+    pixels = np.asarray(image)        # float32 (height, width, channels)
+    image.channels                    # ["R", "G", "B", ...]
     facet.write(image, "cornell.exr")
 
 Errors are ``facet.Error`` (a RuntimeError) whose message starts with the scene location
@@ -311,8 +312,9 @@ def load_dict(d, *, lenient=False, search_path=()):
 
 
 class Image(tuple):
-    """What ``render`` returns: a pair ``(pixels, channels)`` (so ``pixels, channels =
-    facet.render(...)`` works) that also carries ``metadata`` (the ``facet:`` attributes the CLI
+    """What ``render`` returns: an array-like (``np.asarray(image)`` is the float32 pixels of shape
+    (height, width, channels), named by ``image.channels``) that is also the pair ``(pixels,
+    channels)`` (so ``pixels, channels = facet.render(...)`` works) and carries ``metadata`` (the ``facet:`` attributes the CLI
     writes into an EXR), ``half`` (the film's component_format is float16) and ``window``:
     ``(x, y, full_width, full_height)``, where the pixels lie in the whole film (a crop's data
     window inside its display window)."""
@@ -346,6 +348,13 @@ class Image(tuple):
     def channels(self):
         return self[1]
 
+    def __array__(self, dtype=None, copy=None):
+        import numpy as np
+        pixels = self[0]
+        if dtype is not None and np.dtype(dtype) != pixels.dtype:
+            return pixels.astype(dtype)
+        return pixels.copy() if copy else pixels
+
     @property
     def shape(self):
         return self[0].shape
@@ -355,7 +364,8 @@ class Image(tuple):
         return f"<facet.Image {w}x{h} {self[1]}>"
 
 
-def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_index=None, passes=1):
+def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_index=None, passes=1,
+           progress=None):
     """Renders ``sensor`` of ``scene`` with its integrator and returns an ``Image``: a NumPy
     float32 array of shape (height, width, channels) and the channel names (R, G, B, then A and
     the AOVs when the scene asks for them). ``spp`` overrides the sampler's sample_count, ``seed``
@@ -367,12 +377,21 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
     of n x spp samples per pixel (``--pass``/``--passes`` of the CLI), with the raw sums of its
     pixels as extra ``facet.*`` channels. ``facet.merge`` puts such parts back together.
     ``passes=n`` without ``pass_index`` renders all n parts here, combined as their merge
-    combines them (bit-identical to it)."""
+    combines them (bit-identical to it).
+
+    ``progress`` is a callable, called on this thread with the fraction done (0 to 1, rising,
+    1 at the end; an exception it raises stops the render and is raised here), or a bool: draw
+    the CLI's progress bar on stderr. None (the default) draws it when stderr is a terminal."""
+    if progress is None:
+        import sys
+        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    elif not callable(progress):
+        progress = bool(progress)
     if pass_index is None:
         pass_index = -1 if int(passes) > 1 else 0
     pixels, channels, metadata, half, window = _facet.render(
         scene, spp, int(seed), int(sensor), threads,
-        None if crop is None else [int(v) for v in crop], int(pass_index), int(passes))
+        None if crop is None else [int(v) for v in crop], int(pass_index), int(passes), progress)
     return Image(pixels, channels, metadata, half, window)
 
 
@@ -400,11 +419,15 @@ def merge(parts, output=None):
     return image
 
 
-def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="", view="Standard"):
+def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="", display="",
+          view="", look=""):
     """Writes an image through facet's writer (the one ``facet render`` uses): ``.exr`` keeps every
     channel (float16 when the film says so, else float32), ``.hdr``/``.pfm`` are linear, ``.png``
     and ``.jpg`` go through the OpenColorIO display transform. ``image`` is what ``render``
     returns, a ``(pixels, channels)`` pair or an array (channels then default to R, G, B, A or Y).
+    ``ocio_config``, ``display``, ``view`` and ``look`` are the CLI's ``--ocio-config``,
+    ``--display``, ``--view`` and ``--look`` (empty: $OCIO or facet's config, its default display,
+    that display's default view, the view's own looks).
     """
     import numpy as np
 
@@ -430,7 +453,7 @@ def write(image, path, channels=None, *, half=None, metadata=None, ocio_config="
     if window is None:
         window = (0, 0, pixels.shape[1], pixels.shape[0])
     _facet.write(pixels, list(names), _os.fspath(path), film_half if half is None else bool(half), meta,
-                 ocio_config, view, list(window))
+                 _os.fspath(ocio_config), display, view, look, list(window))
 
 
 def read(path):

@@ -28,6 +28,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <iterator>
 #include <mutex>
@@ -120,7 +121,8 @@ Image from_array(const py::array_t<float, py::array::c_style | py::array::forcec
 /// Runs `fn` on a thread of its own while this thread waits with the GIL released, checking for
 /// Python signals (Ctrl-C) every 50 ms when it is the main thread. On a signal, `cancel` is set,
 /// the render is waited for and the Python exception (KeyboardInterrupt) is raised.
-template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel, Fn fn) {
+template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel, Fn fn,
+                                              const std::function<void()> &poll = nullptr) {
     using R = decltype(fn());
     std::packaged_task<R()> task(std::move(fn));
     std::future<R> future = task.get_future();
@@ -134,6 +136,15 @@ template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel, Fn fn) 
             ready = future.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
         }
         if (ready) break;
+        if (poll && !interrupted) {
+            try {
+                poll(); // the progress callback, with the GIL
+            } catch (py::error_already_set &e) {
+                interrupted = true; // the callback raised: stop, and raise that
+                pending.emplace(std::move(e));
+                cancel = true;
+            }
+        }
         if (!interrupted && PyErr_CheckSignals() != 0) {
             interrupted = true;
             pending.emplace(); // takes the KeyboardInterrupt
@@ -159,7 +170,7 @@ py::tuple window_of(const Image &img) {
 /// Returns (pixels, channel names, metadata, half, window).
 py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int sensor_index,
                     std::optional<int> threads, std::optional<std::array<int, 4>> crop,
-                    int pass_index, int pass_count) {
+                    int pass_index, int pass_count, const py::object &progress) {
     const auto &sensors = s.scene->sensors();
     if (sensor_index < 0 || size_t(sensor_index) >= sensors.size())
         FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor_index,
@@ -174,7 +185,21 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     opts.threads = threads ? *threads : 0;
     opts.seed = seed;
     opts.spp = spp ? *spp : 0;
-    opts.progress = false;
+    // progress: True draws the CLI's bar (on a terminal), a callable gets the fraction done.
+    const bool callback = !progress.is_none() && PyCallable_Check(progress.ptr());
+    opts.progress = !callback && !progress.is_none() && progress.cast<bool>();
+    auto fraction = std::make_shared<std::atomic<double>>(-1.0);
+    if (callback) opts.on_progress = [fraction](double f) { fraction->store(f); };
+    double reported = -1.0;
+    std::function<void()> poll;
+    if (callback)
+        poll = [&]() {
+            const double f = fraction->load();
+            if (f > reported) {
+                reported = f;
+                progress(f);
+            }
+        };
     if (crop) opts.crop = *crop;
     opts.pass_index = pass_index;
     opts.pass_count = pass_count;
@@ -183,10 +208,14 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
 
     std::shared_ptr<Scene> keep = s.scene; // alive while the render thread runs
     std::shared_ptr<std::mutex> mutex = s.render_mutex;
-    RenderResult result = run_interruptible(cancel, [keep, mutex, lock, &sensor, opts]() {
-        std::lock_guard<std::mutex> lock(*mutex);
-        return render(*keep, sensor, opts);
-    });
+    RenderResult result = run_interruptible(
+        cancel,
+        [keep, mutex, lock, &sensor, opts]() {
+            std::lock_guard<std::mutex> lock(*mutex);
+            return render(*keep, sensor, opts);
+        },
+        poll);
+    if (callback && reported < 1.0 && !result.cancelled) progress(1.0);
 
     // The attributes `facet render` writes, so that parts from here and from the CLI merge.
     std::map<std::string, std::string> meta = render_metadata(result);
@@ -204,7 +233,8 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
 void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast> &pixels,
               const std::vector<std::string> &channels, const std::string &path, bool half,
               const std::map<std::string, std::string> &metadata, const std::string &ocio_config,
-              const std::string &view, const std::array<int, 4> &window) {
+              const std::string &display, const std::string &view, const std::string &looks,
+              const std::array<int, 4> &window) {
     Image img = from_array(pixels, channels);
     img.x = window[0];
     img.y = window[1];
@@ -214,7 +244,9 @@ void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast
     opts.half = half;
     opts.metadata = metadata;
     opts.ocio_config = ocio_config;
+    opts.display = display;
     opts.view = view;
+    opts.looks = looks;
     py::gil_scoped_release release;
     write_image(path, img, opts);
 }
@@ -562,10 +594,10 @@ PYBIND11_MODULE(_facet, m) {
           py::arg("search_path"));
     m.def("render", &render_py, py::arg("scene"), py::arg("spp"), py::arg("seed"),
           py::arg("sensor"), py::arg("threads"), py::arg("crop"), py::arg("pass_index"),
-          py::arg("pass_count"));
+          py::arg("pass_count"), py::arg("progress"));
     m.def("write", &write_py, py::arg("pixels"), py::arg("channels"), py::arg("path"),
-          py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("view"),
-          py::arg("window"));
+          py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("display"),
+          py::arg("view"), py::arg("looks"), py::arg("window"));
     m.def("read", &read_py, py::arg("path"));
     m.def("merge", &merge_py, py::arg("parts"));
     m.def("plugins", &plugins_py);

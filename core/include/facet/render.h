@@ -48,6 +48,9 @@ struct RenderOptions {
     /// loading the image library for the write then, not before: while the dynamic loader loads
     /// a library, creating a thread waits for it, and the render creates its threads first).
     std::function<void()> on_first_block;
+    /// Called with the fraction of the work done (0 to 1), from a monitor thread, about every
+    /// 50 ms while the render runs and once with the final fraction (the Python `progress=`).
+    std::function<void(double)> on_progress;
 };
 
 /// The samples per pixel a render takes: sample indices [first, first + count) of each pixel of
