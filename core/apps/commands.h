@@ -21,6 +21,8 @@ int compare_main(int argc, char **argv);
 int merge_main(int argc, char **argv);
 /// `facet colors` (colors_cmd.cpp): the OpenColorIO displays, views and looks.
 int colors_main(int argc, char **argv);
+/// `facet info` (info_cmd.cpp): what a scene declares, from parsing it alone.
+int info_main(int argc, char **argv);
 
 /// `facet chi2` (chi2_cmd.cpp) and `facet new-plugin` (new_plugin_cmd.cpp).
 int chi2_main(int argc, char **argv);

@@ -38,6 +38,7 @@ Usage:
                                        chi-square test of a plugin's sampling against its pdf
   facet new-plugin ...                 start a plugin of your own from the template
   facet colors                         the OpenColorIO displays, views and looks for 8-bit outputs
+  facet info <scene.xml>               film size, spp, sensors, plugins (parses, does not load)
 
 Run `facet <command> --help` for the options of a command; `facet --version` prints the
 version.
@@ -92,7 +93,7 @@ int run(int argc, char **argv) {
     const Command commands[] = {
         {"render", render_main},   {"plugins", plugins_main}, {"bench", bench_main},
         {"compare", compare_main}, {"chi2", chi2_main},       {"new-plugin", new_plugin_main},
-        {"merge", merge_main},     {"colors", colors_main},
+        {"merge", merge_main},     {"colors", colors_main},   {"info", info_main},
     };
     for (const Command &cmd : commands) {
         if (first == cmd.name) return cmd.run(argc - 1, argv + 1);
@@ -104,10 +105,11 @@ int run(int argc, char **argv) {
         argv[0] = const_cast<char *>("render");
         return render_main(argc, argv);
     }
-    throw facet::Error(fmt::format("unknown command '{}' (expected render, plugins, bench, "
-                                   "merge, compare, chi2, new-plugin, colors or a scene file; see "
-                                   "facet --help)",
-                                   first));
+    throw facet::Error(
+        fmt::format("unknown command '{}' (expected render, plugins, bench, "
+                    "merge, compare, chi2, new-plugin, colors, info or a scene file; see "
+                    "facet --help)",
+                    first));
 }
 
 } // namespace

@@ -34,6 +34,7 @@
 #include <limits>
 #include <map>
 #include <pugixml.hpp>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
@@ -364,6 +365,76 @@ public:
         SourceFile *src = add_source("string", fs::path(), "", xml);
         ResolverGuard guard;
         return load(src, require_scene);
+    }
+
+    SceneInfo info_file(const std::string &path) {
+        bool ok = false;
+        std::string text = read_text_file(path, ok);
+        if (!ok) FACET_THROW("could not open XML file \"{}\"", path);
+        fs::path dir = fs::path(path).parent_path();
+        SourceFile *src = add_source(path, dir, canonical_name(path), std::move(text));
+        ResolverGuard guard;
+        file_resolver().prepend(
+            fs::absolute(dir.empty() ? fs::path(".") : dir).lexically_normal().string());
+        for (const std::string &d : m_opts.search_path) file_resolver().append(d);
+        size_t root = parse_document(src, NoNode, "");
+        if (m_nodes[root].kind != ObjectType::Scene)
+            fail(m_nodes[root].location, fmt::format("expected a <scene> root element, found <{}>",
+                                                     object_kind_name(m_nodes[root].kind)));
+        check_unused_parameters(src->name);
+        apply_aliases();
+        resolve_references();
+        check_cycles(root);
+
+        SceneInfo info;
+        std::map<std::string, std::set<std::string>> plugins;
+        for (const ObjectNode &node : m_nodes)
+            if (node.kind != ObjectType::Scene)
+                plugins[object_kind_name(node.kind)].insert(node.plugin);
+        auto child_of = [&](const ObjectNode &node, ObjectType kind) -> const ObjectNode * {
+            for (const Entry &e : node.entries)
+                if (e.child != NoNode && m_nodes[e.child].kind == kind) return &m_nodes[e.child];
+            return nullptr;
+        };
+        auto integer = [](const ObjectNode &node, const char *name, int fallback) {
+            for (const Entry &e : node.entries)
+                if (e.kind == Entry::Kind::Value && e.name == name)
+                    if (const int64_t *v = std::get_if<int64_t>(&e.value))
+                        return int(std::clamp<int64_t>(*v, 0, std::numeric_limits<int>::max()));
+            return fallback;
+        };
+        for (const Entry &e : m_nodes[root].entries) {
+            if (e.child == NoNode) continue;
+            const ObjectNode &node = m_nodes[e.child];
+            if (node.kind == ObjectType::Integrator) info.integrator = node.plugin;
+            if (node.kind != ObjectType::Sensor) continue;
+            SceneInfo::SensorInfo s;
+            s.plugin = node.plugin;
+            s.film = s.sampler = "";
+            if (const ObjectNode *film = child_of(node, ObjectType::Film)) {
+                s.film = film->plugin;
+                s.width = integer(*film, "width", s.width);
+                s.height = integer(*film, "height", s.height);
+            }
+            if (const ObjectNode *sampler = child_of(node, ObjectType::Sampler)) {
+                s.sampler = sampler->plugin;
+                s.spp = integer(*sampler, "sample_count", s.spp);
+            }
+            info.sensors.push_back(s);
+        }
+        if (info.sensors.empty()) info.sensors.push_back({"perspective", "", "", 768, 576, 4});
+        for (SceneInfo::SensorInfo &s : info.sensors) {
+            // The defaults the sensor creates (hdrfilm, independent) are plugins the render uses.
+            if (s.film.empty()) s.film = "hdrfilm";
+            if (s.sampler.empty()) s.sampler = "independent";
+            plugins["film"].insert(s.film);
+            plugins["sampler"].insert(s.sampler);
+            plugins["sensor"].insert(s.plugin);
+        }
+        plugins["integrator"].insert(info.integrator);
+        for (const auto &[kind, names] : plugins)
+            info.plugins[kind].assign(names.begin(), names.end());
+        return info;
     }
 
 private:
@@ -1184,6 +1255,10 @@ std::shared_ptr<Object> load_string(const std::string &xml, const LoadOptions &o
 
 std::shared_ptr<Scene> load_scene(const std::string &path, const LoadOptions &opts) {
     return std::static_pointer_cast<Scene>(Loader(opts).load_file(path, true));
+}
+
+SceneInfo scene_info(const std::string &path, const LoadOptions &opts) {
+    return Loader(opts).info_file(path);
 }
 
 } // namespace facet

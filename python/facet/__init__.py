@@ -28,6 +28,7 @@ __all__ = [
     "load_dict",
     "traverse",
     "SceneParameters",
+    "scene_info",
     "render",
     "write",
     "read",
@@ -60,6 +61,15 @@ def load_file(path, *, lenient=False, search_path=(), **params):
     of ``facet render``): ``facet.load_file("scene.xml", spp=64, res=256)``. ``lenient`` turns
     unused parameters into warnings, ``search_path`` adds folders for meshes and textures."""
     return _facet.load_file(_os.fspath(path), _params(params), lenient, [_os.fspath(p) for p in search_path])
+
+
+def scene_info(path, *, lenient=False, search_path=(), **params):
+    """What a scene file declares, from parsing it alone (no plugin created, no mesh read, no BVH
+    built; ``facet info`` on the command line): a dict with ``sensors`` (each a dict of
+    ``plugin``, ``film``, ``sampler``, ``film_size`` (width, height) and ``spp``),
+    ``integrator``, ``plugins`` (names by kind) and ``mode``."""
+    return _facet.scene_info(_os.fspath(path), _params(params), lenient,
+                             [_os.fspath(p) for p in search_path])
 
 
 def load_string(xml, *, lenient=False, search_path=(), **params):
@@ -340,6 +350,13 @@ class Image(tuple):
         return cls(part["pixels"], part["channels"], part["metadata"], part["half"],
                    part["window"])
 
+    def __array__(self, dtype=None, copy=None):
+        import numpy as np
+        pixels = self[0]
+        if dtype is not None and np.dtype(dtype) != pixels.dtype:
+            return pixels.astype(dtype)
+        return pixels.copy() if copy else pixels
+
     @property
     def pixels(self):
         return self[0]
@@ -347,13 +364,6 @@ class Image(tuple):
     @property
     def channels(self):
         return self[1]
-
-    def __array__(self, dtype=None, copy=None):
-        import numpy as np
-        pixels = self[0]
-        if dtype is not None and np.dtype(dtype) != pixels.dtype:
-            return pixels.astype(dtype)
-        return pixels.copy() if copy else pixels
 
     @property
     def shape(self):

@@ -48,13 +48,29 @@ def _scene(path, params):
     return scene
 
 
+def _worker_threads():
+    """The threads of the Dask worker this task runs on (its ``nthreads``, the
+    ``threads_per_worker`` of a LocalCluster), or None outside a worker (every core)."""
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+        state = getattr(worker, "state", None)  # distributed >= 2022.11 keeps it there
+        n = int(state.nthreads if state is not None else worker.nthreads)
+    except Exception:
+        return None
+    return n if n > 0 else None
+
+
 def render_part(scene_path, params, crop, pass_index, passes, spp=None, seed=0, sensor=0,
                 threads=None):
     """One task: renders window ``crop`` of pass ``pass_index`` of ``passes`` and returns it as a
     plain dict (what ``facet.merge`` takes back with ``facet.Image.from_part``)."""
     scene = _scene(scene_path, params)
+    if threads is None:
+        threads = _worker_threads()
     image = facet.render(scene, spp=spp, seed=seed, sensor=sensor, threads=threads, crop=crop,
-                         pass_index=pass_index, passes=passes)
+                         pass_index=pass_index, passes=passes, progress=False)
     return image.to_part()
 
 
@@ -62,13 +78,17 @@ def render(scene_path, client, tiles=(2, 2), passes=1, spp=None, seed=0, sensor=
            params=None, output=None):
     """Renders ``scene_path`` on the workers of the Dask ``client`` and returns the merged
     ``facet.Image``; writes it to ``output`` too when given. ``params`` are the scene's ``$name``
-    values (``-D``), ``threads`` the threads of each task (default: all of its worker's cores)."""
+    values (``-D``), ``threads`` the threads of each task (default: its worker's ``nthreads``,
+    the ``threads_per_worker`` of a LocalCluster)."""
     scene_path = os.path.abspath(os.fspath(scene_path))
     params = {k: facet._param_value(k, v) for k, v in (params or {}).items()}
     if int(passes) < 1:
         raise ValueError(f"passes={passes!r}: expected at least 1")
-    # The film size, from a local load of the scene (the client checks the scene loads at all).
-    width, height = facet.load_file(scene_path, **params).film_size(sensor)
+    # The film size, from parsing the scene (no plugin, mesh or BVH on the client).
+    sensors = facet.scene_info(scene_path, **params)["sensors"]
+    if not 0 <= int(sensor) < len(sensors):
+        raise facet.Error(f"sensor {sensor}: the scene has {len(sensors)} sensors")
+    width, height = sensors[int(sensor)]["film_size"]
     windows = tile_windows(width, height, tiles)
     futures = [
         client.submit(render_part, scene_path, params, crop, p, int(passes), spp, seed, sensor,

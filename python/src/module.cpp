@@ -599,6 +599,24 @@ PYBIND11_MODULE(_facet, m) {
           py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("display"),
           py::arg("view"), py::arg("looks"), py::arg("window"));
     m.def("read", &read_py, py::arg("path"));
+    m.def("scene_info",
+          [](const std::string &path, const std::map<std::string, std::string> &params,
+             bool lenient, const std::vector<std::string> &search_path) {
+              if (!fs::exists(path)) FACET_THROW("scene file \"{}\" does not exist", path);
+              SceneInfo info;
+              {
+                  py::gil_scoped_release release;
+                  info = scene_info(path, load_options(params, lenient, search_path));
+              }
+              py::list sensors;
+              for (const auto &s : info.sensors)
+                  sensors.append(py::dict(py::arg("plugin") = s.plugin, py::arg("film") = s.film,
+                                          py::arg("sampler") = s.sampler,
+                                          py::arg("film_size") = py::make_tuple(s.width, s.height),
+                                          py::arg("spp") = s.spp));
+              return py::dict(py::arg("sensors") = sensors, py::arg("integrator") = info.integrator,
+                              py::arg("plugins") = info.plugins, py::arg("mode") = "scalar_rgb");
+          });
     m.def("merge", &merge_py, py::arg("parts"));
     m.def("plugins", &plugins_py);
     m.def("add_plugin_dir",

@@ -103,3 +103,81 @@ def test_write_takes_display_view_and_look(tmp_path):
     # facet's own config still defaults to its sRGB display and Standard view.
     facet.write(img, tmp_path / "own.png")
     assert 0.5 < facet.read(tmp_path / "own.png")[0].mean() < 0.6
+
+
+def test_scene_info_parses_without_loading(cornell, tmp_path):
+    info = facet.scene_info(cornell, res=100)
+    assert info["sensors"][0]["film_size"] == (100, 100)
+    assert info["sensors"][0]["spp"] == 64
+    assert info["mode"] == "scalar_rgb"
+    assert "diffuse" in info["plugins"]["bsdf"]
+    # A mesh that does not exist is not read: parsing alone does not need it.
+    xml = tmp_path / "mesh.xml"
+    xml.write_text('<scene version="3.0.0"><shape type="ply"><string name="filename" '
+                   'value="missing.ply"/></shape><sensor type="thinlens"><film type="hdrfilm">'
+                   '<integer name="width" value="$w"/></film></sensor></scene>')
+    info = facet.scene_info(xml, w=33)
+    assert info["sensors"] == [dict(plugin="thinlens", film="hdrfilm", sampler="independent",
+                                    film_size=(33, 576), spp=4)]
+    with pytest.raises(facet.Error):
+        facet.load_file(xml, w=33)
+
+
+def _readme_block(after):
+    """The first ```python block after the line `after` in README.md."""
+    text = (SOURCE_DIR / "README.md").read_text()
+    start = text.index(after)
+    m = re.search(r"```python\n(.*?)```", text[start:], re.S)
+    assert m, f"no python block after {after!r}"
+    return m.group(1)
+
+
+def test_readme_dask_example_runs_as_a_script(tmp_path):
+    """Saved as a file and run, the README's example finishes (worker processes import the main
+    module: without the __main__ guard each would start a cluster of its own)."""
+    pytest.importorskip("distributed")
+    script = tmp_path / "dask_example.py"
+    script.write_text(_readme_block("### Dask"))
+    assert 'if __name__ == "__main__":' in script.read_text()
+    (tmp_path / "scenes").symlink_to(SOURCE_DIR / "scenes")
+    subprocess.run([sys.executable, str(script)], cwd=tmp_path, check=True, timeout=300)
+    pixels, channels = facet.read(tmp_path / "cornell.exr")
+    assert channels == ["R", "G", "B"] and pixels.mean() > 0.05
+
+
+def test_dask_tasks_take_the_workers_threads(cornell, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    import facet.distributed
+
+    asked = []
+    real = facet.render
+
+    def spy(*args, **kwargs):
+        asked.append(kwargs.get("threads"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(facet, "render", spy)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None, silence_logs=40) as cluster, \
+            distributed.Client(cluster) as client:
+        facet.distributed.render(cornell, client, tiles=(2, 1), params=SMALL)
+        assert asked == [1, 1]
+        asked.clear()
+        facet.distributed.render(cornell, client, tiles=(2, 1), params=SMALL, threads=2)
+        assert asked == [2, 2]
+    assert facet.distributed._worker_threads() is None  # outside a worker: every core
+
+
+def test_cli_info_prints_what_the_scene_declares(cornell, facet_cli, cli_env):
+    out = subprocess.run([str(facet_cli), "info", str(cornell), "-D", "res=100"], env=cli_env,
+                         check=True, capture_output=True, text=True).stdout
+    assert "mode: scalar_rgb" in out
+    assert "film: 100 x 100" in out
+    assert "spp: 64" in out
+    assert re.search(r"bsdf: .*diffuse", out), out
+    size = subprocess.run([str(facet_cli), "info", str(cornell), "--film-size", "-D", "res=40"],
+                          env=cli_env, check=True, capture_output=True, text=True).stdout
+    assert size == "40 40\n"
+    bad = subprocess.run([str(facet_cli), "info", str(cornell), "-D", "rez=4"], env=cli_env,
+                         capture_output=True, text=True)
+    assert bad.returncode != 0 and "rez" in bad.stderr

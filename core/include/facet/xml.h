@@ -27,4 +27,20 @@ std::shared_ptr<Object> load_string(const std::string &xml, const LoadOptions &o
 /// load_file() that requires a <scene> root.
 std::shared_ptr<Scene> load_scene(const std::string &path, const LoadOptions &opts = {});
 
+/// What a scene file declares, read by parsing it (with its includes, defaults and `$name`
+/// values) without creating any plugin: no mesh or texture is read, no BVH built.
+struct SceneInfo {
+    struct SensorInfo {
+        std::string plugin, film, sampler;
+        int width = 768, height = 576; ///< the film's full size (its defaults when not given)
+        int spp = 4;                   ///< the sampler's sample_count
+    };
+    std::vector<SensorInfo> sensors; ///< in declaration order; a default one when none is declared
+    std::string integrator = "path";
+    /// Every plugin the scene names, by kind ("bsdf", "shape", ...), sorted, each once.
+    std::map<std::string, std::vector<std::string>> plugins;
+};
+/// Throws the errors load_scene() would give for the file's XML itself (not those of plugins).
+SceneInfo scene_info(const std::string &path, const LoadOptions &opts = {});
+
 } // namespace facet
