@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include <facet/logger.h>
+#include <facet/plugin.h>
 
 #include <CLI/CLI.hpp>
 #include <OpenImageIO/oiioversion.h>
@@ -10,6 +11,7 @@
 #include <fmt/format.h>
 #include <tbb/version.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -128,7 +130,22 @@ int parse(CLI::App &app, int argc, char **argv) {
         std::fputs(app.help("", CLI::AppFormatMode::All).c_str(), stdout);
         return 0;
     } catch (const CLI::ParseError &e) {
-        throw facet::Error(fmt::format("{} (see {} --help)", e.what(), app.get_name()));
+        // A misspelt option: the nearest one the command has.
+        std::vector<std::string> names;
+        for (const CLI::Option *opt : app.get_options()) {
+            for (const std::string &l : opt->get_lnames()) names.push_back("--" + l);
+            for (const std::string &n : opt->get_snames()) names.push_back("-" + n);
+        }
+        std::string hint;
+        for (int i = 1; i < argc && hint.empty(); ++i) {
+            std::string arg = argv[i];
+            if (arg.size() < 3 || arg.compare(0, 2, "--") != 0) continue;
+            arg = arg.substr(0, arg.find('='));
+            if (std::find(names.begin(), names.end(), arg) != names.end()) continue;
+            std::string close = facet::closest_name(arg, names);
+            if (!close.empty()) hint = fmt::format("; did you mean \"{}\"?", close);
+        }
+        throw facet::Error(fmt::format("{}{} (see {} --help)", e.what(), hint, app.get_name()));
     }
     return -1;
 }

@@ -1094,9 +1094,16 @@ private:
     // -- Resolution -----------------------------------------------------------------------------
 
     void check_unused_parameters(const std::string &file) {
-        std::vector<std::string> unused;
+        std::vector<std::string> unused, known;
         for (const auto &[key, p] : m_params)
-            if (p.from_options && !p.used) unused.push_back("\"" + key + "\"");
+            if (!p.from_options || p.used) known.push_back(key);
+        for (const auto &[key, p] : m_params) {
+            if (!p.from_options || p.used) continue;
+            // A misspelt -D key: the nearest name the scene does use.
+            std::string close = closest_name(key, known);
+            unused.push_back("\"" + key + "\"" +
+                             (close.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", close)));
+        }
         if (unused.empty()) return;
         std::string list;
         for (size_t i = 0; i < unused.size(); ++i) list += (i ? ", " : "") + unused[i];

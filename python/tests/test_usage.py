@@ -181,3 +181,17 @@ def test_cli_info_prints_what_the_scene_declares(cornell, facet_cli, cli_env):
     bad = subprocess.run([str(facet_cli), "info", str(cornell), "-D", "rez=4"], env=cli_env,
                          capture_output=True, text=True)
     assert bad.returncode != 0 and "rez" in bad.stderr
+
+
+def test_cli_suggests_the_nearest_define_and_option(cornell, facet_cli, cli_env, tmp_path):
+    def error(*args):
+        r = subprocess.run([str(facet_cli), *args], env=cli_env, capture_output=True, text=True)
+        assert r.returncode != 0
+        return r.stderr
+
+    msg = error("render", str(cornell), "-D", "rez=4", "-o", str(tmp_path / "x.exr"))
+    assert 'unused parameter "rez" (did you mean "res"?)' in msg, msg
+    msg = error("render", str(cornell), "--seeed", "3", "-o", str(tmp_path / "x.exr"))
+    assert 'did you mean "--seed"?' in msg, msg
+    msg = error("info", str(cornell), "--film-sise")
+    assert 'did you mean "--film-size"?' in msg, msg
