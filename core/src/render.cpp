@@ -8,6 +8,7 @@
 #include <facet/scene.h>
 #include <facet/sensor.h>
 
+#include <sys/ioctl.h>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -17,6 +18,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -62,18 +64,28 @@ public:
         if (!force && elapsed - m_last < 0.5) return;
         m_last = elapsed;
         const double frac = double(done) / double(total);
-        constexpr int width = 40;
-        const int filled = int(frac * width + 0.5);
-        std::string bar(size_t(filled), '=');
-        bar.append(size_t(width - filled), ' ');
         std::string eta = done > 0 && done < total
                               ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac)
                               : "";
-        std::string line = fmt::format("\rRendering [{}] {:3d}% ({:.1f}s{})", bar,
-                                       int(frac * 100.0), elapsed, eta);
-        // Pad to clear what a longer earlier line left behind.
-        if (line.size() < m_width) line.append(m_width - line.size(), ' ');
-        m_width = line.size();
+        const std::string tail =
+            fmt::format(" {:3d}% ({:.1f}s{})", int(frac * 100.0), elapsed, eta);
+        // The line fits the terminal (one column spare: a full line would wrap on some
+        // terminals): the bar shrinks, then goes, then the line is cut.
+        const size_t columns = terminal_columns() - 1;
+        const size_t room = columns > tail.size() + 12 ? columns - tail.size() - 12 : 0;
+        const size_t width = std::min<size_t>(40, room);
+        std::string line = "Rendering";
+        if (width >= 5) {
+            const size_t filled = std::min(width, size_t(frac * double(width) + 0.5));
+            line += " [" + std::string(filled, '=') + std::string(width - filled, ' ') + "]";
+        }
+        line += tail;
+        if (line.size() > columns) line.resize(columns);
+        // Pad to clear what a longer earlier line left behind (within the terminal).
+        const size_t drawn = line.size();
+        if (drawn < m_width) line.append(m_width - drawn, ' ');
+        m_width = drawn;
+        line.insert(0, "\r");
         std::fputs(line.c_str(), stderr);
         std::fflush(stderr);
         m_drawn = true;
@@ -84,6 +96,16 @@ public:
     bool drawn() const { return m_drawn; }
 
 private:
+    /// Columns of the terminal on stderr ($COLUMNS, else 80, when it does not say).
+    static size_t terminal_columns() {
+        struct winsize ws {};
+        if (::ioctl(2, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0)
+            return std::max<size_t>(ws.ws_col, 2);
+        if (const char *c = std::getenv("COLUMNS"))
+            if (int n = std::atoi(c); n > 1) return size_t(n);
+        return 80;
+    }
+
     bool m_enabled;
     bool m_drawn = false;
     double m_last = -1.0;

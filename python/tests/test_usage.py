@@ -183,6 +183,39 @@ def test_cli_info_prints_what_the_scene_declares(cornell, facet_cli, cli_env):
     assert bad.returncode != 0 and "rez" in bad.stderr
 
 
+@pytest.mark.parametrize("columns", [30, 50, 69, 120])
+def test_cli_progress_line_fits_the_terminal(cornell, facet_cli, cli_env, tmp_path, columns):
+    import fcntl
+    import struct
+    import termios
+
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, columns, 0, 0))
+    cmd = [str(facet_cli), "render", str(cornell), "-D", "res=64", "-D", "spp=16", "-t", "1",
+           "-o", str(tmp_path / "x.exr")]
+    proc = subprocess.Popen(cmd, stderr=slave, stdout=subprocess.DEVNULL, env=cli_env)
+    os.close(slave)
+    out = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        out += chunk
+    assert proc.wait(timeout=120) == 0
+    os.close(master)
+    text = out.decode()
+    frames = [f for line in text.split("\n") for f in line.split("\r") if "Rendering" in f]
+    assert frames, text
+    for f in frames:
+        assert len(f.rstrip("\r\n")) < columns, (columns, f)
+    assert any("100%" in f for f in frames), frames
+    if columns >= 69:
+        assert any("[" in f for f in frames)  # room for a bar
+
+
 def test_cli_suggests_the_nearest_define_and_option(cornell, facet_cli, cli_env, tmp_path):
     def error(*args):
         r = subprocess.run([str(facet_cli), *args], env=cli_env, capture_output=True, text=True)
