@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -44,8 +45,24 @@ ObjectType kind_from_word(std::string word) {
 }
 
 struct Entry {
-    std::string name, description;
+    std::string name, description, file; ///< file: set when not one of facet's own plugins
 };
+
+/// The library that serves `name` (the first on the search path) when it is not in facet's own
+/// plugin folder (the search path's last), with " (shadows the built-in)" when that has one too.
+std::string user_file(const std::string &name) {
+    const std::vector<std::string> path = PluginRegistry::instance().search_path();
+    if (path.empty()) return "";
+    std::error_code ec;
+    for (size_t i = 0; i + 1 < path.size(); ++i) {
+        const std::filesystem::path p = std::filesystem::path(path[i]) / (name + ".so");
+        if (!std::filesystem::is_regular_file(p, ec)) continue;
+        const bool shadows = std::filesystem::is_regular_file(
+            std::filesystem::path(path.back()) / (name + ".so"), ec);
+        return p.string() + (shadows ? " (shadows the built-in)" : "");
+    }
+    return "";
+}
 
 /// Loads every plugin on the search path once; one that fails is listed with its error.
 std::map<ObjectType, std::vector<Entry>> collect(std::vector<std::string> &broken) {
@@ -54,7 +71,8 @@ std::map<ObjectType, std::vector<Entry>> collect(std::vector<std::string> &broke
     for (const std::string &name : registry.available()) {
         try {
             const PluginDescriptor &desc = registry.descriptor(name);
-            by_kind[desc.kind].push_back({name, desc.description ? desc.description : ""});
+            by_kind[desc.kind].push_back(
+                {name, desc.description ? desc.description : "", user_file(name)});
         } catch (const std::exception &e) {
             broken.push_back(fmt::format("{}: {}", name, e.what()));
         }
@@ -66,7 +84,9 @@ void print_kind(ObjectType kind, const std::vector<Entry> &entries) {
     size_t width = 0;
     for (const Entry &e : entries) width = std::max(width, e.name.size());
     fmt::print("{} ({}):\n", object_type_folder(kind), object_type_name(kind));
-    for (const Entry &e : entries) fmt::print("  {:<{}}  {}\n", e.name, width, e.description);
+    for (const Entry &e : entries)
+        fmt::print("  {:<{}}  {}{}\n", e.name, width, e.description,
+                   e.file.empty() ? "" : " [" + e.file + "]");
 }
 
 } // namespace
@@ -103,8 +123,10 @@ int plugins_main(int argc, char **argv) {
         std::string doc = desc.doc ? desc.doc : "";
         doc.erase(0, doc.find_first_not_of("\n"));
         doc.erase(doc.find_last_not_of("\n") + 1);
-        fmt::print("{} ({}): {}\n\n{}\n", desc.name, object_type_name(desc.kind),
-                   desc.description ? desc.description : "", doc);
+        const std::string file = user_file(what);
+        fmt::print("{} ({}): {}\n{}\n{}\n", desc.name, object_type_name(desc.kind),
+                   desc.description ? desc.description : "",
+                   file.empty() ? "" : fmt::format("from {}\n", file), doc);
         return 0;
     }
 

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <dlfcn.h>
 #include <filesystem>
+#include <mutex>
 #include <set>
 
 namespace facet {
@@ -96,7 +97,20 @@ std::string PluginRegistry::find_library(const std::string &name) const {
     for (const auto &dir : search_path()) {
         fs::path p = fs::path(dir) / (name + ".so");
         std::error_code ec;
-        if (fs::is_regular_file(p, ec)) return p.string();
+        if (!fs::is_regular_file(p, ec)) continue;
+        // A library of the same name among facet's own plugins is shadowed: say so, once.
+        const std::string lib = libfacet_dir();
+        const fs::path builtin = fs::path(lib) / "facet" / "plugins" / (name + ".so");
+        if (!lib.empty() && fs::path(dir) != builtin.parent_path() &&
+            fs::is_regular_file(builtin, ec)) {
+            static std::mutex mutex;
+            static std::set<std::string> announced;
+            std::lock_guard<std::mutex> lock(mutex);
+            if (announced.insert(name).second)
+                FACET_LOG(Info, "plugin \"{}\": using {}, which shadows the built-in {}", name,
+                          p.string(), builtin.string());
+        }
+        return p.string();
     }
     return "";
 }

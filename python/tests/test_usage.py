@@ -228,3 +228,26 @@ def test_cli_suggests_the_nearest_define_and_option(cornell, facet_cli, cli_env,
     assert 'did you mean "--seed"?' in msg, msg
     msg = error("info", str(cornell), "--film-sise")
     assert 'did you mean "--film-size"?' in msg, msg
+
+
+def test_cli_announces_a_user_plugin_that_shadows_a_built_in(cornell, facet_cli, cli_env,
+                                                             tmp_path):
+    import shutil
+
+    builtin = BINARY_DIR / "lib" / "facet" / "plugins" / "diffuse.so"
+    assert builtin.exists(), builtin
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    shutil.copy(builtin, mine / "diffuse.so")
+    r = subprocess.run([str(facet_cli), "render", str(cornell), "-a", str(mine), "-D", "res=16",
+                        "-D", "spp=1", "-o", str(tmp_path / "x.exr")], env=cli_env,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    lines = [l for l in r.stderr.splitlines() if "shadows the built-in" in l]
+    assert len(lines) == 1 and str(mine / "diffuse.so") in lines[0], r.stderr
+    listing = subprocess.run([str(facet_cli), "plugins", "bsdf", "-a", str(mine)], env=cli_env,
+                             check=True, capture_output=True, text=True).stdout
+    line = next(l for l in listing.splitlines() if l.strip().startswith("diffuse "))
+    assert f"[{mine / 'diffuse.so'} (shadows the built-in)]" in line, listing
+    other = next(l for l in listing.splitlines() if l.strip().startswith("conductor "))
+    assert "[" not in other  # facet's own plugins are not annotated
