@@ -17,10 +17,60 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 using namespace facet;
+
+namespace {
+
+/// The per-sample variance (CIE XYZ) of a render of the moment integrator, m2 - m1² of its first
+/// nested integrator's `<name>.X/Y/Z` and `m2_<name>.X/Y/Z` channels; `image` keeps only its
+/// leading R, G, B (the mean).
+Image variance_from_moments(Image &image, const std::string &path) {
+    auto index = [&](const std::string &name) {
+        for (size_t i = 0; i < image.channel_names.size(); ++i)
+            if (image.channel_names[i] == name) return int(i);
+        return -1;
+    };
+    int first = -1;
+    for (size_t i = 0; i < image.channel_names.size() && first < 0; ++i) {
+        const std::string &n = image.channel_names[i];
+        if (n.size() > 2 && n.compare(n.size() - 2, 2, ".X") == 0 && n.compare(0, 3, "m2_") != 0 &&
+            index("m2_" + n) >= 0)
+            first = int(i);
+    }
+    if (first < 0 || index("R") != 0 || index("G") != 1 || index("B") != 2)
+        FACET_THROW("\"{}\" has no moment channels (<name>.X and m2_<name>.X): give the "
+                    "variance image as the third argument, or render the reference with the "
+                    "moment integrator",
+                    path);
+    const std::string stem = image.channel_names[size_t(first)];
+    const std::string name = stem.substr(0, stem.size() - 2);
+    int m1[3], m2[3];
+    for (int c = 0; c < 3; ++c) {
+        const std::string ch = name + "." + std::string(1, "XYZ"[c]);
+        m1[c] = index(ch);
+        m2[c] = index("m2_" + ch);
+        if (m1[c] < 0 || m2[c] < 0)
+            FACET_THROW("\"{}\": the moment channels of \"{}\" are incomplete", path, name);
+    }
+    Image var(image.width, image.height, 3), mean(image.width, image.height, 3);
+    var.channel_names = {"X", "Y", "Z"};
+    mean.channel_names = {"R", "G", "B"};
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double a = image.at(x, y, m1[c]), b = image.at(x, y, m2[c]);
+                var.at(x, y, c) = float(std::max(0.0, b - a * a));
+                mean.at(x, y, c) = image.at(x, y, c);
+            }
+    image = std::move(mean);
+    return var;
+}
+
+} // namespace
 
 int compare_main(int argc, char **argv) {
     std::string ours_path, mean_path, var_path, z_path;
@@ -30,8 +80,9 @@ int compare_main(int argc, char **argv) {
                  "facet compare");
     app.add_option("ours", ours_path, "The render to check (linear RGB EXR)")->required();
     app.add_option("ref_mean", mean_path, "Reference mean radiance (linear RGB EXR)")->required();
-    app.add_option("ref_var_xyz", var_path, "Reference per-sample variance (CIE XYZ EXR)")
-        ->required();
+    app.add_option("ref_var_xyz", var_path,
+                   "Reference per-sample variance (CIE XYZ EXR); without it, ref_mean is a "
+                   "render of the moment integrator and the variance comes from its moments");
     app.add_option("--spp", spp, "Samples per pixel of the render being checked")
         ->required()
         ->check(CLI::PositiveNumber);
@@ -42,7 +93,13 @@ int compare_main(int argc, char **argv) {
     app.add_option("--z-image", z_path, "Write the per-channel z scores (XYZ) to this EXR");
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
 
-    Image ours = read_image(ours_path), mean = read_image(mean_path), var = read_image(var_path);
+    Image ours = read_image(ours_path), mean = read_image(mean_path), var;
+    if (!var_path.empty()) {
+        var = read_image(var_path);
+    } else {
+        var = variance_from_moments(mean, mean_path);
+        var_path = mean_path + " (moments)";
+    }
     PeerComparison r = compare_with_reference(
         ours, mean, var, spp,
         {"\"" + ours_path + "\"", "\"" + mean_path + "\"", "\"" + var_path + "\""});

@@ -251,3 +251,47 @@ def test_cli_announces_a_user_plugin_that_shadows_a_built_in(cornell, facet_cli,
     assert f"[{mine / 'diffuse.so'} (shadows the built-in)]" in line, listing
     other = next(l for l in listing.splitlines() if l.strip().startswith("conductor "))
     assert "[" not in other  # facet's own plugins are not annotated
+
+
+COMPARE_SCENE = """<scene version="3.0.0">
+    {integrator}
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/>
+            <rfilter type="box"/></film>
+    </sensor>
+    <shape type="rectangle"><bsdf type="diffuse"/></shape>
+    <shape type="sphere"><point name="center" value="0.3,0.2,1"/><float name="radius" value="0.3"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.2,0.6,0.3"/></bsdf></shape>
+    <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+</scene>"""
+
+
+def test_cli_compare_with_a_moment_reference(facet_cli, cli_env, tmp_path):
+    """The README's recipe: a reference rendered with the moment integrator gives `facet
+    compare` both the mean and the per-sample variance."""
+    path = '<integrator type="path"><integer name="max_depth" value="3"/></integrator>'
+    (tmp_path / "scene.xml").write_text(COMPARE_SCENE.format(integrator=path))
+    (tmp_path / "ref.xml").write_text(COMPARE_SCENE.format(
+        integrator=f'<integrator type="moment">{path}</integrator>'))
+
+    def run(*args, check=True):
+        return subprocess.run([str(facet_cli), *map(str, args)], env=cli_env, check=check,
+                              capture_output=True, text=True)
+
+    run("render", tmp_path / "ref.xml", "-D", "spp=512", "-q", "-o", tmp_path / "ref.exr")
+    run("render", tmp_path / "scene.xml", "-D", "spp=16", "--seed", "7", "-q", "-o",
+        tmp_path / "ours.exr")
+    ok = run("compare", tmp_path / "ours.exr", tmp_path / "ref.exr", "--spp", "16", check=False)
+    assert ok.returncode == 0 and "PASS" in ok.stdout, ok.stdout + ok.stderr
+    # A render 30% too bright does not agree.
+    pixels, channels = facet.read(tmp_path / "ours.exr")
+    facet.write((pixels * 1.3, channels), tmp_path / "bright.exr")
+    bad = run("compare", tmp_path / "bright.exr", tmp_path / "ref.exr", "--spp", "16", check=False)
+    assert bad.returncode == 1 and "FAIL" in bad.stdout, bad.stdout + bad.stderr
+    # A plain render is no variance reference: the error says what to do.
+    plain = run("compare", tmp_path / "ours.exr", tmp_path / "ours.exr", "--spp", "16",
+                check=False)
+    assert plain.returncode != 0 and "moment integrator" in plain.stderr, plain.stderr
