@@ -101,7 +101,11 @@ using namespace facet;
 /// name already has an extension.
 std::string output_path(const std::string &scene, const std::string &out, const Film &film) {
     fs::path path = out.empty() ? fs::path(scene) : fs::path(out);
-    if (out.empty() || !path.has_extension()) path.replace_extension(film.default_extension());
+    // -o a folder (existing, or named with a trailing '/'): the scene's name in that folder.
+    const bool folder = !out.empty() && (out.back() == '/' || fs::is_directory(path));
+    if (folder) path = path / fs::path(scene).filename();
+    if (out.empty() || folder || !path.has_extension())
+        path.replace_extension(film.default_extension());
     return path.string();
 }
 

@@ -295,3 +295,11 @@ def test_cli_compare_with_a_moment_reference(facet_cli, cli_env, tmp_path):
     plain = run("compare", tmp_path / "ours.exr", tmp_path / "ours.exr", "--spp", "16",
                 check=False)
     assert plain.returncode != 0 and "moment integrator" in plain.stderr, plain.stderr
+
+
+def test_cli_output_into_a_folder(cornell, facet_cli, cli_env, tmp_path):
+    out = tmp_path / "renders"
+    out.mkdir()
+    subprocess.run([str(facet_cli), "render", str(cornell), "-D", "res=8", "-D", "spp=1", "-q",
+                    "-o", str(out)], env=cli_env, check=True)
+    assert [p.name for p in out.iterdir()] == ["scene.exr"]
