@@ -132,3 +132,18 @@ if(DOCS_TEST)
 else()
     message(FATAL_ERROR "run_sdk_test.cmake: DOCS_TEST (the unit_plugin_docs executable) is not set")
 endif()
+
+# 4. The build tree is a CMake package too: a plugin built against it (CMAKE_PREFIX_PATH=<build>)
+# loads in the build's own `facet`.
+build_project(${SOURCE_DIR}/tests/sdk/phong ${WORK}/phong-buildtree -DCMAKE_BUILD_TYPE=Release
+              -DCMAKE_PREFIX_PATH=${BUILD_DIR})
+file(STRINGS ${WORK}/phong-buildtree/CMakeCache.txt _dir REGEX "^facet_DIR:")
+if(NOT _dir STREQUAL "facet_DIR:PATH=${BUILD_DIR}/lib/cmake/facet")
+    message(FATAL_ERROR "the build-tree project found facet at \"${_dir}\", not in ${BUILD_DIR}")
+endif()
+step("render with the build tree's plugin" ${BUILD_DIR}/bin/facet render
+     ${SOURCE_DIR}/tests/sdk/phong/scene.xml -a ${WORK}/phong-buildtree -o ${WORK}/phong3.exr -q
+     -D spp=1)
+if(NOT EXISTS ${WORK}/phong3.exr)
+    message(FATAL_ERROR "the render with the build tree's plugin wrote no image")
+endif()
