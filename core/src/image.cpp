@@ -856,8 +856,12 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path) {
     auto in = ext.size() > 1 ? OIIO::ImageInput::create(ext.substr(1), /*do_open=*/false) : nullptr;
     std::string error;
     OIIO::ImageSpec spec;
+    // Colour is kept as stored next to an alpha channel (Mitsuba drops alpha, it never
+    // multiplies colour by it); left to itself OpenImageIO premultiplies PNG, TIFF and Targa.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
     if (in && is_readable_format(in->format_name())) {
-        if (in->open(path, spec)) return in;
+        if (in->open(path, spec, config)) return in;
         error = in->geterror();
     } else {
         (void)OIIO::geterror(); // "could not find a format reader", said better below
@@ -869,7 +873,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path) {
         if (in && in->format_name() == std::string(format)) continue;
         auto other = OIIO::ImageInput::create(format, /*do_open=*/false);
         if (!other || !other->valid_file(path)) continue;
-        if (other->open(path, spec)) return other;
+        if (other->open(path, spec, config)) return other;
         // The contents are this format's: its reader's error says what is wrong.
         error = fmt::format("read as {} (by its contents): {}", format, other->geterror());
         break;

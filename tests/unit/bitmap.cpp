@@ -10,6 +10,7 @@
 #include <facet/texture.h>
 #include <facet/xml.h>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,6 +20,7 @@
 #include <string>
 #include <tuple>
 #include <unistd.h>
+#include <vector>
 
 using namespace facet;
 namespace fs = std::filesystem;
@@ -441,4 +443,51 @@ TEST_F(Bitmap, WorksAsABSDFParameter) {
     Vector3f wo = normalize(Vector3f(-0.2f, 0.1f, 0.9f));
     EXPECT_NEAR(textured->eval(BSDFContext(), s2, wo).r, plain->eval(BSDFContext(), s2, wo).r,
                 1e-6f);
+}
+
+TEST_F(Bitmap, AlphaIsDroppedAndTheStoredColourKept) {
+    // As Mitsuba: a texel of RGB (200, 120, 40) under alpha 128 is the colour as stored (sRGB
+    // decoded), not the colour times alpha (0.128 for the red channel). The files are written
+    // with OpenImageIO told that their colour is not premultiplied, so the bytes are the ones
+    // given; PNG, Targa and TIFF are the formats whose readers would premultiply.
+    for (const char *ext : {".png", ".tga", ".tif"}) {
+        for (int channels : {2, 4}) {
+            const std::string name = std::string("alpha") + std::to_string(channels) + ext;
+            std::vector<unsigned char> texels;
+            for (int x = 0; x < 2; ++x) {
+                const unsigned char alpha = x == 0 ? 128 : 0;
+                if (channels == 2)
+                    texels.insert(texels.end(), {200, alpha});
+                else
+                    texels.insert(texels.end(), {200, 120, 40, alpha});
+            }
+            auto out = OIIO::ImageOutput::create(path(name));
+            ASSERT_TRUE(out) << name;
+            OIIO::ImageSpec spec(2, 1, channels, OIIO::TypeDesc::UINT8);
+            spec.alpha_channel = channels - 1;
+            spec.attribute("oiio:UnassociatedAlpha", 1);
+            ASSERT_TRUE(out->open(path(name), spec)) << name;
+            ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, texels.data())) << name;
+            out->close();
+
+            // The image as read: colour as stored, alpha kept as its own channel.
+            Image img = read_image(path(name));
+            ASSERT_EQ(img.channels, channels) << name;
+            EXPECT_FLOAT_EQ(img.at(0, 0, 0), 200.f / 255.f) << name;
+            EXPECT_FLOAT_EQ(img.at(0, 0, channels - 1), 128.f / 255.f) << name;
+            EXPECT_FLOAT_EQ(img.at(1, 0, 0), 200.f / 255.f) << name << " (alpha 0)";
+
+            auto tex = make_bitmap(name, "nearest", "", false, "variant");
+            const Color3f expected =
+                channels == 2 ? Color3f(srgb_decode(200.f / 255.f))
+                              : Color3f(srgb_decode(200.f / 255.f), srgb_decode(120.f / 255.f),
+                                        srgb_decode(40.f / 255.f));
+            for (float u : {0.25f, 0.75f}) {
+                expect_color_near(tex->eval(at_uv(u, 0.5f)), expected, 1e-6f, name);
+                // Scalar queries (a mask's opacity, a roughness) read the colour too, never
+                // the alpha channel.
+                EXPECT_NEAR(tex->eval_1(at_uv(u, 0.5f)), expected.luminance(), 1e-6f) << name;
+            }
+        }
+    }
 }
