@@ -67,8 +67,8 @@ std::pair<Color3f, Color3f> conductor_eta_k(const std::string &material) {
                     closest.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", closest),
                     fmt::join(names, ", "));
     }
-    return {spectrum_to_rgb(grid_spectrum(found->eta), SpectrumKind::Unbounded),
-            spectrum_to_rgb(grid_spectrum(found->k), SpectrumKind::Unbounded)};
+    return {spectrum_to_rgb(grid_spectrum(found->eta), SpectrumKind::Measured),
+            spectrum_to_rgb(grid_spectrum(found->k), SpectrumKind::Measured)};
 }
 
 ConductorIOR read_conductor_ior(const Properties &props) {

@@ -124,7 +124,7 @@ TEST(Conductor, EtaAndKAsNumbersRGBAndSpectra) {
         fresnel_conductor(si.wi.z, Color3f(0.2f, 0.9f, 1.1f), Color3f(3.9f, 2.4f, 2.1f)), 1e-6f,
         "rgb");
 
-    // Spectra are unbounded quantities: no D65 weighting, no clamping to 1.
+    // Spectra are unbounded quantities: weighted by D65 (as every non-emitter), no clamping to 1.
     SpectrumData eta_s = parse_spectrum_pairs("400:1.5, 500:1.0, 600:0.4, 700:0.2");
     SpectrumData k_s = parse_spectrum_pairs("400:2.0, 500:2.5, 600:3.5, 700:4.0");
     auto spectral = make_bsdf("conductor", {{"eta", eta_s}, {"k", k_s}});
@@ -133,6 +133,21 @@ TEST(Conductor, EtaAndKAsNumbersRGBAndSpectra) {
     EXPECT_GT(k.r, 1.f);
     expect_color_near(spectral->sample(BSDFContext(), si, 0.5f, Point2f(0.5f)).second,
                       fresnel_conductor(si.wi.z, eta, k), 1e-6f, "spectrum");
+}
+
+TEST(Conductor, InlineSpectraAtNormalIncidenceMatchMitsuba) {
+    // Mitsuba 3.8 (scalar_rgb) renders this conductor with a normal-incidence reflectance of
+    // (0.986, 0.708, 0.404): its inline eta and k are weighted by D65. Without the weighting the
+    // result is (0.974, 0.703, 0.372).
+    auto bsdf = make_bsdf(
+        "conductor",
+        {{"eta", parse_spectrum_pairs("300:1.8, 400:1.65, 500:0.9, 600:0.2, 700:0.16, 800:0.18")},
+         {"k", parse_spectrum_pairs("300:1.92, 400:1.95, 500:1.95, 600:2.97, 700:3.8, 800:5.12")}});
+    SurfaceInteraction si = make_si(Vector3f(0.f, 0.f, 1.f));
+    Color3f r = bsdf->sample(BSDFContext(), si, 0.5f, Point2f(0.5f)).second;
+    // The figures are given to three decimals.
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(r[c], Color3f(0.986f, 0.708f, 0.404f)[c], 6e-4f) << "channel " << c;
 }
 
 TEST(Conductor, RejectsBadParameters) {

@@ -53,11 +53,15 @@ struct TempFile {
 
 } // namespace
 
+/// What a flat spectrum of 1 weighted by D65 comes to: Mitsuba scales D65 to luminance 1 against
+/// the continuous curves (1 / 98.9974), which over its 1000-step quadrature gives 0.99889.
+constexpr float D65White = 0.99889f;
+
 TEST(Spectrum, ConstantReflectanceIsGrey) {
-    // D65 is normalised so that white maps to Y = 1, and D65 is the sRGB white point.
-    expect_color(spectrum_to_rgb(flat(0.5), SpectrumKind::Reflectance), Color3f(0.5f), 1e-3f);
-    expect_color(spectrum_to_rgb(flat(1.0), SpectrumKind::Reflectance), Color3f(1.f), 1e-3f);
-    expect_color(spectrum_to_rgb(flat(0.2), SpectrumKind::Reflectance), Color3f(0.2f), 1e-3f);
+    // D65 is the sRGB white point: a flat reflectance is grey.
+    for (float v : {0.5f, 1.f, 0.2f})
+        expect_color(spectrum_to_rgb(flat(v), SpectrumKind::Reflectance), Color3f(v * D65White),
+                     2e-4f * v);
 }
 
 TEST(Spectrum, UniformEmissionQuirk) {
@@ -80,7 +84,24 @@ TEST(Spectrum, EmissionIsNotWeightedByD65) {
     // An equal-energy emitter given as pairs goes through the integration: its XYZ is about
     // (1, 1, 1) (the normalisation divides by the y-bar integral), so its RGB is the quirk white.
     expect_color(spectrum_to_rgb(flat(1.0), SpectrumKind::Emission), QuirkWhite, 1e-3f);
-    expect_color(spectrum_to_rgb(flat(4.0), SpectrumKind::Unbounded), QuirkWhite * 4.f, 4e-3f);
+    // So are a conductor preset's tabulated eta and k.
+    expect_color(spectrum_to_rgb(flat(4.0), SpectrumKind::Measured), QuirkWhite * 4.f, 4e-3f);
+}
+
+TEST(Spectrum, UnboundedSpectraOfNonEmittersAreWeightedByD65) {
+    // An eta or k given as pairs is weighted by D65 like a reflectance (a flat spectrum is grey),
+    // but not clamped to 1.
+    expect_color(spectrum_to_rgb(flat(4.0), SpectrumKind::Unbounded), Color3f(4.f * D65White),
+                 8e-4f);
+    SpectrumData ramp = parse_spectrum_pairs("400:1, 700:3");
+    Color3f weighted = spectrum_to_rgb(ramp, SpectrumKind::Unbounded);
+    Color3f unweighted = spectrum_to_rgb(ramp, SpectrumKind::Measured);
+    EXPECT_GT(weighted.r, 1.f);
+    EXPECT_GT(std::abs(weighted.b - unweighted.b), 0.05f);
+    // Weighted the same way as a reflectance, only without the clamp.
+    SpectrumData low = parse_spectrum_pairs("400:0.1, 700:0.9");
+    expect_color(spectrum_to_rgb(low, SpectrumKind::Unbounded),
+                 spectrum_to_rgb(low, SpectrumKind::Reflectance), 0.f);
 }
 
 TEST(Spectrum, Clamping) {
@@ -89,7 +110,8 @@ TEST(Spectrum, Clamping) {
     EXPECT_GT(spectrum_to_rgb(flat(3.0), SpectrumKind::Emission).r, 3.f);
     // A narrow green line has negative red in sRGB: clamped to zero.
     SpectrumData green = parse_spectrum_pairs("500:0, 510:10, 520:0");
-    for (auto kind : {SpectrumKind::Reflectance, SpectrumKind::Emission, SpectrumKind::Unbounded}) {
+    for (auto kind : {SpectrumKind::Reflectance, SpectrumKind::Emission, SpectrumKind::Unbounded,
+                      SpectrumKind::Measured}) {
         Color3f c = spectrum_to_rgb(green, kind);
         EXPECT_EQ(c.r, 0.f);
         EXPECT_GT(c.g, 0.f);

@@ -16,7 +16,8 @@ namespace facet {
 /// Names of all embedded materials, sorted, plus "none" (the ideal mirror: η = 0, k = 1).
 std::vector<std::string> conductor_names();
 
-/// RGB η and k of a material, integrated against the CIE curves as unbounded spectra.
+/// RGB η and k of a material, integrated against the CIE curves without D65 (as Mitsuba converts
+/// its data/ior files), clamped to >= 0 only.
 /// Exact names first, then a case-insensitive match; unknown names throw facet::Error listing
 /// the valid names and the closest one.
 std::pair<Color3f, Color3f> conductor_eta_k(const std::string &material);

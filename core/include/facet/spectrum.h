@@ -7,11 +7,14 @@
 
 namespace facet {
 
-/// How a spectrum is turned into RGB (as in Mitsuba 3's RGB variants).
+/// How a spectrum is turned into RGB (as in Mitsuba 3's RGB variants). Every spectrum a scene
+/// gives outside an emitter is weighted by D65, bounded or not; only reflectances are clamped
+/// to 1.
 enum class SpectrumKind {
     Reflectance, ///< weighted by D65, clamped to [0, 1]
     Emission,    ///< unweighted, clamped to >= 0; a uniform value c becomes c·xyz_to_srgb(1,1,1)
-    Unbounded,   ///< unweighted, clamped to >= 0 (eta, k, alpha)
+    Unbounded,   ///< weighted by D65, clamped to >= 0 (eta, k, alpha given in a scene)
+    Measured,    ///< unweighted, clamped to >= 0 (a conductor `material`'s tabulated eta and k)
 };
 
 /// A spectrum as written in a scene: a uniform value or (wavelength nm, value) pairs.
@@ -42,7 +45,8 @@ Color3f xyz_to_srgb(const Color3f &xyz);
 Color3f srgb_to_xyz(const Color3f &rgb);
 /// CIE 1931 colour matching functions at `lambda` nm (linear interpolation of the 5 nm table).
 Color3f cie1931_xyz(double lambda);
-/// D65 relative power at `lambda` nm, normalised so that a white reflectance maps to luminance 1.
+/// D65 relative power at `lambda` nm, scaled as Mitsuba's (to luminance 1 against the continuous
+/// CIE curves; a white reflectance integrates to 0.99889 over spectrum_to_rgb's quadrature).
 double cie_d65(double lambda);
 
 } // namespace facet
