@@ -301,7 +301,10 @@ void check_spawned_rays(const Transform &to_world, float radius_world, uint64_t 
 TEST(SpawnRay, NoSelfIntersectionAtUnitScale) { check_spawned_rays(Transform(), 1.f, 1); }
 
 TEST(SpawnRay, NoSelfIntersectionAtLargeCoordinates) {
-    check_spawned_rays(Transform::translate(Vector3f(1e4f, -2e4f, 1e4f)), 1.f, 2);
+    // The offset there is (1 + 2e4) · RayEpsilon = 1.8 (Mitsuba's): the shapes are sized above it.
+    check_spawned_rays(Transform::translate(Vector3f(1e4f, -2e4f, 1e4f)) *
+                           Transform::scale(Vector3f(10, 10, 10)),
+                       10.f, 2);
     check_spawned_rays(Transform::translate(Vector3f(1e4f, 1e4f, 3e4f)) *
                            Transform::rotate(Vector3f(1, 2, 3), 37.f) *
                            Transform::scale(Vector3f(50, 50, 50)),
@@ -360,6 +363,56 @@ TEST(SpawnRay, ShadowRaysReachSurfacePointsAndDoNotLeak) {
         ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-x, 0.3f, 3.f), Vector3f(0, 0, -1)), right));
         EXPECT_FALSE(scene.ray_test(right.spawn_ray_to(Point3f(0.5f, 0.3f, 0.5f))));
     }
+}
+
+TEST(SpawnRay, OffsetsAreMitsubas) {
+    // Mitsuba 3: origin + n · ±(1 + max |p_i|) · RayEpsilon with RayEpsilon = 1500 · 2^-24, on
+    // the side the direction points to; a ray towards a point stops ShadowEpsilon = 10 ·
+    // RayEpsilon of its length short.
+    EXPECT_EQ(RayEpsilon, 1500.f / 16777216.f);
+    EXPECT_EQ(ShadowEpsilon, 10.f * RayEpsilon);
+    Interaction it;
+    it.p = Point3f(0.5f, -3.f, 2.f);
+    it.n = Normal3f(0.f, 0.f, 1.f);
+    it.t = 1.f;
+    const float offset = 4.f * RayEpsilon;
+    Ray up = it.spawn_ray(normalize(Vector3f(1.f, 0.f, 1.f)));
+    EXPECT_FLOAT_EQ(up.o.z, 2.f + offset);
+    EXPECT_EQ(up.o.x, 0.5f);
+    Ray down = it.spawn_ray(normalize(Vector3f(1.f, 0.f, -1.f)));
+    EXPECT_FLOAT_EQ(down.o.z, 2.f - offset);
+    Ray to = it.spawn_ray_to(Point3f(0.5f, -3.f, 7.f));
+    EXPECT_FLOAT_EQ(to.o.z, 2.f + offset);
+    EXPECT_FLOAT_EQ(to.maxt, (5.f - offset) * (1.f - ShadowEpsilon));
+}
+
+TEST(SpawnRay, SmallGeometryWithinTheOffsetsIsSteppedOver) {
+    // What the offsets mean for small geometry, as in Mitsuba: a sheet 4e-5 above a floor is
+    // below the origin of rays spawned upwards from the floor, and a bulb of radius 3e-4 around
+    // a point 1 away lies within the part of the shadow ray towards that point left out.
+    Properties floor;
+    floor.set_transform("to_world", Transform::scale(Vector3f(2, 2, 1)));
+    Properties sheet;
+    sheet.set_transform("to_world", Transform::translate(Vector3f(0.f, 0.f, 4e-5f)) *
+                                        Transform::scale(Vector3f(0.5f, 0.5f, 1)));
+    Properties bulb;
+    bulb.set_vector("center", Vector3f(1.2f, 0.f, 1.f));
+    bulb.set_float("radius", 3e-4);
+    Properties props;
+    props.set_object("floor", create(ObjectType::Shape, "rectangle", floor));
+    props.set_object("sheet", create(ObjectType::Shape, "rectangle", sheet));
+    props.set_object("bulb", create(ObjectType::Shape, "sphere", bulb));
+    Scene scene(props);
+
+    // A floor point under the sheet, reached from below.
+    SurfaceInteraction si;
+    ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(0.1f, 0.2f, -1.f), Vector3f(0, 0, 1)), si));
+    ASSERT_EQ(si.shape, scene.shapes()[0].get());
+    SurfaceInteraction hit;
+    EXPECT_FALSE(scene.ray_intersect(si.spawn_ray(normalize(Vector3f(0.f, 0.3f, 1.f))), hit))
+        << "hit shape " << (hit.shape == scene.shapes()[1].get() ? "sheet" : "other");
+    // The bulb's centre is visible from a floor point 1.2 away from it.
+    EXPECT_FALSE(scene.ray_test(si.spawn_ray_to(Point3f(1.2f, 0.f, 1.f))));
 }
 
 TEST(SceneEmitters, SampleAndPdfAgree) {
