@@ -30,9 +30,9 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
+#include <new>
 #include <pugixml.hpp>
 #include <set>
 #include <sstream>
@@ -50,6 +50,25 @@ constexpr int MaxIncludeDepth = 15;
 /// scenes (a shape, its BSDF, a texture of that: a handful). Parsing, instantiation and some
 /// plugins recurse along such chains, so a deeper one is refused instead of exhausting the stack.
 constexpr size_t MaxObjectDepth = 256;
+
+// Budgets of one load, far above real scenes (which include tens to hundreds of files and hold up
+// to a few million elements) and low enough that a hostile scene (files that include each other
+// many times, `$name` values that grow tenfold per <default>) ends in a located error within
+// seconds instead of exhausting time or memory. README.md ("Scene compatibility") lists them.
+/// Bytes of one XML file.
+constexpr size_t MaxFileBytes = size_t(256) << 20;
+/// Inclusions of files, each <include> of each included copy counted.
+constexpr size_t MaxIncludes = 100000;
+/// Bytes of XML a load walks through: every file once per inclusion (a file is read and parsed
+/// once, but each inclusion reads all its elements and attributes again).
+constexpr size_t MaxSceneBytes = size_t(1) << 30;
+/// Elements read again because their file is included more than once (a file included once,
+/// however large, is bounded by the byte limits alone).
+constexpr size_t MaxRepeatedElements = 1000000;
+/// Length of one attribute value after `$name` substitution.
+constexpr size_t MaxExpandedValue = size_t(1) << 20;
+/// Bytes of all attribute values that `$name` substitution produces in one load.
+constexpr size_t MaxExpandedText = size_t(256) << 20;
 
 // =============================================================================================
 // Tags
@@ -107,13 +126,17 @@ struct Version {
     }
 };
 
-/// One XML text (a file or a string) and what turns pugixml's byte offsets into line:column.
+/// One XML text (a file or a string), its parsed document (parsed once, however often the file is
+/// included) and what turns pugixml's byte offsets into line:column.
 struct SourceFile {
     std::string name;      ///< shown in locations: the path as given, or "string"
     fs::path dir;          ///< folder for relative <include> and <path> values
     std::string canonical; ///< for include-cycle detection; empty for strings
-    std::string text;
-    size_t bom = 0; ///< bytes of a UTF-8 byte order mark skipped before parsing
+    std::string text;      ///< parsed in place: only its size is used once `doc` is loaded
+    size_t bom = 0;        ///< bytes of a UTF-8 byte order mark skipped before parsing
+    size_t size = 0;       ///< bytes of the text, for the scene's budget
+    size_t inclusions = 0; ///< times included so far in this load
+    std::unique_ptr<pugi::xml_document> doc;
     std::vector<size_t> line_starts;
     Version version;
     bool upgrade = false; ///< version < 2.0.0: apply the 0.x upgrade to this file's nodes
@@ -122,6 +145,7 @@ struct SourceFile {
         : name(std::move(name_)), dir(std::move(dir_)), canonical(std::move(canonical_)),
           text(std::move(text_)) {
         if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) bom = 3;
+        size = text.size();
         line_starts.push_back(0);
         for (size_t i = 0; i < text.size(); ++i)
             if (text[i] == '\n') line_starts.push_back(i + 1);
@@ -150,15 +174,6 @@ struct Element {
 };
 
 [[noreturn]] void fail(const Location &loc, const std::string &msg) { throw Error(loc, msg); }
-
-std::string read_text_file(const fs::path &path, bool &ok) {
-    std::ifstream in(path, std::ios::binary);
-    ok = bool(in);
-    if (!ok) return {};
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 std::string canonical_name(const fs::path &path) {
     std::error_code ec;
@@ -349,9 +364,9 @@ public:
     }
 
     std::shared_ptr<Object> load_file(const std::string &path, bool require_scene) {
-        bool ok = false;
-        std::string text = read_text_file(path, ok);
-        if (!ok) FACET_THROW("could not open XML file \"{}\"", path);
+        // The checks every file reader shares: a folder, a FIFO or a device is refused, and so
+        // is a file larger than MaxFileBytes.
+        std::string text = read_file(path, "scene file", MaxFileBytes);
         fs::path dir = fs::path(path).parent_path();
         SourceFile *src = add_source(path, dir, canonical_name(path), std::move(text));
 
@@ -439,6 +454,17 @@ public:
 
 private:
     std::shared_ptr<Object> load(SourceFile *src, bool require_scene) {
+        try {
+            return load_checked(src, require_scene);
+        } catch (const std::bad_alloc &) {
+            // Parsing locates its own allocation failures (parse_child()); these come from
+            // resolving references or from the objects' construction.
+            FACET_THROW("{}: out of memory while loading the scene", src->name);
+        }
+    }
+
+    std::shared_ptr<Object> load_checked(SourceFile *src, bool require_scene) {
+        m_scene_bytes = src->size;
         for (const std::string &dir : m_opts.search_path) file_resolver().append(dir);
 
         size_t root = parse_document(src, NoNode, "");
@@ -540,7 +566,9 @@ private:
                            std::string text) {
         m_sources.push_back(std::make_unique<SourceFile>(std::move(name), std::move(dir),
                                                          std::move(canonical), std::move(text)));
-        return m_sources.back().get();
+        SourceFile *src = m_sources.back().get();
+        if (!src->canonical.empty()) m_files.emplace(src->canonical, src);
+        return src;
     }
 
     // -- Attributes and $name substitution ------------------------------------------------------
@@ -554,18 +582,22 @@ private:
     }
 
     /// Replaces `$key` by its value (longest keys first), `\$` by `$`; a `$name` that matches no
-    /// key is an error.
+    /// key is an error. The result of each substitution and the total of a load are bounded
+    /// (MaxExpandedValue, MaxExpandedText): <default> values made of copies of other values
+    /// grow geometrically.
     std::string substitute(const Element &el, const std::string &text) {
         if (text.find('$') == std::string::npos) return text;
         std::string out;
+        out.reserve(text.size());
         for (size_t i = 0; i < text.size();) {
-            if (text[i] == '\\' && i + 1 < text.size() && text[i + 1] == '$') {
+            size_t special = std::min(text.find('$', i), text.find("\\$", i));
+            if (special == std::string::npos) special = text.size();
+            out.append(text, i, special - i);
+            i = special;
+            if (i == text.size()) break;
+            if (text[i] == '\\') { // `\$`
                 out += '$';
                 i += 2;
-                continue;
-            }
-            if (text[i] != '$') {
-                out += text[i++];
                 continue;
             }
             const std::string *key = nullptr;
@@ -577,6 +609,10 @@ private:
             if (key) {
                 Parameter &p = m_params[*key];
                 p.used = true;
+                if (p.value.size() > MaxExpandedValue - std::min(out.size(), MaxExpandedValue))
+                    fail(el.loc, fmt::format("substituting ${} makes a value of {} longer than "
+                                             "{} MiB (the loader's limit)",
+                                             *key, el.bracketed(), MaxExpandedValue >> 20));
                 out += p.value;
                 i += 1 + key->size();
                 continue;
@@ -586,6 +622,11 @@ private:
             if (j > i + 1) fail(el.loc, "undefined parameter: $" + text.substr(i + 1, j - i - 1));
             out += text[i++];
         }
+        m_expanded += out.size();
+        if (m_expanded > MaxExpandedText)
+            fail(el.loc, fmt::format("$name substitution has produced more than {} MiB of text in "
+                                     "this scene (the loader's limit)",
+                                     MaxExpandedText >> 20));
         return out;
     }
 
@@ -727,14 +768,19 @@ private:
     /// a <scene> root's children are spliced into `parent`; another root becomes its child,
     /// named `include_name` (or the root's own name).
     size_t parse_document(SourceFile *src, size_t parent, const std::string &include_name) {
-        pugi::xml_document doc;
-        pugi::xml_parse_result result =
-            doc.load_buffer(src->text.data() + src->bom, src->text.size() - src->bom,
-                            pugi::parse_default, pugi::encoding_utf8);
-        if (!result)
-            fail(src->location(result.offset), fmt::format("Parsing of XML file \"{}\" failed: {}",
-                                                           src->name, result.description()));
-        Element root(doc.document_element(), src);
+        if (!src->doc) {
+            // Parsed once, in place (the text is not needed again), however often it is included.
+            src->doc = std::make_unique<pugi::xml_document>();
+            pugi::xml_parse_result result = src->doc->load_buffer_inplace(
+                src->text.data() + src->bom, src->text.size() - src->bom, pugi::parse_default,
+                pugi::encoding_utf8);
+            if (!result)
+                fail(src->location(result.offset),
+                     fmt::format("Parsing of XML file \"{}\" failed: {}", src->name,
+                                 result.description()));
+        }
+        Element root(src->doc->document_element(), src);
+        count_element(root);
         parse_version(root, parent != NoNode ? &m_include_stack.back()->version : nullptr);
 
         m_include_stack.push_back(src);
@@ -792,18 +838,26 @@ private:
         std::string filename = attr(el, "filename");
         std::string name = property_name(el, true);
 
-        fs::path p(filename), found;
-        if (p.is_absolute()) {
-            found = p;
-        } else if (fs::is_regular_file(el.src->dir / p)) {
-            found = (el.src->dir / p).lexically_normal();
-        } else {
-            found = file_resolver().resolve(filename);
+        // Resolved once per folder and name: a scene may include a file many times.
+        auto [resolved, is_new] = m_resolved.try_emplace(el.src->dir.string() + '\n' + filename);
+        if (is_new) {
+            fs::path p(filename), found;
+            std::error_code ec;
+            if (p.is_absolute()) {
+                found = p;
+            } else if (fs::is_regular_file(el.src->dir / p, ec)) {
+                found = (el.src->dir / p).lexically_normal();
+            } else {
+                found = file_resolver().resolve(filename);
+            }
+            if (!fs::exists(found, ec)) {
+                m_resolved.erase(resolved);
+                fail(el.loc, fmt::format("included file \"{}\" not found", filename));
+            }
+            resolved->second = {found, canonical_name(found)};
         }
-        if (!fs::is_regular_file(found))
-            fail(el.loc, fmt::format("included file \"{}\" not found", filename));
-
-        std::string canonical = canonical_name(found);
+        const fs::path found = resolved->second.first; // copies: <path> clears the map
+        const std::string canonical = resolved->second.second;
         for (size_t i = 0; i < m_include_stack.size(); ++i) {
             if (m_include_stack[i]->canonical != canonical) continue;
             std::string chain;
@@ -814,13 +868,42 @@ private:
         if (int(m_include_stack.size()) > MaxIncludeDepth)
             fail(el.loc, fmt::format("maximum include depth of {} exceeded while including \"{}\"",
                                      MaxIncludeDepth, filename));
+        if (++m_includes > MaxIncludes)
+            fail(el.loc, fmt::format("including \"{}\" makes more than {} inclusions of files in "
+                                     "this scene (the loader's limit)",
+                                     filename, MaxIncludes));
 
-        bool ok = false;
-        std::string text = read_text_file(found, ok);
-        if (!ok) fail(el.loc, fmt::format("could not open included file \"{}\"", found.string()));
-        SourceFile *src =
-            add_source(found.string(), found.parent_path(), canonical, std::move(text));
+        SourceFile *src = nullptr;
+        if (auto cached = m_files.find(canonical); cached != m_files.end()) {
+            src = cached->second;
+        } else {
+            std::string text;
+            try {
+                text = read_file(found.string(), "included file", MaxFileBytes);
+            } catch (const Error &e) {
+                fail(el.loc, e.message());
+            }
+            src = add_source(found.string(), found.parent_path(), canonical, std::move(text));
+        }
+        m_scene_bytes += src->size;
+        if (m_scene_bytes > MaxSceneBytes)
+            fail(el.loc, fmt::format("including \"{}\" takes the XML of this scene past {} MiB, "
+                                     "each inclusion of a file counted (the loader's limit)",
+                                     filename, MaxSceneBytes >> 20));
+        const bool repeated = src->inclusions++ > 0;
+        if (repeated && m_repeating++ == 0) m_repeated_include = {el.loc, filename};
         parse_document(src, parent, name);
+        if (repeated) --m_repeating;
+    }
+
+    /// Counts an element read again (its file included before) against MaxRepeatedElements.
+    void count_element(const Element &el) {
+        if (m_repeating == 0 || ++m_repeated_elements <= MaxRepeatedElements) return;
+        fail(el.loc, fmt::format("including \"{}\" at {} makes the scene read more than {} "
+                                 "elements again, in files included more than once (the loader's "
+                                 "limit)",
+                                 m_repeated_include.second, m_repeated_include.first.to_string(),
+                                 MaxRepeatedElements));
     }
 
     // -- Elements inside objects ----------------------------------------------------------------
@@ -831,6 +914,16 @@ private:
     }
 
     void parse_child(const Element &el, size_t parent, bool parent_is_root) {
+        count_element(el);
+        try {
+            parse_element(el, parent, parent_is_root);
+        } catch (const std::bad_alloc &) {
+            // The innermost element names where memory ran out (outer ones see a facet::Error).
+            fail(el.loc, fmt::format("out of memory while reading {}", el.bracketed()));
+        }
+    }
+
+    void parse_element(const Element &el, size_t parent, bool parent_is_root) {
         std::string tag = el.tag();
         if (tag == "scene")
             fail(el.loc, "<scene> may only appear as the root element of a file");
@@ -944,6 +1037,7 @@ private:
         for (pugi::xml_node c : el.node.children()) {
             if (c.type() != pugi::node_element) continue;
             Element op(c, el.src);
+            count_element(op);
             if (!is_transform_op(op.tag(), el.src->upgrade))
                 fail(op.loc, fmt::format("{} cannot appear inside <transform>: only translate, "
                                          "rotate, scale, matrix and lookat can",
@@ -1048,6 +1142,7 @@ private:
         if (!fs::is_directory(found))
             fail(el.loc, fmt::format("folder \"{}\" does not exist", value));
         file_resolver().prepend(fs::absolute(found).lexically_normal().string());
+        m_resolved.clear(); // names may resolve elsewhere now
     }
 
     // -- The 0.x upgrade ------------------------------------------------------------------------
@@ -1246,6 +1341,15 @@ private:
     std::map<std::string, Parameter> m_params;
     std::vector<std::string> m_keys; ///< parameter names, longest first
     std::vector<SourceFile *> m_include_stack;
+    std::unordered_map<std::string, SourceFile *> m_files; ///< by canonical name: read once
+    /// (folder of the including file, filename) -> (path, canonical name); cleared by <path>.
+    std::unordered_map<std::string, std::pair<fs::path, std::string>> m_resolved;
+    size_t m_includes = 0;          ///< inclusions so far (MaxIncludes)
+    size_t m_scene_bytes = 0;       ///< XML bytes so far, each inclusion counted (MaxSceneBytes)
+    size_t m_repeating = 0;         ///< repeated inclusions being read (nested in one another)
+    size_t m_repeated_elements = 0; ///< elements read in them (MaxRepeatedElements)
+    std::pair<Location, std::string> m_repeated_include; ///< the outermost of them, its filename
+    size_t m_expanded = 0;         ///< bytes produced by $name substitution (MaxExpandedText)
     std::vector<size_t> m_created; ///< nodes in creation order
     size_t m_object_depth = 0;     ///< objects open around the element being parsed
 };
