@@ -55,6 +55,7 @@ are skipped with a warning.
 #include <fcntl.h>
 #include <string_view>
 #include <unistd.h>
+#include <unordered_set>
 
 namespace facet {
 
@@ -417,6 +418,47 @@ private:
         return size_t(count);
     }
 
+    /// Warnings of one kind are logged once, with their count and the first few names they
+    /// concern: a header may declare thousands of properties that all fail the same way.
+    class WarningTally {
+    public:
+        explicit WarningTally(const std::string &file) : m_file(file) {}
+        /// `many` says what several of them are ("list properties of element vertex ignored");
+        /// `single()` gives the message of one.
+        template <typename Single>
+        void add(const std::string &many, const std::string &name, Single single) {
+            for (Kind &k : m_kinds)
+                if (k.many == many) {
+                    ++k.count;
+                    if (k.names.size() < 3) k.names.push_back(name);
+                    return;
+                }
+            m_kinds.push_back(Kind{many, single(), 1, {name}});
+        }
+        void log() const {
+            for (const Kind &k : m_kinds) {
+                if (k.count == 1) {
+                    FACET_LOG(Warn, "{}", k.single);
+                    continue;
+                }
+                std::string names;
+                for (const std::string &n : k.names)
+                    names += (names.empty() ? "\"" : ", \"") + n + "\"";
+                FACET_LOG(Warn, "{}: {} {}: {}{}", m_file, k.count, k.many, names,
+                          k.count > k.names.size() ? ", ..." : "");
+            }
+        }
+
+    private:
+        struct Kind {
+            std::string many, single;
+            size_t count;
+            std::vector<std::string> names;
+        };
+        const std::string &m_file;
+        std::vector<Kind> m_kinds;
+    };
+
     /// A named attribute made of some of an element's properties (one per channel).
     struct AttributeGroup {
         std::string name;
@@ -435,6 +477,7 @@ private:
     std::vector<AttributeGroup> group_attributes(const PlyElement &el, const std::string &prefix,
                                                  std::vector<char> &reserved) const {
         std::vector<AttributeGroup> groups;
+        WarningTally warnings(m_name);
         auto find = [&](const char *n) -> int {
             for (size_t i = 0; i < el.props.size(); ++i)
                 if (!el.props[i].is_list && el.props[i].name == n) return int(i);
@@ -442,10 +485,15 @@ private:
         };
         auto integer_warning = [&](const AttributeGroup &g) {
             if (g.props.size() >= 3 && is_integer(el.props[g.props[0]].type))
-                FACET_LOG(Warn,
-                          "{}: mesh attribute \"{}\" has integer fields: color attributes are "
-                          "expected to be in the [0, 1] range (the values are used as they are)",
-                          m_name, g.name);
+                warnings.add("mesh attributes have integer fields: color attributes are expected "
+                             "to be in the [0, 1] range (the values are used as they are)",
+                             g.name, [&] {
+                                 return fmt::format("{}: mesh attribute \"{}\" has integer fields: "
+                                                    "color attributes are expected to be in the "
+                                                    "[0, 1] range (the values are used as they "
+                                                    "are)",
+                                                    m_name, g.name);
+                             });
         };
 
         const char *bare[2][4] = {{"r", "g", "b", "a"}, {"red", "green", "blue", "alpha"}};
@@ -463,7 +511,7 @@ private:
                 if (int i = find(n); i >= 0) reserved[size_t(i)] = 1;
 
         static const char *families[4] = {"xr01", "yg12", "zb23", "wa34"};
-        std::vector<std::string> seen;
+        std::unordered_set<std::string> seen;
         AttributeGroup current;
         std::string current_prefix;
         int family = -1;
@@ -473,11 +521,15 @@ private:
             if (n == 1 || n == 3) {
                 current.name = prefix + current_prefix + (family == 1 ? "_color" : "");
                 integer_warning(current);
-                seen.push_back(current_prefix);
+                seen.insert(current_prefix);
                 groups.push_back(std::move(current));
             } else {
-                FACET_LOG(Warn, "{}: attribute \"{}{}\" has {} fields (1 or 3 are needed); ignored",
-                          m_name, prefix, current_prefix, n);
+                warnings.add("attributes ignored (1 or 3 fields are needed)",
+                             prefix + current_prefix, [&] {
+                                 return fmt::format("{}: attribute \"{}{}\" has {} fields (1 or 3 "
+                                                    "are needed); ignored",
+                                                    m_name, prefix, current_prefix, n);
+                             });
             }
             current = AttributeGroup();
             family = -1;
@@ -486,16 +538,25 @@ private:
             const PlyProperty &p = el.props[i];
             if (reserved[i]) continue;
             if (p.is_list) {
-                FACET_LOG(Warn, "{}: list property \"{}\" of element {} ignored", m_name, p.name,
-                          el.name);
+                warnings.add(fmt::format("list properties of element {} ignored", el.name), p.name,
+                             [&] {
+                                 return fmt::format("{}: list property \"{}\" of element {} "
+                                                    "ignored",
+                                                    m_name, p.name, el.name);
+                             });
                 continue;
             }
             size_t pos = p.name.find_last_of('_');
             if (pos == std::string::npos || pos + 2 != p.name.size()) {
-                FACET_LOG(Warn,
-                          "{}: property \"{}\" of element {} ignored (attributes are named "
-                          "<name>_<one-letter suffix>)",
-                          m_name, p.name, el.name);
+                warnings.add(fmt::format("properties of element {} ignored (attributes are "
+                                         "named <name>_<one-letter suffix>)",
+                                         el.name),
+                             p.name, [&] {
+                                 return fmt::format("{}: property \"{}\" of element {} ignored "
+                                                    "(attributes are named <name>_<one-letter "
+                                                    "suffix>)",
+                                                    m_name, p.name, el.name);
+                             });
                 flush();
                 continue;
             }
@@ -503,17 +564,25 @@ private:
             char suffix = p.name[pos + 1];
             if (family >= 0 && name != current_prefix) flush();
             if (family < 0) {
-                if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
-                    FACET_LOG(Warn, "{}: attribute \"{}\" seen before: property \"{}\" ignored",
-                              m_name, name, p.name);
+                if (seen.count(name)) {
+                    warnings.add("properties ignored (their attribute was seen before)", p.name,
+                                 [&] {
+                                     return fmt::format("{}: attribute \"{}\" seen before: "
+                                                        "property \"{}\" ignored",
+                                                        m_name, name, p.name);
+                                 });
                     continue;
                 }
                 const char *f = std::strchr(families[0], suffix);
                 if (!f || suffix == 0) {
-                    FACET_LOG(Warn,
-                              "{}: property \"{}\" ignored (an attribute's first suffix is one "
-                              "of x, r, 0, 1)",
-                              m_name, p.name);
+                    warnings.add("properties ignored (an attribute's first suffix is one of x, "
+                                 "r, 0, 1)",
+                                 p.name, [&] {
+                                     return fmt::format("{}: property \"{}\" ignored (an "
+                                                        "attribute's first suffix is one of x, "
+                                                        "r, 0, 1)",
+                                                        m_name, p.name);
+                                 });
                     continue;
                 }
                 family = int(f - families[0]);
@@ -523,9 +592,12 @@ private:
             }
             size_t level = current.props.size();
             if (level >= 4 || families[level][family] != suffix) {
-                FACET_LOG(Warn, "{}: attribute \"{}\" has an invalid suffix sequence; ignored",
-                          m_name, current_prefix);
-                seen.push_back(current_prefix);
+                warnings.add("attributes ignored (invalid suffix sequences)", current_prefix, [&] {
+                    return fmt::format("{}: attribute \"{}\" has an invalid suffix sequence; "
+                                       "ignored",
+                                       m_name, current_prefix);
+                });
+                seen.insert(current_prefix);
                 current = AttributeGroup();
                 family = -1;
                 continue;
@@ -533,6 +605,7 @@ private:
             current.props.push_back(i);
         }
         flush();
+        warnings.log();
         for (const AttributeGroup &g : groups)
             for (size_t i : g.props) reserved[i] = 1;
         return groups;

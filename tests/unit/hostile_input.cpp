@@ -284,3 +284,39 @@ TEST(HostileInput, OutOfMemoryWhileLoadingNamesTheElement) {
     EXPECT_LOCATED_ERROR_IN_CHILD([&] { load_string(xml); }, "string",
                                   "out of memory while reading", 128);
 }
+
+// -- One warning per kind of problem -------------------------------------------------------------
+
+TEST(HostileInput, PlyPropertiesOfOneKindGiveOneWarning) {
+    // 100,000 properties that fit no attribute printed 100,000 warnings (and the search for
+    // names seen before was quadratic in them).
+    TempDir dir;
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
+                      "property float x\nproperty float y\nproperty float z\n";
+    const int unknown = 100000;
+    for (int i = 0; i < unknown; ++i) ply += fmt::format("property uchar quality{}\n", i);
+    ply += "property list uchar float weights\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const float pos[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    for (const auto &p : pos) {
+        ply.append(reinterpret_cast<const char *>(p), sizeof(p));
+        ply.append(size_t(unknown), '\0');
+        ply += '\0'; // an empty list
+    }
+    ply += '\3';
+    for (int32_t i : {0, 1, 2}) ply.append(reinterpret_cast<const char *>(&i), sizeof(i));
+    const std::string path = dir.write("many.ply", ply);
+
+    Properties props("ply");
+    props.set_string("filename", path);
+    const size_t before = Logger::warning_count();
+    ::testing::internal::CaptureStderr();
+    auto shape = PluginRegistry::instance().create(ObjectType::Shape, props);
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_TRUE(shape);
+    EXPECT_EQ(Logger::warning_count() - before, 2u) << log;
+    EXPECT_CONTAINS(log,
+                    "100000 properties of element vertex ignored (attributes are named "
+                    "<name>_<one-letter suffix>): \"quality0\", \"quality1\", \"quality2\", ...");
+    EXPECT_CONTAINS(log, "list property \"weights\" of element vertex ignored");
+}
