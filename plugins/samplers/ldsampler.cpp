@@ -27,7 +27,8 @@ namespace facet {
 
 class LowDiscrepancySampler final : public Sampler {
 public:
-    explicit LowDiscrepancySampler(const Properties &props) : Sampler(props) {
+    explicit LowDiscrepancySampler(const Properties &props)
+        : Sampler(props), m_location(props.location()) {
         if (m_sample_count > MaxCount)
             FACET_THROW_AT(props.location("sample_count"),
                            "ldsampler: sample_count must be at most 2^31 = {} (it is rounded up "
@@ -70,14 +71,16 @@ private:
 
     void round_count() {
         if (m_sample_count > MaxCount)
-            FACET_THROW("ldsampler: the sample count must be at most 2^31 = {} (it is rounded up "
-                        "to a power of two), got {}",
-                        MaxCount, m_sample_count);
+            FACET_THROW_AT(m_location,
+                           "ldsampler: the sample count must be at most 2^31 = {} (it is rounded "
+                           "up to a power of two), got {}",
+                           MaxCount, m_sample_count);
         uint32_t n = 1;
         while (n < m_sample_count) n <<= 1;
         m_sample_count = n;
     }
 
+    Location m_location; ///< where the sampler is declared, for errors at render setup
     uint32_t m_pixel_seed = 0;
 };
 

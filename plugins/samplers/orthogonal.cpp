@@ -41,7 +41,8 @@ namespace facet {
 
 class OrthogonalSampler final : public Sampler {
 public:
-    explicit OrthogonalSampler(const Properties &props) : Sampler(props) {
+    explicit OrthogonalSampler(const Properties &props)
+        : Sampler(props), m_location(props.location()) {
         m_jitter = props.get_bool("jitter", true);
         int64_t strength = props.get_int("strength", 2);
         if (strength < 2 || strength > 8)
@@ -108,9 +109,11 @@ private:
         uint64_t rows = 1;
         for (uint32_t k = 0; k < m_strength; ++k) rows *= p;
         if (rows > UINT32_MAX)
-            FACET_THROW("orthogonal: {}^{} array rows do not fit 32 bits (lower the strength or "
-                        "the sample count)",
-                        p, m_strength);
+            // Also when the render sets a larger count: at the sampler's place in the scene.
+            FACET_THROW_AT(m_location,
+                           "orthogonal: {}^{} array rows do not fit 32 bits (lower the strength or "
+                           "the sample count, {} here)",
+                           p, m_strength, m_sample_count);
         m_rows = uint32_t(rows);
     }
 
@@ -162,6 +165,7 @@ private:
         return (float(stratum) + (float(sub) + jitter(i, j)) / float(stm)) / float(p);
     }
 
+    Location m_location; ///< where the sampler is declared
     bool m_jitter = true;
     uint32_t m_strength = 2, m_resolution = 2, m_rows = 4;
     uint32_t m_pixel_seed = 0;

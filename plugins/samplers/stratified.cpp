@@ -29,7 +29,8 @@ namespace facet {
 
 class StratifiedSampler final : public Sampler {
 public:
-    explicit StratifiedSampler(const Properties &props) : Sampler(props) {
+    explicit StratifiedSampler(const Properties &props)
+        : Sampler(props), m_location(props.location()) {
         m_jitter = props.get_bool("jitter", true);
         if (m_sample_count > MaxCount)
             FACET_THROW_AT(props.location("sample_count"),
@@ -77,9 +78,10 @@ private:
 
     void update_resolution() {
         if (m_sample_count > MaxCount)
-            FACET_THROW("stratified: the sample count must be at most 65535^2 = {} (it is rounded "
-                        "up to a square), got {}",
-                        MaxCount, m_sample_count);
+            FACET_THROW_AT(m_location,
+                           "stratified: the sample count must be at most 65535^2 = {} (it is "
+                           "rounded up to a square), got {}",
+                           MaxCount, m_sample_count);
         m_resolution = uint32_t(std::ceil(std::sqrt(double(m_sample_count)) - 1e-9));
         m_sample_count = m_resolution * m_resolution;
     }
@@ -90,6 +92,7 @@ private:
             qmc::hash_combine(qmc::hash_combine(dim_seed, m_sample_index), axis + 1));
     }
 
+    Location m_location; ///< where the sampler is declared, for errors at render setup
     bool m_jitter = true;
     uint32_t m_resolution = 2;
     uint32_t m_pixel_seed = 0;

@@ -320,3 +320,26 @@ TEST(HostileInput, PlyPropertiesOfOneKindGiveOneWarning) {
                     "<name>_<one-letter suffix>): \"quality0\", \"quality1\", \"quality2\", ...");
     EXPECT_CONTAINS(log, "list property \"weights\" of element vertex ignored");
 }
+
+// -- Errors at render setup ----------------------------------------------------------------------
+
+TEST(HostileInput, SamplerErrorsAtRenderSetupCarryTheSamplersLocation) {
+    // Strength 8 with 4 samples loads (2^8 rows); 1,000 samples per pixel given to the render
+    // need 37^8 rows, more than 32 bits: the error had no location.
+    const std::string xml = "<scene version=\"3.0.0\">\n"
+                            "<sensor type=\"perspective\">\n"
+                            "  <film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/>"
+                            "<integer name=\"height\" value=\"4\"/></film>\n"
+                            "  <sampler type=\"orthogonal\">\n"
+                            "    <integer name=\"strength\" value=\"8\"/>\n"
+                            "    <integer name=\"sample_count\" value=\"4\"/>\n"
+                            "  </sampler>\n"
+                            "</sensor>\n</scene>\n";
+    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
+    ASSERT_TRUE(scene);
+    RenderOptions opts;
+    opts.spp = 1000;
+    Error e = error_of([&] { render_sample_range(*scene->sensors().at(0), opts); });
+    EXPECT_EQ(e.location().to_string(), "string:4:4");
+    EXPECT_CONTAINS(e.message(), "37^8 array rows do not fit 32 bits");
+}
