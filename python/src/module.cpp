@@ -57,8 +57,21 @@ std::string file_text(const std::string &path) {
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+/// A path argument, refused when it holds a NUL character: the C++ side would read it only up to
+/// the NUL, a different file than the one named.
+const std::string &checked_path(const std::string &path, const char *what) {
+    if (path.find('\0') != std::string::npos) {
+        std::string shown = path;
+        for (size_t at; (at = shown.find('\0')) != std::string::npos;) shown.replace(at, 1, "\\0");
+        throw py::value_error(
+            fmt::format("{}: the path \"{}\" contains a NUL character", what, shown));
+    }
+    return path;
+}
+
 LoadOptions load_options(const std::map<std::string, std::string> &params, bool lenient,
                          const std::vector<std::string> &search_path) {
+    for (const std::string &dir : search_path) checked_path(dir, "search_path");
     LoadOptions opts;
     opts.params = params;
     opts.lenient = lenient;
@@ -76,13 +89,16 @@ std::shared_ptr<Scene> as_scene(std::shared_ptr<Object> obj, const std::string &
 
 PyScene load_file_py(const std::string &path, const std::map<std::string, std::string> &params,
                      bool lenient, const std::vector<std::string> &search_path) {
+    checked_path(path, "load_file");
+    LoadOptions opts = load_options(params, lenient, search_path);
     if (!fs::exists(path)) FACET_THROW("scene file \"{}\" does not exist", path);
     PyScene s;
     s.path = fs::absolute(path).lexically_normal().string();
     s.params = params;
     py::gil_scoped_release release;
+    // The loader first: it refuses what is not a regular file (a FIFO would block the read).
+    s.scene = facet::load_scene(path, opts);
     s.text = file_text(path);
-    s.scene = facet::load_scene(path, load_options(params, lenient, search_path));
     return s;
 }
 
@@ -90,9 +106,9 @@ PyScene load_string_py(const std::string &xml, const std::map<std::string, std::
                        bool lenient, const std::vector<std::string> &search_path) {
     PyScene s;
     s.params = params;
+    LoadOptions opts = load_options(params, lenient, search_path);
     py::gil_scoped_release release;
-    s.scene =
-        as_scene(facet::load_string(xml, load_options(params, lenient, search_path)), "string");
+    s.scene = as_scene(facet::load_string(xml, opts), "string");
     return s;
 }
 
@@ -235,6 +251,8 @@ void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast
               const std::map<std::string, std::string> &metadata, const std::string &ocio_config,
               const std::string &display, const std::string &view, const std::string &looks,
               const std::array<int, 4> &window) {
+    checked_path(path, "write");
+    checked_path(ocio_config, "write: ocio_config");
     Image img = from_array(pixels, channels);
     img.x = window[0];
     img.y = window[1];
@@ -252,6 +270,7 @@ void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast
 }
 
 py::tuple read_py(const std::string &path) {
+    checked_path(path, "read");
     Image img;
     {
         py::gil_scoped_release release;
@@ -268,6 +287,7 @@ py::tuple merge_py(const py::list &items) {
         py::handle item = items[i];
         if (py::isinstance<py::str>(item)) {
             std::string path = item.cast<std::string>();
+            checked_path(path, "merge");
             py::gil_scoped_release release;
             parts.push_back(merge::read_part(path));
             continue;
@@ -619,8 +639,9 @@ PYBIND11_MODULE(_facet, m) {
           });
     m.def("merge", &merge_py, py::arg("parts"));
     m.def("plugins", &plugins_py);
-    m.def("add_plugin_dir",
-          [](const std::string &dir) { PluginRegistry::instance().add_search_dir(dir); });
+    m.def("add_plugin_dir", [](const std::string &dir) {
+        PluginRegistry::instance().add_search_dir(checked_path(dir, "add_plugin_dir"));
+    });
     m.def("plugin_search_path", []() { return PluginRegistry::instance().search_path(); });
     m.def("set_log_level", [](const std::string &level) {
         static const std::map<std::string, LogLevel> levels = {
