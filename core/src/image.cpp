@@ -287,8 +287,8 @@ std::vector<unsigned char> encode_pfm(const float *pixels, int width, int height
 
 /// Checks that the temporary file `file` (of the expected size, see replace_image_file()) really
 /// holds the image just encoded, before it replaces anything: OpenImageIO reads it back
-/// completely with the expected size and channel count; a PNG's or PFM's pixels must equal the
-/// ones written. Returns "" or what is wrong.
+/// completely with the expected size and channel count; a PNG's, TIFF's or PFM's pixels must
+/// equal the ones written. Returns "" or what is wrong.
 std::string verify_written(const std::string &file, const OIIO::ImageSpec &spec,
                            const std::string &ext, const void *pixels) {
     // The temporary file's name has no image extension: the reader is chosen by the output's.
@@ -304,8 +304,10 @@ std::string verify_written(const std::string &file, const OIIO::ImageSpec &spec,
         (back.nchannels != spec.nchannels && !dropped_alpha))
         return fmt::format("the written file reads back as {}x{} with {} channels", back.width,
                            back.height, back.nchannels);
-    const bool compare = ext == ".png" || ext == ".pfm";
-    const OIIO::TypeDesc type = ext == ".png" ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
+    // Lossless formats read back the very values written.
+    const bool eight_bit = ext == ".png" || ext == ".tif" || ext == ".tiff";
+    const bool compare = eight_bit || ext == ".pfm";
+    const OIIO::TypeDesc type = eight_bit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
     std::vector<unsigned char> data(back.image_pixels() * size_t(back.nchannels) * type.size());
     bool ok = in->read_image(0, 0, 0, back.nchannels, type, data.data());
     std::string err = ok ? "" : in->geterror();
@@ -365,6 +367,12 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
         if (n == 2 || n == 4) spec.alpha_channel = n - 1;
         if (ext == ".jpg" || ext == ".jpeg") spec.attribute("compression", "jpeg:95");
         spec.attribute("oiio:ColorSpace", "sRGB");
+        // OpenImageIO's TIFF writer puts Exif data (the colour space above becomes
+        // Exif:ColorSpace) in a directory of its own and then reads the main directory back from
+        // the output, which it cannot do through an output proxy (its read callback returns
+        // nothing): the file lost its main directory ("missing required ImageLength"). An 8-bit
+        // TIFF without that tag is read as sRGB anyway.
+        if (ext == ".tif" || ext == ".tiff") spec.attribute("tiff:write_exif", 0);
         pixels = display_pixels.data();
         pixel_type = OIIO::TypeDesc::UINT8;
     }
