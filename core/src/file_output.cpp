@@ -1,8 +1,11 @@
 #include "file_output.h"
 
+#include <facet/image.h>
 #include <facet/logger.h>
 
 #include <cerrno>
+#include <climits>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
@@ -15,10 +18,24 @@ namespace facet::detail {
 
 namespace {
 
+/// The temporary file a write of `path` goes to: ".NAME.tmp-PID" next to it. A name too long
+/// for that (a file name has at most NAME_MAX bytes) keeps the start of NAME and adds a hash of
+/// the whole of it, so that two long names still get different temporary files.
 std::string temp_path_for(const std::string &path) {
     fs::path p(path);
     fs::path dir = p.parent_path();
-    std::string name = "." + p.filename().string() + ".tmp-" + std::to_string(::getpid());
+    std::string base = p.filename().string();
+    const std::string suffix = ".tmp-" + std::to_string(::getpid());
+    if (1 + base.size() + suffix.size() > size_t(NAME_MAX)) {
+        uint64_t h = 0xcbf29ce484222325ull; // FNV-1a
+        for (unsigned char c : base) h = (h ^ c) * 0x100000001b3ull;
+        const std::string tag = fmt::format("~{:016x}", h);
+        size_t keep = size_t(NAME_MAX) - 1 - tag.size() - suffix.size();
+        // Cut at a character boundary of UTF-8, not inside a character.
+        while (keep > 0 && (static_cast<unsigned char>(base[keep]) & 0xC0) == 0x80) --keep;
+        base = base.substr(0, keep) + tag;
+    }
+    std::string name = "." + base + suffix;
     return dir.empty() ? name : (dir / name).string();
 }
 
@@ -57,6 +74,8 @@ std::string write_bytes(const std::string &file, const std::vector<unsigned char
 
 } // namespace
 
+std::string temp_file_for(const std::string &path) { return temp_path_for(path); }
+
 void replace_image_file(const std::string &path, const std::vector<unsigned char> &bytes,
                         const std::function<std::string(const std::string &)> &verify) {
     const std::string tmp = temp_path_for(path);
@@ -81,3 +100,35 @@ void replace_image_file(const std::string &path, const std::vector<unsigned char
 }
 
 } // namespace facet::detail
+
+namespace facet {
+
+void check_output_file(const std::string &path) {
+    fs::path p(path);
+    std::error_code ec;
+    if (fs::is_directory(p, ec)) FACET_THROW("cannot write image \"{}\": it is a directory", path);
+    if (p.filename().empty()) FACET_THROW("cannot write image \"{}\": it has no file name", path);
+    if (p.filename().string().size() > size_t(NAME_MAX))
+        FACET_THROW("cannot write image \"{}\": its file name has {} bytes, more than the {} a "
+                    "file name can have",
+                    path, p.filename().string().size(), NAME_MAX);
+    const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    if (!fs::is_directory(dir, ec))
+        FACET_THROW("cannot write image \"{}\": the folder \"{}\" does not exist", path,
+                    dir.string());
+    const fs::file_status st = fs::status(p, ec);
+    if (fs::exists(st) && !fs::is_regular_file(st))
+        FACET_THROW("cannot write image \"{}\": it exists and is not a regular file", path);
+    // The write creates its temporary file next to the output and renames it: creating that
+    // very file proves both (a folder without write permission, a read-only file system, a name
+    // too long, ...).
+    const std::string tmp = detail::temp_file_for(path);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0)
+        FACET_THROW("cannot write image \"{}\": cannot create a file in the folder \"{}\": {}",
+                    path, dir.string(), std::strerror(errno));
+    ::close(fd);
+    std::remove(tmp.c_str());
+}
+
+} // namespace facet

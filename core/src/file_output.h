@@ -16,4 +16,8 @@ namespace facet::detail {
 void replace_image_file(const std::string &path, const std::vector<unsigned char> &bytes,
                         const std::function<std::string(const std::string &)> &verify);
 
+/// The temporary file replace_image_file() writes `path` through (".NAME.tmp-PID" next to it,
+/// NAME shortened and made unique by a hash where the whole would exceed NAME_MAX).
+std::string temp_file_for(const std::string &path);
+
 } // namespace facet::detail

@@ -60,6 +60,10 @@ void write_image(const std::string &path, const Image &image, const ImageWriteOp
 /// or an extension no writer knows (.pfm is written by facet itself, the rest by OpenImageIO).
 /// Lets a command refuse a bad output name before a long render.
 void check_image_path(const std::string &path);
+/// Proves that write_image() can replace `path`: it is not a directory (nor another non-regular
+/// file), its folder exists, and the temporary file the write goes through can be created there
+/// (it is created and removed). Throws "cannot write image" with the reason.
+void check_output_file(const std::string &path);
 /// check_image_path(), and for 8-bit formats resolve_display_view(): a wrong display, view or
 /// look name fails before a long render. Warns when display options meet a linear format.
 void check_image_output(const std::string &path, const ImageWriteOptions &opts);
