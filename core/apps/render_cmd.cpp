@@ -4,6 +4,7 @@
 
 #include <facet/film.h>
 #include <facet/image.h>
+#include <facet/integrator.h>
 #include <facet/logger.h>
 #include <facet/output_metadata.h>
 #include <facet/plugin.h>
@@ -25,6 +26,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -109,13 +111,85 @@ std::string output_path(const std::string &scene, const std::string &out, const 
     return path.string();
 }
 
-/// Catches a bad output name (or display, view, look) before a long render rather than after it.
-void check_output(const std::string &path, const ImageWriteOptions &wopts) {
+/// A one-pixel image with the channels of the image `facet render` writes: the film's own
+/// colour channels (a one-pixel develop of the sensor's film: a film plugin names them), the
+/// integrator's AOVs, and the raw sums of a part of a split render. The film's crop window is
+/// the scene file's afterwards (the render sets its own).
+struct ChannelsProbe {
+    Image image;
+    size_t colour = 0, aovs = 0; ///< the first `colour` channels, then `aovs`, then raw sums
+};
+
+ChannelsProbe output_channels_probe(const Scene &scene, const Sensor &sensor, bool part) {
+    Film &film = sensor.film();
+    std::vector<std::string> aovs;
+    if (auto sampling = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator()))
+        aovs = sampling->aov_names();
+    film.set_crop_window(Point2i(0, 0), Point2i(1, 1));
+    film.prepare(aovs);
+    ChannelsProbe probe;
+    probe.image = film.develop();
+    probe.aovs = aovs.size();
+    probe.colour = size_t(probe.image.channels) - aovs.size();
+    if (part) {
+        const std::vector<std::string> raw = film.raw_channel_names();
+        Image with_raw(1, 1, probe.image.channels + int(raw.size()));
+        with_raw.x = probe.image.x;
+        with_raw.y = probe.image.y;
+        with_raw.full_width = probe.image.full_width;
+        with_raw.full_height = probe.image.full_height;
+        with_raw.channel_names = probe.image.channel_names;
+        with_raw.channel_names.insert(with_raw.channel_names.end(), raw.begin(), raw.end());
+        probe.image = std::move(with_raw);
+    }
+    film.reset_crop_window();
+    return probe;
+}
+
+/// Proves before a long render that its output can be written, rather than failing after it:
+/// the name (not a directory, fits a file name with its temporary name), the folder (exists, a
+/// file can be created there), the display, view and looks of 8-bit formats, channel names that
+/// differ (Mitsuba refuses duplicates too: an AOV called "R" would hide the red channel), and a
+/// trial write of a one-pixel image with the output's format, channels and options through the
+/// same writer (encoded, written, read back, renamed) to a scratch name next to the output.
+void check_output(const std::string &path, const ImageWriteOptions &wopts, const Scene &scene,
+                  const Sensor &sensor, const std::string &scene_file, bool part) {
+    check_output_file(path);
+    check_image_output(path, wopts);
+
+    const ChannelsProbe probe = output_channels_probe(scene, sensor, part);
+    const std::vector<std::string> &names = probe.image.channel_names;
+    auto kind = [&probe](size_t c) {
+        return c < probe.colour                ? "a colour channel of the film"
+               : c < probe.colour + probe.aovs ? "another AOV"
+                                               : "a raw channel of a part";
+    };
+    for (size_t i = 0; i < names.size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (names[i] == names[j]) {
+                // j < i: the AOV is i, unless i is a raw channel (then j is the AOV).
+                const bool raw_i = i >= probe.colour + probe.aovs;
+                FACET_THROW("{}: the integrator's AOV \"{}\" has the name of {}: channel names "
+                            "must be unique, rename the AOV",
+                            scene_file, names[i], kind(raw_i ? i : j));
+            }
+
     fs::path p(path);
-    fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-    if (!fs::is_directory(dir))
-        FACET_THROW("cannot write \"{}\": folder \"{}\" does not exist", path, dir.string());
-    check_image_output(path, wopts); // PFM has no OpenImageIO writer: facet writes it itself
+    const fs::path trial =
+        p.parent_path() / fmt::format(".facet-check-{}{}", ::getpid(), p.extension().string());
+    try {
+        sensor.film().write(probe.image, trial.string(), wopts);
+    } catch (const std::exception &e) {
+        std::error_code ec;
+        fs::remove(trial, ec);
+        std::string why = e.what();
+        // The writer's message names the scratch file; say it of the output.
+        for (size_t at; (at = why.find(trial.string())) != std::string::npos;)
+            why.replace(at, trial.string().size(), path);
+        FACET_THROW("{} (a trial write of one pixel, before rendering)", why);
+    }
+    std::error_code ec;
+    fs::remove(trial, ec);
 }
 
 std::string format_seconds(double s) {
@@ -186,7 +260,8 @@ int render_main(int argc, char **argv) {
     wopts.display = display;
     wopts.view = view;
     wopts.looks = looks;
-    check_output(out, wopts);
+    const bool part = pass_count > 1 && app.count("--pass") > 0; // raw sums follow
+    check_output(out, wopts, *scene, sensor, opts.scene, part);
 
     RenderOptions ropts;
     ropts.threads = opts.threads;
@@ -236,8 +311,13 @@ int render_main(int argc, char **argv) {
                            std::istreambuf_iterator<char>());
     const std::string scene_hash = scene_identity(scene_text, params, film.size().x, film.size().y);
 
-    // From here on Ctrl-C stops the render and the partial image is written.
+    // From here on Ctrl-C, SIGTERM and SIGHUP stop the render and the partial image is written;
+    // from the end of the render to the rename of the output, no signal is fatal (the write
+    // finishes, or removes its temporary file), and facet exits 128 + the signal after it.
     install_interrupt_handler(&cancel);
+    struct HandlerGuard {
+        ~HandlerGuard() { uninstall_interrupt_handler(); }
+    } handler_guard;
     if (!opts.quiet) {
         const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
         const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
@@ -261,14 +341,10 @@ int render_main(int argc, char **argv) {
     RenderResult result;
     // The module that writes the output loads while the render runs, from its first pixels on.
     ropts.on_first_block = [out] { preload_image_writer(out); };
-    try {
-        result = render(*scene, sensor, ropts);
-        result.load_seconds = load_seconds;
-    } catch (...) {
-        uninstall_interrupt_handler();
-        throw;
-    }
-    uninstall_interrupt_handler();
+    result = render(*scene, sensor, ropts);
+    defer_interrupts();
+    const bool signal_in_render = interrupt_signal() != 0;
+    result.load_seconds = load_seconds;
 
     wopts.metadata = render_metadata(result);
     wopts.metadata["facet:scene_hash"] = scene_hash;
@@ -281,7 +357,13 @@ int render_main(int argc, char **argv) {
             fmt::format("{}/{}", result.blocks_done, result.blocks_total);
     cli::set_activity(fmt::format("writing \"{}\"", out));
     const auto write_start = std::chrono::steady_clock::now();
-    film.write(result.image, out, wopts);
+    std::string write_error;
+    try {
+        film.write(result.image, out, wopts);
+    } catch (const std::exception &e) {
+        if (interrupt_signal() == 0) throw;
+        write_error = e.what(); // said with the signal, below
+    }
     const double write_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
     if (!opts.quiet) {
@@ -312,19 +394,32 @@ int render_main(int argc, char **argv) {
     const std::string reached =
         fmt::format("{} of {} spp{}", result.spp, result.spp_target,
                     result.spp == 0 ? ", no pass finished: the image is black" : "");
+    if (const int sig = interrupt_signal(); sig != 0) {
+        // One line: the signal, when it came, and what is in the output file.
+        const std::string what =
+            result.cancelled && !result.timed_out ? fmt::format("the partial image ({})", reached)
+            : result.timed_out ? fmt::format("the image of the timeout ({})", reached)
+                               : fmt::format("the complete image ({})", reached);
+        const std::string when =
+            signal_in_render ? "after " + format_seconds(result.seconds) : "while writing";
+        const char *verb = sig == SIGTERM  ? "terminated"
+                           : sig == SIGHUP ? "hung up"
+                                           : "interrupted";
+        if (write_error.empty())
+            std::fprintf(stderr, "facet: %s (%s) %s: wrote %s to %s\n", verb,
+                         interrupt_signal_name(sig), when.c_str(), what.c_str(), out.c_str());
+        else
+            std::fprintf(stderr, "facet: %s (%s) %s: %s was not written: %s\n", verb,
+                         interrupt_signal_name(sig), when.c_str(), what.c_str(),
+                         write_error.c_str());
+        return 128 + sig;
+    }
     if (result.timed_out) {
         // The integrator's `timeout` is a request, not an interruption: success.
         if (!opts.quiet)
             fmt::print("Timeout reached after {} ({}), wrote {}\n", format_seconds(result.seconds),
                        reached, out);
         return 0;
-    }
-    if (result.cancelled) {
-        const int sig = interrupt_signal();
-        std::fprintf(stderr, "facet: %s after %s: wrote the partial image (%s) to %s\n",
-                     sig == SIGTERM ? "terminated" : "interrupted",
-                     format_seconds(result.seconds).c_str(), reached.c_str(), out.c_str());
-        return 128 + (sig > 0 ? sig : SIGINT);
     }
     if (!opts.quiet) fmt::print("Rendered in {}, wrote {}\n", format_seconds(result.seconds), out);
     return 0;

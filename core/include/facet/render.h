@@ -109,12 +109,19 @@ std::string scene_identity(const std::string &scene_text,
                            const std::map<std::string, std::string> &params, int film_width,
                            int film_height);
 
-/// Installs SIGINT/SIGHUP/SIGTERM handlers that set `flag` (restored by
-/// uninstall_interrupt_handler). A second signal of the same kind takes its default action.
+/// Installs SIGINT/SIGHUP/SIGTERM handlers that set `flag` and record the first signal (restored
+/// by uninstall_interrupt_handler). While rendering, a second signal of the same kind takes its
+/// default action (force quit); after defer_interrupts() no signal is fatal any more.
 void install_interrupt_handler(std::atomic<bool> *flag);
+/// From now on (the write of the output: encoding, writing, fsync, read-back and rename) every
+/// signal, repeated or not, is only recorded; the caller exits after the write, 128 + the signal.
+void defer_interrupts();
 void uninstall_interrupt_handler();
-/// The signal that set the flag since install_interrupt_handler() (0: none).
+/// The first signal received since install_interrupt_handler() (0: none); kept after the
+/// uninstall.
 int interrupt_signal();
+/// "SIGINT", "SIGHUP" or "SIGTERM".
+const char *interrupt_signal_name(int sig);
 
 // ---------------------------------------------------------------------------------------------
 // Building blocks of integrators' render loops
