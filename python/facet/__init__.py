@@ -9,7 +9,8 @@
 
 Errors are ``facet.Error`` (a RuntimeError) whose message starts with the scene location
 (``scene.xml:12:5: ...``, also in its ``file``, ``line`` and ``column`` attributes). A render
-releases the GIL; Ctrl-C stops it and raises KeyboardInterrupt.
+releases the GIL; Ctrl-C stops it and raises KeyboardInterrupt, whose ``partial`` attribute is
+the Image of the passes done.
 """
 
 import os as _os

@@ -136,15 +136,19 @@ Image from_array(const py::array_t<float, py::array::c_style | py::array::forcec
 
 /// Runs `fn` on a thread of its own while this thread waits with the GIL released, checking for
 /// Python signals (Ctrl-C) every 50 ms when it is the main thread. On a signal, `cancel` is set,
-/// the render is waited for and the Python exception (KeyboardInterrupt) is raised.
-template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel, Fn fn,
-                                              const std::function<void()> &poll = nullptr) {
+/// the Python exception (KeyboardInterrupt) is kept in `interrupt`, and fn's result (the render
+/// stopped early) is returned all the same, for the caller to attach to it; further Ctrl-C while
+/// the render stops are absorbed (one KeyboardInterrupt, not one in the caller's handler too).
+/// An error of fn after the signal gives way to the KeyboardInterrupt. `poll` (the progress
+/// callback) runs with the GIL at the same times; an exception it raises stops the render the
+/// same way and is kept in `interrupt` instead.
+template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel,
+                                              std::optional<py::error_already_set> &interrupt,
+                                              Fn fn, const std::function<void()> &poll = nullptr) {
     using R = decltype(fn());
     std::packaged_task<R()> task(std::move(fn));
     std::future<R> future = task.get_future();
     std::thread worker(std::move(task));
-    bool interrupted = false;
-    std::optional<py::error_already_set> pending;
     for (;;) {
         bool ready;
         {
@@ -152,24 +156,30 @@ template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel, Fn fn,
             ready = future.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
         }
         if (ready) break;
-        if (poll && !interrupted) {
+        if (poll && !interrupt) {
             try {
                 poll(); // the progress callback, with the GIL
             } catch (py::error_already_set &e) {
-                interrupted = true; // the callback raised: stop, and raise that
-                pending.emplace(std::move(e));
+                interrupt.emplace(std::move(e)); // the callback raised: stop, and raise that
                 cancel = true;
             }
         }
-        if (!interrupted && PyErr_CheckSignals() != 0) {
-            interrupted = true;
-            pending.emplace(); // takes the KeyboardInterrupt
-            cancel = true;
+        if (PyErr_CheckSignals() != 0) {
+            if (!interrupt) {
+                interrupt.emplace(); // takes the KeyboardInterrupt
+                cancel = true;
+            } else {
+                PyErr_Clear();
+            }
         }
     }
     worker.join();
-    if (interrupted) throw *pending;
-    return future.get(); // rethrows the render's exception
+    if (!interrupt) return future.get(); // rethrows the render's exception
+    try {
+        return future.get();
+    } catch (...) {
+        throw *interrupt;
+    }
 }
 
 py::dict metadata_dict(const std::map<std::string, std::string> &m) {
@@ -224,8 +234,9 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
 
     std::shared_ptr<Scene> keep = s.scene; // alive while the render thread runs
     std::shared_ptr<std::mutex> mutex = s.render_mutex;
+    std::optional<py::error_already_set> interrupt;
     RenderResult result = run_interruptible(
-        cancel,
+        cancel, interrupt,
         [keep, mutex, lock, &sensor, opts]() {
             std::lock_guard<std::mutex> lock(*mutex);
             return render(*keep, sensor, opts);
@@ -240,10 +251,22 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     meta["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
     if (!s.path.empty()) meta["facet:scene"] = s.path;
     meta["facet:seed"] = std::to_string(seed);
-    if (result.timed_out)
+    if (result.cancelled)
         meta["facet:blocks"] = fmt::format("{}/{}", result.blocks_done, result.blocks_total);
-    return py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
-                          sensor.film().half(), window_of(result.image));
+    py::tuple image =
+        py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
+                       sensor.film().half(), window_of(result.image));
+    if (interrupt) {
+        // Ctrl-C stopped the render: the passes done go with the KeyboardInterrupt, as the
+        // facet.Image `partial` (as `facet render` writes them to its output).
+        try {
+            interrupt->value().attr("partial") = py::module_::import("facet").attr("Image")(*image);
+        } catch (py::error_already_set &) {
+            interrupt->value().attr("partial") = image; // the module alone, without the package
+        }
+        throw *interrupt;
+    }
+    return image;
 }
 
 void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast> &pixels,

@@ -147,6 +147,35 @@ def test_ctrl_c_stops_the_render(cornell):
     assert facet.render(facet.load_file(cornell, **SMALL)).pixels.shape == (48, 48, 3)
 
 
+def test_ctrl_c_raises_promptly_with_the_partial_image(cornell):
+    """The KeyboardInterrupt of a stopped render carries the passes done as `partial`, a
+    facet.Image like the one render() returns (what `facet render` writes on Ctrl-C), and comes
+    within a second of the signal."""
+    scene = facet.load_file(cornell, res=64, spp=100000, max_depth=4)
+    sent = []
+
+    def ctrl_c():
+        sent.append(time.monotonic())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(1.0, ctrl_c)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt) as info:
+        facet.render(scene, threads=2)
+    raised = time.monotonic()
+    timer.join()
+    assert raised - sent[0] < 1.0, f"KeyboardInterrupt {raised - sent[0]:.2f} s after Ctrl-C"
+    partial = info.value.partial
+    assert isinstance(partial, facet.Image)
+    assert partial.pixels.shape == (64, 64, 3)
+    assert partial.channels == ["R", "G", "B"]
+    spp = int(partial.metadata["facet:spp"])
+    assert 1 <= spp < 100000
+    assert partial.metadata["facet:spp_target"] == "100000"
+    assert "facet:blocks" in partial.metadata
+    assert np.isfinite(partial.pixels).all() and partial.pixels.mean() > 0.0
+
+
 def test_render_releases_the_gil(cornell):
     """Python code runs while a render is in progress on another thread: with the GIL held for
     the whole render, this loop could not run until the render returned."""
