@@ -344,8 +344,12 @@ TEST_F(OutputSafety, TimeoutAndSignalWriteThePartialImageTheSameWay) {
 // check_output: refused before rendering, not after it
 
 TEST_F(OutputSafety, AnOutputThatIsADirectoryIsRefusedBeforeRendering) {
-    fs::create_directories(m_dir / "out.exr");
-    expect_refused("-o out.exr", "is a directory");
+    // `-o a_folder` writes the scene's name into the folder (as Mitsuba does), so the output
+    // that is a directory is the one that name gives: scene.exr, next to scene.xml.
+    fs::create_directories(m_dir / "scene.exr");
+    expect_refused("", "is a directory");
+    fs::create_directories(m_dir / "out" / "scene.exr");
+    expect_refused("-o out", "is a directory");
 }
 
 TEST_F(OutputSafety, AMissingFolderIsRefusedBeforeRendering) {
