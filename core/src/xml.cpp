@@ -383,9 +383,7 @@ public:
     }
 
     SceneInfo info_file(const std::string &path) {
-        bool ok = false;
-        std::string text = read_text_file(path, ok);
-        if (!ok) FACET_THROW("could not open XML file \"{}\"", path);
+        std::string text = read_file(path, "scene file", MaxFileBytes);
         fs::path dir = fs::path(path).parent_path();
         SourceFile *src = add_source(path, dir, canonical_name(path), std::move(text));
         ResolverGuard guard;
