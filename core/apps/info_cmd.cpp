@@ -50,7 +50,10 @@ int info_main(int argc, char **argv) {
         if (eq == 0) FACET_THROW("-D \"{}\" has no parameter name before '='", define);
         load.params[define.substr(0, eq)] = define.substr(eq + 1);
     }
-    if (!fs::exists(scene)) FACET_THROW("scene file \"{}\" does not exist", scene);
+    std::error_code exists_error; // e.g. a name over NAME_MAX
+    if (!fs::exists(scene, exists_error))
+        FACET_THROW("scene file \"{}\" {}", scene,
+                    exists_error ? exists_error.message() : std::string("does not exist"));
     const facet::SceneInfo info = facet::scene_info(scene, load);
     if (sensor < 0 || size_t(sensor) >= info.sensors.size())
         FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor,

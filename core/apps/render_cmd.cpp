@@ -86,7 +86,10 @@ std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
         load.params[define.substr(0, eq)] = define.substr(eq + 1);
     }
 
-    if (!fs::exists(opts.scene)) FACET_THROW("scene file \"{}\" does not exist", opts.scene);
+    std::error_code exists_error; // e.g. a name over NAME_MAX
+    if (!fs::exists(opts.scene, exists_error))
+        FACET_THROW("scene file \"{}\" {}", opts.scene,
+                    exists_error ? exists_error.message() : std::string("does not exist"));
     // The first call fixes Embree's thread count; it must come before the scene builds its BVH.
     embree_device(opts.threads);
     set_activity(fmt::format("loading \"{}\"", opts.scene));
@@ -104,7 +107,9 @@ using namespace facet;
 std::string output_path(const std::string &scene, const std::string &out, const Film &film) {
     fs::path path = out.empty() ? fs::path(scene) : fs::path(out);
     // -o a folder (existing, or named with a trailing '/'): the scene's name in that folder.
-    const bool folder = !out.empty() && (out.back() == '/' || fs::is_directory(path));
+    // (An error such as a name over NAME_MAX is no folder; check_output says what is wrong.)
+    std::error_code ec;
+    const bool folder = !out.empty() && (out.back() == '/' || fs::is_directory(path, ec));
     if (folder) path = path / fs::path(scene).filename();
     if (out.empty() || folder || !path.has_extension())
         path.replace_extension(film.default_extension());
@@ -291,7 +296,18 @@ int render_main(int argc, char **argv) {
     }
     std::atomic<bool> cancel{false};
     ropts.cancel = &cancel;
-    const SampleRange range = render_sample_range(sensor, ropts);
+    SampleRange range;
+    try {
+        range = render_sample_range(sensor, ropts);
+    } catch (const Error &e) {
+        if (e.location().valid()) throw; // a sampler's error, at its place in the scene
+        // Else the sample count and the parts come from these options: name them.
+        const std::string count =
+            spp > 0 ? fmt::format("--spp {}", spp)
+                    : fmt::format("the sampler's sample_count {}", sensor.sampler().sample_count());
+        const std::string parts = pass_count > 0 ? fmt::format(", --passes {}", pass_count) : "";
+        FACET_THROW("{}{}: {}", count, parts, e.message());
+    }
     const uint64_t asked = uint64_t(spp > 0 ? uint32_t(spp) : sensor.sampler().sample_count()) *
                            uint64_t(ropts.pass_count);
     // The sampler's rounding, said where the spp is printed.

@@ -153,3 +153,33 @@ TEST(HostileCli, FilmTooLarge) {
     EXPECT_NE(err.find("1000000x1000000 pixels, more than"), std::string::npos) << err;
     fs::remove_all(dir);
 }
+
+// Errors that come from the command line rather than the scene name the option they come from,
+// also for a scene name the file system refuses (it was an uncaught "File name too long").
+TEST(HostileCli, OptionErrorsNameTheirOption) {
+    fs::path dir = fs::temp_directory_path() / ("facet_hostile_opts_" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    std::ofstream(dir / "scene.xml") << scene("<shape type=\"sphere\"/>");
+    const struct {
+        std::string args, message;
+    } cases[] = {
+        {"scene.xml --passes 600000000", "the sampler's sample_count 4, --passes 600000000: "},
+        {"scene.xml --spp 4096 --passes 3000000 --pass 0",
+         "--spp 4096, --passes 3000000: 3000000 passes of 4096 samples per pixel are too many"},
+        {std::string(300, 'n') + ".xml", "File name too long"},
+    };
+    for (const auto &c : cases) {
+        SCOPED_TRACE(c.args);
+        std::string cmd = "cd '" + dir.string() + "' && '" + FACET + "' render -q -o out.exr " +
+                          c.args + " > out.txt 2> err.txt < /dev/null";
+        int status = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal";
+        EXPECT_EQ(WEXITSTATUS(status), 1);
+        std::string err = read_file(dir / "err.txt");
+        EXPECT_EQ(err.find("facet: error: "), 0u) << err;
+        EXPECT_NE(err.find(c.message), std::string::npos) << err;
+        EXPECT_EQ(err.find('\n'), err.size() - 1) << "more than one line: " << err;
+        EXPECT_FALSE(fs::exists(dir / "out.exr"));
+    }
+    fs::remove_all(dir);
+}
