@@ -890,7 +890,15 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string &path) {
     FACET_THROW("cannot read image \"{}\": {}", path, error);
 }
 
-Image read_pixels(const std::string &path) {
+/// How read_pixels() reads: the checked header only, or the pixels; where the values are
+/// bytes (8-bit, one type for every channel, scanlines), into `bytes` as stored when given.
+struct PixelRead {
+    bool header_only = false;
+    std::vector<uint8_t> *bytes = nullptr;
+    bool keeps_bytes = false; ///< out: the values are (or would be) read into `bytes`
+};
+
+Image read_pixels(const std::string &path, PixelRead &how) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec))
         FACET_THROW("cannot read image \"{}\": {}", path,
@@ -959,13 +967,23 @@ Image read_pixels(const std::string &path) {
     // 64 MB buffer it allocates for every read, however small the image.
     const bool native_layout = spec.tile_width <= 0 && spec.channelformats.empty();
     const bool convert_here = native_layout && spec.format != OIIO::TypeDesc::FLOAT;
+    // Bytes as stored: the values convert_here would convert, unconverted.
+    how.keeps_bytes = convert_here && spec.format == OIIO::TypeDesc::UINT8;
+    if (how.header_only) return img;
+    std::vector<uint8_t> *bytes = how.keeps_bytes ? how.bytes : nullptr;
     std::vector<unsigned char> native;
     bool ok = true;
     for (int y0 = 0; ok && y0 < spec.height; y0 += band) {
         const int y1 = std::min(spec.height, y0 + std::max(band, 1));
+        const size_t values = size_t(y1 - y0) * row;
+        if (bytes) {
+            bytes->resize(size_t(y1) * row);
+            ok = in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0, spec.nchannels,
+                                    OIIO::TypeDesc::UNKNOWN, bytes->data() + size_t(y0) * row);
+            continue;
+        }
         img.data.resize(size_t(y1) * row);
         float *dst = img.data.data() + size_t(y0) * row;
-        const size_t values = size_t(y1 - y0) * row;
         if (spec.tile_width > 0) {
             ok = in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1, spec.z,
                                 spec.z + 1, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, dst);
@@ -989,16 +1007,48 @@ Image read_pixels(const std::string &path) {
 
 } // namespace
 
-Image read_image(const std::string &path) {
+namespace {
+
+Image read_pixels_or_throw(const std::string &path, PixelRead &how) {
     // A size that passed every check can still be more than the machine has (a TIFF strip of
     // many more rows than the image, say, which OpenImageIO buffers whole).
     try {
-        return read_pixels(path);
+        return read_pixels(path, how);
     } catch (const std::bad_alloc &) {
         FACET_THROW("cannot read image \"{}\": out of memory (a size the file gives is more "
                     "than this machine can allocate)",
                     path);
     }
+}
+
+} // namespace
+
+Image read_image(const std::string &path) {
+    PixelRead how;
+    return read_pixels_or_throw(path, how);
+}
+
+ImageHeader read_image_header(const std::string &path) {
+    PixelRead how;
+    how.header_only = true;
+    ImageHeader header;
+    header.image = read_pixels_or_throw(path, how);
+    header.bytes = how.keeps_bytes;
+    return header;
+}
+
+ByteImage read_image_bytes(const std::string &path) {
+    ByteImage out;
+    PixelRead how;
+    how.bytes = &out.bytes;
+    out.image = read_pixels_or_throw(path, how);
+    // Each byte value as the float path converts it (the same conversion, value by value).
+    uint8_t all[256];
+    for (int i = 0; i < 256; ++i) all[i] = uint8_t(i);
+    if (!OIIO::convert_pixel_values(OIIO::TypeDesc::UINT8, all, OIIO::TypeDesc::FLOAT,
+                                    out.values.data(), 256))
+        FACET_THROW("cannot read image \"{}\": OpenImageIO cannot convert bytes to floats", path);
+    return out;
 }
 
 std::string ocio_config_path(const std::string &explicit_path) {
@@ -1067,6 +1117,7 @@ facet_image_library() {
         &facet::ocio_displays,       &facet::resolve_display_view,
         &facet::read_image,          &facet::read_image_file,
         &facet::ocio_config_path,    [] { return versions.c_str(); },
+        &facet::read_image_header,   &facet::read_image_bytes,
     };
     return &table;
 }

@@ -188,6 +188,10 @@ Image read_image(const std::string &path) { return library().read_image(path); }
 
 ImageFile read_image_file(const std::string &path) { return library().read_image_file(path); }
 
+ImageHeader read_image_header(const std::string &path) { return library().read_image_header(path); }
+
+ByteImage read_image_bytes(const std::string &path) { return library().read_image_bytes(path); }
+
 std::string ocio_config_path(const std::string &explicit_path) {
     return library().ocio_config_path(explicit_path);
 }

@@ -30,6 +30,8 @@ struct ImageLibrary {
     ImageFile (*read_image_file)(const std::string &);
     std::string (*ocio_config_path)(const std::string &);
     const char *(*versions)();
+    ImageHeader (*read_image_header)(const std::string &);
+    ByteImage (*read_image_bytes)(const std::string &);
 };
 
 /// libfacet_exr's table.
@@ -43,7 +45,7 @@ struct ExrLibrary {
 } // namespace facet::detail
 
 /// Bump when ImageLibrary changes.
-#define FACET_IMAGE_LIBRARY_VERSION 1
+#define FACET_IMAGE_LIBRARY_VERSION 2
 /// The one symbol libfacet_image exports.
 #define FACET_IMAGE_LIBRARY_ENTRY "facet_image_library"
 /// Bump when ExrLibrary changes.

@@ -3,6 +3,8 @@
 #include <facet/assert.h>
 #include <facet/transform.h>
 
+#include <array>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -94,6 +96,27 @@ DisplayView resolve_display_view(const ImageWriteOptions &opts);
 
 /// Reads any format OpenImageIO knows; 8-bit images are returned as stored (no decoding).
 Image read_image(const std::string &path);
+
+/// What an image file declares, read and checked as read_image() checks it (a size that wraps
+/// or exceeds allocation_limit(), the hostile headers it refuses) without reading a pixel: the
+/// size of an image is known before any memory is spent on it.
+struct ImageHeader {
+    Image image;        ///< sizes, windows and channel names; no pixels
+    bool bytes = false; ///< read_image_bytes() keeps its values as stored, a byte each
+};
+ImageHeader read_image_header(const std::string &path);
+
+/// An image read as read_image() reads it, but with its values kept as stored where they are
+/// bytes (8-bit files read by scanlines, all channels of one type: ImageHeader::bytes): a
+/// quarter of the memory, and the same values through `values`.
+struct ByteImage {
+    /// Sizes, windows and channel names; its pixels only when `bytes` is empty (a file whose
+    /// values are not bytes).
+    Image image;
+    std::vector<uint8_t> bytes;      ///< the interleaved values as stored
+    std::array<float, 256> values{}; ///< the float read_image() gives each byte value
+};
+ByteImage read_image_bytes(const std::string &path);
 
 /// An image file with what read_image() leaves out: how it stores its channels and its
 /// attributes (as `facet merge` reads the parts of a split render).
