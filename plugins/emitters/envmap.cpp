@@ -44,6 +44,7 @@ scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba
 #include <facet/plugin.h>
 #include <facet/resolver.h>
 #include <facet/scene.h>
+#include <facet/texture_image.h>
 #include <facet/transform.h>
 #include <facet/warp.h>
 
@@ -83,12 +84,15 @@ public:
         m_bilinear = filter == "bilinear";
         m_importance = props.get_bool("importance_sampling", true);
 
-        Image img;
+        // Read through the process's image cache: its memory budget is checked before the
+        // pixels are read, and a file another reference holds is not read again.
+        std::shared_ptr<const Image> shared;
         try {
-            img = read_image(m_path);
+            shared = read_shared_image(m_path);
         } catch (const Error &e) {
             FACET_THROW_AT(props.location("filename"), "envmap: {}", e.what());
         }
+        const Image &img = *shared;
         if (img.width < 2 || img.height < 3)
             FACET_THROW_AT(props.location("filename"),
                            "envmap: \"{}\" is {}x{} pixels; an environment map needs at least 2x3 "

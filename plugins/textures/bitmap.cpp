@@ -37,11 +37,11 @@ value, or the luminance of a colour image.
 ```
 )DOC";
 
-#include <facet/image.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/resolver.h>
 #include <facet/texture.h>
+#include <facet/texture_image.h>
 #include <facet/transform.h>
 
 #include <fmt/format.h>
@@ -50,7 +50,6 @@ value, or the luminance of a colour image.
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <vector>
 
 namespace facet {
 
@@ -58,23 +57,6 @@ namespace {
 
 enum class FilterType { Nearest, Bilinear };
 enum class WrapMode { Repeat, Mirror, Clamp };
-
-/// sRGB electro-optical transfer function (IEC 61966-2-1): encoded value -> linear.
-float srgb_to_linear(float v) {
-    if (v <= 0.04045f) return v * (1.f / 12.92f);
-    return std::pow((v + 0.055f) * (1.f / 1.055f), 2.4f);
-}
-
-/// v rounded to the nearest IEEE half-precision value (ties to even; overflow to infinity).
-float round_to_half(float v) {
-    if (!std::isfinite(v) || v == 0.f) return v;
-    float a = std::fabs(v);
-    if (a >= 65520.f) return std::copysign(Infinity, v);
-    int e;
-    std::frexp(a, &e); // a = m 2^e with m in [0.5, 1): 11 significant bits, subnormals below 2^-14
-    int spacing = std::max(e - 11, -24);
-    return std::copysign(std::ldexp(std::nearbyint(std::ldexp(a, -spacing)), spacing), v);
-}
 
 /// Formats whose pixels are scene-linear floating-point values.
 bool is_linear_format(const std::string &path) {
@@ -121,38 +103,52 @@ public:
         m_uv_matrix[3] = m[1][0], m_uv_matrix[4] = m[1][1], m_uv_matrix[5] = m[1][3];
 
         m_path = file_resolver().resolve(m_filename);
-        Image image;
+        // As in Mitsuba, `auto` stores images of 16 bits per channel or fewer in half precision
+        // (after decoding). Integer formats are; a half EXR already holds half values, and
+        // float HDR/PFM/EXR files keep 32 bits. Every bitmap of the same file and decoding
+        // shares one copy of the texels (8-bit files keep a byte per value).
+        const bool linear = is_linear_format(m_path);
+        TexelDecoding how;
+        how.srgb = !m_raw && !linear;
+        how.half = format == "fp16" || (format == "auto" && !linear);
         try {
-            image = read_image(m_path);
+            m_texels = load_texels(m_path, how);
         } catch (const Error &e) {
             FACET_THROW_AT(props.location("filename"), "bitmap: {}", e.message());
         }
-        if (image.width <= 0 || image.height <= 0 || image.channels <= 0)
+        const TexelImage &t = *m_texels;
+        if (t.width <= 0 || t.height <= 0 || t.channels <= 0)
             FACET_THROW_AT(props.location("filename"), "bitmap: \"{}\" holds no pixels", m_path);
-        // As in Mitsuba, `auto` stores images of 16 bits per channel or fewer in half precision
-        // (after decoding). Integer formats are; a half EXR already holds half values, and
-        // float HDR/PFM/EXR files keep 32 bits.
-        bool linear = is_linear_format(m_path);
-        bool half = format == "fp16" || (format == "auto" && !linear);
-        load_pixels(image, !m_raw && !linear, half);
+        m_width = t.width;
+        m_height = t.height;
+        m_channels = t.channels;
+        m_floats = t.bytes.empty() ? t.floats.data() : nullptr;
+        m_bytes = t.bytes.empty() ? nullptr : t.bytes.data();
+        m_table = t.table.data();
+        m_mean = t.mean;
+        m_max = t.max;
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
         Point2f uv = to_uv(si.uv);
-        if (m_channels == 1) return Color3f(lookup<1>(uv).r);
-        return lookup<3>(uv);
+        if (m_bytes) return m_channels == 1 ? Color3f(lookup<1, true>(uv).r) : lookup<3, true>(uv);
+        return m_channels == 1 ? Color3f(lookup<1, false>(uv).r) : lookup<3, false>(uv);
     }
 
     float eval_1(const SurfaceInteraction &si) const override {
         Point2f uv = to_uv(si.uv);
-        if (m_channels == 1) return lookup<1>(uv).r;
-        return lookup<3>(uv).luminance();
+        if (m_bytes)
+            return m_channels == 1 ? lookup<1, true>(uv).r : lookup<3, true>(uv).luminance();
+        return m_channels == 1 ? lookup<1, false>(uv).r : lookup<3, false>(uv).luminance();
     }
 
     /// Gradient of eval_1 in (u, v): the slope of the bilinear interpolation (zero for the
     /// nearest filter, which is piecewise constant), carried through to_uv by its transpose.
     Vector2f eval_1_grad(const SurfaceInteraction &si) const override {
-        Vector2f g = m_channels == 1 ? lookup_grad<1>(to_uv(si.uv)) : lookup_grad<3>(to_uv(si.uv));
+        const Point2f uv = to_uv(si.uv);
+        Vector2f g =
+            m_bytes ? (m_channels == 1 ? lookup_grad<1, true>(uv) : lookup_grad<3, true>(uv))
+                    : (m_channels == 1 ? lookup_grad<1, false>(uv) : lookup_grad<3, false>(uv));
         return {m_uv_matrix[0] * g.x + m_uv_matrix[3] * g.y,
                 m_uv_matrix[1] * g.x + m_uv_matrix[4] * g.y};
     }
@@ -175,33 +171,6 @@ public:
     }
 
 private:
-    /// Keeps grey (1 channel) or RGB (3), drops alpha, decodes sRGB, rounds to half precision
-    /// if asked, computes mean and max.
-    void load_pixels(const Image &image, bool decode_srgb, bool half) {
-        m_width = image.width;
-        m_height = image.height;
-        m_channels = image.channels <= 2 ? 1 : 3;
-        size_t n = size_t(m_width) * size_t(m_height);
-        m_data.resize(n * size_t(m_channels));
-        double sum[3] = {0, 0, 0};
-        m_max = -Infinity;
-        for (size_t i = 0; i < n; ++i) {
-            for (int c = 0; c < m_channels; ++c) {
-                float v = image.data[i * size_t(image.channels) + size_t(c)];
-                if (decode_srgb) v = srgb_to_linear(v);
-                if (half) v = round_to_half(v);
-                m_data[i * size_t(m_channels) + size_t(c)] = v;
-                sum[c] += double(v);
-                m_max = std::max(m_max, v);
-            }
-        }
-        if (m_channels == 1)
-            m_mean = Color3f(float(sum[0] / double(n)));
-        else
-            m_mean = Color3f(float(sum[0] / double(n)), float(sum[1] / double(n)),
-                             float(sum[2] / double(n)));
-    }
-
     Point2f to_uv(const Point2f &uv) const {
         return {m_uv_matrix[0] * uv.x + m_uv_matrix[1] * uv.y + m_uv_matrix[2],
                 m_uv_matrix[3] * uv.x + m_uv_matrix[4] * uv.y + m_uv_matrix[5]};
@@ -231,18 +200,28 @@ private:
         return int(std::floor(clamp(x, -1e8f, 1e8f)));
     }
 
-    template <int C> Color3f pixel(int x, int y) const {
-        const float *p = m_data.data() + (size_t(y) * size_t(m_width) + size_t(x)) * C;
-        if constexpr (C == 1)
-            return Color3f(p[0]);
-        else
-            return Color3f(p[0], p[1], p[2]);
+    /// The texel at (x, y): C floats, or C bytes through their table.
+    template <int C, bool Bytes> Color3f pixel(int x, int y) const {
+        const size_t i = (size_t(y) * size_t(m_width) + size_t(x)) * C;
+        if constexpr (Bytes) {
+            const uint8_t *p = m_bytes + i;
+            if constexpr (C == 1)
+                return Color3f(m_table[p[0]]);
+            else
+                return Color3f(m_table[p[0]], m_table[p[1]], m_table[p[2]]);
+        } else {
+            const float *p = m_floats + i;
+            if constexpr (C == 1)
+                return Color3f(p[0]);
+            else
+                return Color3f(p[0], p[1], p[2]);
+        }
     }
 
-    template <int C> Color3f lookup(const Point2f &uv) const {
+    template <int C, bool Bytes> Color3f lookup(const Point2f &uv) const {
         float x = uv.x * float(m_width), y = uv.y * float(m_height);
         if (m_filter == FilterType::Nearest)
-            return pixel<C>(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
+            return pixel<C, Bytes>(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
 
         // Bilinear between the four pixel centres around (x, y); centres sit at half-integers.
         x -= 0.5f;
@@ -253,13 +232,13 @@ private:
         if (!std::isfinite(fy)) fy = 0.f;
         int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
         int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
-        return (pixel<C>(xa, ya) * (1.f - fx) + pixel<C>(xb, ya) * fx) * (1.f - fy) +
-               (pixel<C>(xa, yb) * (1.f - fx) + pixel<C>(xb, yb) * fx) * fy;
+        return (pixel<C, Bytes>(xa, ya) * (1.f - fx) + pixel<C, Bytes>(xb, ya) * fx) * (1.f - fy) +
+               (pixel<C, Bytes>(xa, yb) * (1.f - fx) + pixel<C, Bytes>(xb, yb) * fx) * fy;
     }
 
     /// Gradient of the scalar (grey or luminance) bilinear lookup with respect to the transformed
     /// uv: the four pixels of lookup(), differentiated in x and y, times the resolution.
-    template <int C> Vector2f lookup_grad(const Point2f &uv) const {
+    template <int C, bool Bytes> Vector2f lookup_grad(const Point2f &uv) const {
         if (m_filter == FilterType::Nearest) return Vector2f(0.f);
         float x = uv.x * float(m_width) - 0.5f, y = uv.y * float(m_height) - 0.5f;
         int x0 = floor_to_int(x), y0 = floor_to_int(y);
@@ -269,7 +248,7 @@ private:
         int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
         int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
         auto value = [&](int px, int py) {
-            Color3f c = pixel<C>(px, py);
+            Color3f c = pixel<C, Bytes>(px, py);
             return C == 1 ? c.r : c.luminance();
         };
         float f00 = value(xa, ya), f10 = value(xb, ya), f01 = value(xa, yb), f11 = value(xb, yb);
@@ -284,7 +263,10 @@ private:
     bool m_raw = false;
     float m_uv_matrix[6] = {1, 0, 0, 0, 1, 0};
     int m_width = 0, m_height = 0, m_channels = 3;
-    std::vector<float> m_data;
+    std::shared_ptr<const TexelImage> m_texels; ///< shared by every bitmap of the file
+    const float *m_floats = nullptr;            ///< m_texels' floats, or
+    const uint8_t *m_bytes = nullptr;           ///< its bytes, looked up in
+    const float *m_table = nullptr;             ///< its table
     Color3f m_mean;
     float m_max = 0.f;
 };
