@@ -1,13 +1,17 @@
 #include "merge.h"
 
+#include <facet/checked.h>
 #include <facet/film.h>
 #include <facet/logger.h>
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <new>
 
 namespace fs = std::filesystem;
 
@@ -31,12 +35,12 @@ long long get_int(const Part &p, const char *key, long long fallback) {
     FACET_THROW("{}: attribute {} is \"{}\", expected an integer", p.name, key, it->second);
 }
 
-std::string rect(int x0, int y0, int x1, int y1) {
+std::string rect(long long x0, long long y0, long long x1, long long y1) {
     return fmt::format("[{}, {}) x [{}, {})", x0, x1, y0, y1);
 }
 
 std::string rect_of(const Part &p) {
-    return rect(p.x, p.y, p.x + p.image.width, p.y + p.image.height);
+    return rect(p.x, p.y, (long long)p.x + p.image.width, (long long)p.y + p.image.height);
 }
 
 std::string join(const std::vector<std::string> &v) {
@@ -121,6 +125,72 @@ RawLayout raw_layout(const Part &p) {
     return l;
 }
 
+/// The first non-finite value of a part (a render that went wrong, or a damaged file: one such
+/// value would spread through every pixel its sums reach): a facet::Error names the pixel (in
+/// the full image) and the channel.
+void check_finite(const Part &p) {
+    const Image &img = p.image;
+    const size_t n = img.data.size();
+    for (size_t i = 0; i < n; ++i) {
+        if (std::isfinite(img.data[i])) continue;
+        const size_t c = i % size_t(img.channels), pixel = i / size_t(img.channels);
+        const long long x = p.x + (long long)(pixel % size_t(img.width));
+        const long long y = p.y + (long long)(pixel / size_t(img.width));
+        FACET_THROW("{}: pixel ({}, {}) has the value {} in its channel {}: a part must hold "
+                    "finite values (render it again)",
+                    p.name, x, y, img.data[i],
+                    c < img.channel_names.size() ? img.channel_names[c] : std::to_string(c));
+    }
+}
+
+/// The bounding rectangle {x0, y0, x1, y1} of the pixels of the W x H image that no part of
+/// `in_pass` covers (the parts do not overlap). Found band by band between the parts' top and
+/// bottom edges, without a buffer of the image's size (the display window is only as big as
+/// the parts' headers say).
+std::array<int, 4> uncovered(const std::vector<const Part *> &in_pass, int W, int H) {
+    std::vector<int> edges = {0, H};
+    for (const Part *p : in_pass) {
+        edges.push_back(p->y);
+        edges.push_back(p->y + p->image.height);
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::array<int, 4> box = {W, H, 0, 0};
+    std::vector<std::pair<int, int>> spans;
+    for (size_t b = 0; b + 1 < edges.size(); ++b) {
+        const int ya = edges[b], yb = edges[b + 1];
+        spans.clear();
+        for (const Part *p : in_pass)
+            if (p->y <= ya && ya < p->y + p->image.height)
+                spans.emplace_back(p->x, p->x + p->image.width);
+        std::sort(spans.begin(), spans.end());
+        auto gap = [&](int a, int e) {
+            if (a >= e) return;
+            box = {std::min(box[0], a), std::min(box[1], ya), std::max(box[2], e),
+                   std::max(box[3], yb)};
+        };
+        int at = 0;
+        for (const auto &[a, e] : spans) {
+            gap(at, a);
+            at = std::max(at, e);
+        }
+        gap(at, W);
+    }
+    return box;
+}
+
+/// `count` values of `size` bytes for `what`, checked against the allocation limit; running
+/// out of memory is a facet::Error that names them.
+template <typename T> void allocate(std::vector<T> &v, size_t count, const std::string &what) {
+    const size_t bytes = allocation_bytes(count, sizeof(T), "facet merge", what.c_str());
+    try {
+        v.assign(count, T(0));
+    } catch (const std::bad_alloc &) {
+        FACET_THROW("facet merge: out of memory for {} ({:.1f} MiB)", what,
+                    double(bytes) / double(1 << 20));
+    }
+}
+
 } // namespace
 
 Part read_part(const std::string &path) {
@@ -128,7 +198,22 @@ Part read_part(const std::string &path) {
     if (!fs::is_regular_file(path, ec))
         FACET_THROW("cannot read part \"{}\": {}", path,
                     fs::exists(path, ec) ? "not a regular file" : "no such file");
-    ImageFile file = read_image_file(path);
+    // The header first: a data window outside the display window is refused before any pixel
+    // is read.
+    const Image header = read_image_header(path).image;
+    if (header.full_width <= 0 || header.full_height <= 0 || header.x < 0 || header.y < 0 ||
+        (long long)header.x + header.width > header.full_width ||
+        (long long)header.y + header.height > header.full_height)
+        FACET_THROW("{}: its data window {} is not inside its {}x{} display window", path,
+                    rect(header.x, header.y, header.x + header.width, header.y + header.height),
+                    header.full_width, header.full_height);
+    ImageFile file;
+    try {
+        file = read_image_file(path);
+    } catch (const std::bad_alloc &) {
+        FACET_THROW("cannot read part \"{}\": out of memory for its {}x{} pixels of {} channels",
+                    path, header.width, header.height, header.channels);
+    }
     Part part;
     part.name = path;
     part.full_width = file.image.full_width;
@@ -146,6 +231,7 @@ Merged merge_parts(const std::vector<Part> &parts) {
     if (parts.empty()) FACET_THROW("no parts to merge");
     const Part &first = parts[0];
     const int W = first.full_width, H = first.full_height, C = first.image.channels;
+    if (W <= 0 || H <= 0) FACET_THROW("{}: its display window is {}x{} pixels", first.name, W, H);
     const long long passes = get_int(first, attr::passes, 1);
     if (passes < 1)
         FACET_THROW("{}: {} is {}, expected at least 1", first.name, attr::passes, passes);
@@ -184,9 +270,16 @@ Merged merge_parts(const std::vector<Part> &parts) {
         long long i = get_int(p, attr::pass, 0);
         if (i < 0 || i >= passes)
             FACET_THROW("{}: {} is {}, expected 0..{}", p.name, attr::pass, i, passes - 1);
-        if (p.x < 0 || p.y < 0 || p.x + p.image.width > W || p.y + p.image.height > H)
+        if (p.x < 0 || p.y < 0 || (long long)p.x + p.image.width > W ||
+            (long long)p.y + p.image.height > H)
             FACET_THROW("{}: its data window {} is not inside the {}x{} image", p.name, rect_of(p),
                         W, H);
+        if (p.image.width <= 0 || p.image.height <= 0 || p.image.channels <= 0 ||
+            p.image.data.size() !=
+                size_t(p.image.width) * size_t(p.image.height) * size_t(p.image.channels))
+            FACET_THROW("{} holds {} values for {}x{} pixels of {} channels", p.name,
+                        p.image.data.size(), p.image.width, p.image.height, p.image.channels);
+        check_finite(p);
         if (passes > 1 && get(p, attr::spp).empty())
             FACET_THROW("{} has no {} attribute: passes are averaged by their sample counts",
                         p.name, attr::spp);
@@ -197,9 +290,54 @@ Merged merge_parts(const std::vector<Part> &parts) {
     const int out_channels = passes > 1 ? int(raw.developed.size()) : C;
     const int nraw = int(raw.raw.size());
 
+    // The parts of each pass, checked to cover the image exactly once before anything of the
+    // image's size is allocated: the display window is then no larger than the parts' pixels.
+    auto parts_of = [&](long long pass) {
+        std::vector<const Part *> in_pass;
+        for (const Part &p : parts)
+            if (get_int(p, attr::pass, 0) == pass) in_pass.push_back(&p);
+        return in_pass;
+    };
+    auto which = [&](long long pass) {
+        return passes > 1 ? fmt::format(" of pass {} (of {})", pass, passes) : std::string();
+    };
+    for (long long pass = 0; pass < passes; ++pass) {
+        const std::vector<const Part *> in_pass = parts_of(pass);
+        if (in_pass.empty())
+            FACET_THROW("pass {} of {} is missing: no part has {} {}", pass, passes, attr::pass,
+                        pass);
+        // Overlaps, by rectangle intersection.
+        for (size_t i = 0; i < in_pass.size(); ++i)
+            for (size_t j = i + 1; j < in_pass.size(); ++j) {
+                const Part &a = *in_pass[i], &b = *in_pass[j];
+                int x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
+                int x1 = std::min(a.x + a.image.width, b.x + b.image.width);
+                int y1 = std::min(a.y + a.image.height, b.y + b.image.height);
+                if (x0 < x1 && y0 < y1 && a.name == b.name)
+                    FACET_THROW("{} is given twice{}", a.name, which(pass));
+                if (x0 < x1 && y0 < y1)
+                    FACET_THROW("{} ({}) and {} ({}) overlap{} in the pixels {}", a.name,
+                                rect_of(a), b.name, rect_of(b), which(pass), rect(x0, y0, x1, y1));
+            }
+        // Holes: with no overlaps, the pass is complete when the areas add up.
+        long long area = 0;
+        for (const Part *p : in_pass) area += (long long)p->image.width * p->image.height;
+        if (area != (long long)W * H) {
+            const std::array<int, 4> box = uncovered(in_pass, W, H);
+            FACET_THROW("the parts{} leave {} of the {}x{} pixels uncovered, within {}: a part "
+                        "is missing",
+                        which(pass), (long long)W * H - area, W, H,
+                        rect(box[0], box[1], box[2], box[3]));
+        }
+    }
+
     Merged out;
     out.passes = int(passes);
-    out.image = Image(W, H, out_channels);
+    out.image.width = W;
+    out.image.height = H;
+    out.image.channels = out_channels;
+    allocate(out.image.data, size_t(W) * size_t(H) * size_t(out_channels),
+             fmt::format("the merged image ({}x{} pixels of {} channels)", W, H, out_channels));
     if (passes > 1)
         for (int c : raw.developed)
             out.image.channel_names.push_back(first.image.channel_names[size_t(c)]);
@@ -214,50 +352,13 @@ Merged merge_parts(const std::vector<Part> &parts) {
     // Σ of every raw channel over the passes, in pass order (the order a render of all the
     // passes in one process adds them in).
     std::vector<double> sum;
-    if (passes > 1) sum.assign(size_t(W) * H * size_t(nraw), 0.0);
+    if (passes > 1)
+        allocate(sum, size_t(W) * size_t(H) * size_t(nraw),
+                 fmt::format("the sums of the passes ({}x{} pixels of {} channels)", W, H, nraw));
     long long total_spp = 0;
     bool uniform_spp = true;
     for (long long pass = 0; pass < passes; ++pass) {
-        std::vector<const Part *> in_pass;
-        for (const Part &p : parts)
-            if (get_int(p, attr::pass, 0) == pass) in_pass.push_back(&p);
-        const std::string which =
-            passes > 1 ? fmt::format(" of pass {} (of {})", pass, passes) : std::string();
-        if (in_pass.empty())
-            FACET_THROW("pass {} of {} is missing: no part has {} {}", pass, passes, attr::pass,
-                        pass);
-        // Overlaps, by rectangle intersection.
-        for (size_t i = 0; i < in_pass.size(); ++i)
-            for (size_t j = i + 1; j < in_pass.size(); ++j) {
-                const Part &a = *in_pass[i], &b = *in_pass[j];
-                int x0 = std::max(a.x, b.x), y0 = std::max(a.y, b.y);
-                int x1 = std::min(a.x + a.image.width, b.x + b.image.width);
-                int y1 = std::min(a.y + a.image.height, b.y + b.image.height);
-                if (x0 < x1 && y0 < y1 && a.name == b.name)
-                    FACET_THROW("{} is given twice{}", a.name, which);
-                if (x0 < x1 && y0 < y1)
-                    FACET_THROW("{} ({}) and {} ({}) overlap{} in the pixels {}", a.name,
-                                rect_of(a), b.name, rect_of(b), which, rect(x0, y0, x1, y1));
-            }
-        // Holes: with no overlaps, the pass is complete when the areas add up.
-        long long area = 0;
-        for (const Part *p : in_pass) area += (long long)p->image.width * p->image.height;
-        if (area != (long long)W * H) {
-            std::vector<char> covered(size_t(W) * H, 0);
-            for (const Part *p : in_pass)
-                for (int y = 0; y < p->image.height; ++y)
-                    std::fill_n(covered.begin() + (size_t(p->y + y) * W + p->x), p->image.width, 1);
-            int x0 = W, y0 = H, x1 = 0, y1 = 0;
-            for (int y = 0; y < H; ++y)
-                for (int x = 0; x < W; ++x)
-                    if (!covered[size_t(y) * W + x]) {
-                        x0 = std::min(x0, x), y0 = std::min(y0, y);
-                        x1 = std::max(x1, x + 1), y1 = std::max(y1, y + 1);
-                    }
-            FACET_THROW("the parts{} leave {} of the {}x{} pixels uncovered, within {}: a part "
-                        "is missing",
-                        which, (long long)W * H - area, W, H, rect(x0, y0, x1, y1));
-        }
+        const std::vector<const Part *> in_pass = parts_of(pass);
         long long pass_spp = get_int(*in_pass[0], attr::spp, 0);
         for (const Part *p : in_pass) {
             const long long spp = get_int(*p, attr::spp, 0);

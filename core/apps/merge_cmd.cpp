@@ -23,8 +23,14 @@ int merge_main(int argc, char **argv) {
 
     std::vector<facet::merge::Part> parts;
     parts.reserve(inputs.size());
-    for (const std::string &path : inputs) parts.push_back(facet::merge::read_part(path));
+    // Running out of memory names the step (the part, the merge, the output).
+    for (const std::string &path : inputs) {
+        facet::cli::set_activity(fmt::format("reading the part \"{}\"", path));
+        parts.push_back(facet::merge::read_part(path));
+    }
+    facet::cli::set_activity(fmt::format("merging {} parts", parts.size()));
     facet::merge::Merged merged = facet::merge::merge_parts(parts);
+    facet::cli::set_activity(fmt::format("writing \"{}\"", output));
     facet::merge::write_merged(merged, output);
     if (!quiet)
         fmt::print("Merged {} part{} ({} pass{}) into {} ({}x{})\n", parts.size(),
