@@ -16,9 +16,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <thread>
 #include <unistd.h>
 #include <zlib.h>
@@ -267,4 +269,43 @@ TEST_F(TextureImage, TheEnvironmentMapReadsThroughTheCache) {
     set_texture_memory_budget(0);
     EXPECT_NO_THROW(PluginRegistry::instance().create_as<Emitter>(ObjectType::Emitter, props));
     EXPECT_EQ(texture_memory_used(), 0u); // the map keeps its own pixels, not the file's
+}
+
+TEST_F(TextureImage, ABrokenPngGivesFacetsErrorLineAlone) {
+    // libpng printed "libpng error: IDAT: incorrect data check" on stderr before facet's own
+    // line. Run through the facet program: a program that links libpng itself (these tests
+    // link OpenImageIO) binds OpenImageIO to libpng directly.
+    std::string png;
+    {
+        std::ifstream in(write_8bit("good.png", 16, 16, 3), std::ios::binary);
+        png.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const size_t idat = png.find("IDAT");
+    ASSERT_NE(idat, std::string::npos);
+    png[idat + 8] = char(png[idat + 8] ^ 0x55); // the compressed data, its CRC left as it was
+    std::ofstream(path("broken.png"), std::ios::binary) << png;
+    std::ofstream(path("scene.xml")) << R"(<scene version="3.0.0">
+    <sensor type="perspective">
+        <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film>
+    </sensor>
+    <shape type="sphere">
+        <bsdf type="diffuse">
+            <texture type="bitmap" name="reflectance">
+                <string name="filename" value="broken.png"/>
+            </texture>
+        </bsdf>
+    </shape>
+</scene>
+)";
+    const std::string command = std::string("'") + FACET_BINARY_DIR + "/bin/facet' render '" +
+                                path("scene.xml") + "' -q -o '" + path("out.exr") + "' 2>'" +
+                                path("stderr.txt") + "'";
+    EXPECT_NE(std::system(command.c_str()), 0);
+    std::ifstream err(path("stderr.txt"));
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(err, line);) lines.push_back(line);
+    ASSERT_EQ(lines.size(), 1u) << "stderr: " << (lines.empty() ? "" : lines[0]) << " ...";
+    EXPECT_EQ(lines[0].rfind("facet: error: ", 0), 0u) << lines[0];
+    EXPECT_CONTAINS(lines[0], "scene.xml:8:");
+    EXPECT_CONTAINS(lines[0], "broken.png");
 }
