@@ -58,7 +58,8 @@ std::shared_ptr<Scene> load_scene(SceneOptions &opts);
 /// memory runs out, which std::bad_alloc itself does not say.
 void set_activity(const std::string &what);
 
-/// Threads a render will use: `threads`, or every core when it is 0.
+/// Threads a render will use: `threads` but at most the hardware threads, or all of those when
+/// it is 0.
 int effective_threads(int threads);
 
 } // namespace facet::cli

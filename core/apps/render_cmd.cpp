@@ -15,7 +15,6 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <tbb/info.h>
 
 #include <algorithm>
 #include <atomic>
@@ -47,9 +46,7 @@ void add_scene_options(CLI::App &app, SceneOptions &opts) {
                  "Unused -D values and unused scene parameters are warnings, not errors");
 }
 
-int effective_threads(int threads) {
-    return threads > 0 ? threads : tbb::info::default_concurrency();
-}
+int effective_threads(int threads) { return capped_thread_count(std::max(threads, 0)); }
 
 std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
     if (opts.verbose >= 2)
@@ -62,6 +59,11 @@ std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
     if (opts.threads_given && opts.threads < 1) {
         FACET_LOG(Warn, "-t {} is less than 1: using 1 thread", opts.threads);
         opts.threads = 1;
+    }
+    if (opts.threads > hardware_threads()) {
+        FACET_LOG(Warn, "-t {}: this machine has {} hardware threads; using {}", opts.threads,
+                  hardware_threads(), hardware_threads());
+        opts.threads = hardware_threads();
     }
 
     LoadOptions load;

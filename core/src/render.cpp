@@ -11,6 +11,7 @@
 #include <sys/ioctl.h>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -213,12 +214,16 @@ double process_cpu_seconds() {
            1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
-int render_thread_count(const RenderOptions &opts) {
-    if (opts.threads < 0)
-        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
-    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
-    return arena.max_concurrency();
+int hardware_threads() { return std::max(1, tbb::info::default_concurrency()); }
+
+int capped_thread_count(int threads) {
+    if (threads < 0)
+        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", threads);
+    const int hardware = hardware_threads();
+    return threads > 0 ? std::min(threads, hardware) : hardware;
 }
+
+int render_thread_count(const RenderOptions &opts) { return capped_thread_count(opts.threads); }
 
 bool StopCondition::timed_out() const { return timeout > 0.0 && seconds_since(start) >= timeout; }
 
@@ -240,14 +245,13 @@ std::vector<uint32_t> progressive_schedule(uint32_t spp, uint32_t samples_per_pa
 WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondition &stop,
                        const std::atomic<uint64_t> &work_done, uint64_t work_total,
                        const std::function<std::function<void(size_t)>()> &make_worker) {
-    if (opts.threads < 0)
-        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", opts.threads);
+    const int threads = capped_thread_count(opts.threads);
     const auto start = Clock::now();
     std::unique_ptr<tbb::global_control> allow;
     if (opts.threads > 0)
         allow = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      size_t(opts.threads));
-    tbb::task_arena arena(opts.threads > 0 ? opts.threads : tbb::task_arena::automatic);
+                                                      size_t(threads));
+    tbb::task_arena arena(threads);
     const int workers = arena.max_concurrency();
 
     ProgressLine progress(opts.progress);
@@ -676,6 +680,13 @@ RenderResult Integrator::render(const Scene &, const Sensor &, const RenderOptio
 }
 
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts) {
+    if (opts.threads > hardware_threads()) {
+        FACET_LOG(Warn, "{} render threads asked for: using the {} hardware threads", opts.threads,
+                  hardware_threads());
+        RenderOptions capped = opts;
+        capped.threads = hardware_threads();
+        return render(scene, sensor, capped);
+    }
     const Scene::RenderLock lock(scene); // no update() of the scene while it renders
     if (!scene.integrator()) FACET_THROW("the scene has no integrator");
     const Integrator &integrator = *scene.integrator();

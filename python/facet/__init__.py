@@ -400,6 +400,9 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
         progress = bool(progress)
     if pass_index is None:
         pass_index = -1 if int(passes) > 1 else 0
+    if threads is not None:
+        # Beyond the cores the count is capped with a warning; so it is beyond a C int.
+        threads = min(int(threads), 2**31 - 1)
     pixels, channels, metadata, half, window = _facet.render(
         scene, spp, int(seed), int(sensor), threads,
         None if crop is None else [int(v) for v in crop], int(pass_index), int(passes), progress)

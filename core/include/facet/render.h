@@ -201,8 +201,17 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
                        const std::atomic<uint64_t> &work_done, uint64_t work_total,
                        const std::function<std::function<void(size_t)>()> &make_worker);
 
-/// Number of threads a render with `opts` uses.
+/// Number of threads a render with `opts` uses: capped_thread_count(opts.threads).
 int render_thread_count(const RenderOptions &opts);
+
+/// Hardware threads this process may run on (its CPU affinity).
+int hardware_threads();
+
+/// Threads a render asked for `threads` runs on: every hardware thread for 0, else `threads` but
+/// at most hardware_threads() (more only cost memory: a million took half a gigabyte, and TBB
+/// crashed on ten million). render() says so once, as a warning, when it caps opts.threads.
+/// Throws for a negative count.
+int capped_thread_count(int threads);
 
 /// CPU seconds (user + system, every thread) of the whole process so far.
 double process_cpu_seconds();
