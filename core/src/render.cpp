@@ -227,6 +227,18 @@ int render_thread_count(const RenderOptions &opts) { return capped_thread_count(
 
 bool StopCondition::timed_out() const { return timeout > 0.0 && seconds_since(start) >= timeout; }
 
+namespace {
+
+/// The stop condition of the render whose work unit the thread runs (render_should_stop()).
+thread_local const StopCondition *t_render_stop = nullptr;
+
+} // namespace
+
+bool render_should_stop() {
+    const StopCondition *stop = t_render_stop;
+    return stop && (*stop)();
+}
+
 std::vector<uint32_t> progressive_schedule(uint32_t spp, uint32_t samples_per_pass, uint32_t cap) {
     cap = std::max(cap, 1u);
     std::vector<uint32_t> pass_start; // pass p takes samples [pass_start[p], pass_start[p + 1])
@@ -284,6 +296,12 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
 
     auto worker = [&](int) {
         ScopedFlushToZero ftz;
+        // render_should_stop() on this thread asks `stop` (the previous one again afterwards).
+        struct ScopedStop {
+            const StopCondition *saved = t_render_stop;
+            explicit ScopedStop(const StopCondition *s) { t_render_stop = s; }
+            ~ScopedStop() { t_render_stop = saved; }
+        } scoped_stop(&stop);
         std::function<void(size_t)> run = make_worker();
         for (;;) {
             if (stop.cancelled()) {
@@ -337,24 +355,33 @@ WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondit
 // ---------------------------------------------------------------------------------------------
 // The sampling integrators' render loop
 
-double read_timeout(const Properties &props) { return props.get_float("timeout", -1.0); }
+double read_timeout(const Properties &props) {
+    const double timeout = props.get_float("timeout", -1.0);
+    if (std::isnan(timeout))
+        FACET_THROW_AT(props.location("timeout"),
+                       "timeout must be a number of seconds (<= 0 for none), got {}", timeout);
+    return timeout;
+}
 
+// Depths are path lengths counted in 32 bits (4294967295: as good as unbounded); a larger value
+// is a mistake, not a wish for longer paths.
 uint32_t read_max_depth(const Properties &props, const char *plugin) {
     int64_t max_depth = props.get_int("max_depth", -1);
-    if (max_depth < -1)
+    if (max_depth < -1 || max_depth > int64_t(UINT32_MAX))
         FACET_THROW_AT(props.location("max_depth"),
-                       "{}: max_depth must be -1 (unbounded) or a value >= 0, got {}", plugin,
-                       max_depth);
+                       "{}: max_depth must be -1 (unbounded) or a value in [0, {}], got {}", plugin,
+                       UINT32_MAX, max_depth);
     return max_depth == -1 ? std::numeric_limits<uint32_t>::max()
                            : uint32_t(std::min<int64_t>(max_depth, 0xfffffffe));
 }
 
 uint32_t read_rr_depth(const Properties &props, const char *plugin) {
     int64_t rr_depth = props.get_int("rr_depth", 5);
-    if (rr_depth <= 0)
+    if (rr_depth <= 0 || rr_depth > int64_t(UINT32_MAX))
         FACET_THROW_AT(props.location("rr_depth"),
-                       "{}: rr_depth must be a value greater than zero, got {}", plugin, rr_depth);
-    return uint32_t(std::min<int64_t>(rr_depth, 0xffffffff));
+                       "{}: rr_depth must be a value in [1, {}], got {}", plugin, UINT32_MAX,
+                       rr_depth);
+    return uint32_t(rr_depth);
 }
 
 uint32_t read_samples_per_pass(const Properties &props) {
@@ -549,6 +576,12 @@ RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor
                 }
                 samples_done.fetch_add(uint64_t(x1 - x0) * (last - first),
                                        std::memory_order_relaxed);
+            }
+            // An integrator may have cut its last samples short (render_should_stop()); a stop
+            // stays true once it is, so this sees it.
+            if (stop()) {
+                merger.release(std::move(block));
+                return;
             }
             invalid_samples += invalid;
             merger.submit(index, std::move(block));

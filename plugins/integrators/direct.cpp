@@ -93,6 +93,8 @@ public:
         // ---- Emitter sampling ----
         if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
             for (uint32_t i = 0; i < m_emitter_samples; ++i) {
+                // Up to 65535 samples: a stop (Ctrl-C, timeout) need not wait for them all.
+                if (render_should_stop(i)) return result;
                 // The shadow ray last: a sample the BSDF gives no weight costs none.
                 auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), false);
                 if (ds.pdf == 0.f || em_weight.is_black()) continue;
@@ -108,6 +110,7 @@ public:
 
         // ---- BSDF sampling ----
         for (uint32_t i = 0; i < m_bsdf_samples; ++i) {
+            if (render_should_stop(i)) return result;
             float sample1 = sampler.next_1d();
             Point2f sample2 = sampler.next_2d();
             auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);

@@ -136,6 +136,9 @@ public:
             prev_bsdf_delta = has_flag(bs.sampled_type, BSDFFlags::Delta);
             ray = si.spawn_ray(si.to_world(bs.wo));
             ++depth;
+            // A stop (Ctrl-C, timeout) ends even a path that would bounce for hours (a closed
+            // mirror without Russian roulette); the render drops the unit of this sample.
+            if (render_should_stop(depth)) break;
 
             // ---- Russian roulette; eta² undoes the radiance scaling of refraction ----
             float throughput_max = throughput.max();

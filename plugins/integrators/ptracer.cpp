@@ -143,6 +143,12 @@ public:
                         sampler->seed(sample_stream_seed(seed, i));
                         trace(scene, sensor, *sampler, *block, filter);
                     }
+                // trace() may have cut the last paths short (render_should_stop()); a stop stays
+                // true once it is, so this sees it.
+                if (stop()) {
+                    merger.release(std::move(block));
+                    return;
+                }
                 paths_done.fetch_add(end - begin, std::memory_order_relaxed);
                 merger.submit(index, std::move(block));
             };
@@ -252,6 +258,9 @@ private:
             Ray next = si.spawn_ray(wo_world);
             if (!scene.ray_intersect(next, si)) return;
             ++depth;
+            // A stop (Ctrl-C, timeout) ends even a path that would bounce for hours (a closed
+            // mirror without Russian roulette); the render drops the unit of this path.
+            if (render_should_stop(depth)) return;
             // ---- Russian roulette (on the power the path carries, as Mitsuba does) ----
             if (depth > m_rr_depth) {
                 const float q = std::min(throughput.max() * eta * eta, 0.95f);

@@ -213,6 +213,20 @@ int hardware_threads();
 /// Throws for a negative count.
 int capped_thread_count(int threads);
 
+/// For a loop inside one sample or light path that may run long (a path of unbounded depth in a
+/// closed mirror, thousands of emitter samples): true when the render the calling thread works
+/// for is to stop, because its cancel flag is set or its timeout has passed (false outside a
+/// render). The loop then ends at once; the render loop drops the work unit it was part of, so
+/// the sample cut short never reaches the image. Costs a thread-local lookup and a clock read:
+/// ask through render_should_stop(iteration) in per-bounce code.
+bool render_should_stop();
+
+/// render_should_stop(), asked on every 16th value of a loop counter only (false on the others),
+/// so that a check on every bounce of a path costs next to nothing.
+inline bool render_should_stop(uint32_t iteration) {
+    return (iteration & 15u) == 15u && render_should_stop();
+}
+
 /// CPU seconds (user + system, every thread) of the whole process so far.
 double process_cpu_seconds();
 
