@@ -20,9 +20,10 @@ namespace facet {
 
 class BoxFilter final : public ReconstructionFilter {
 public:
-    explicit BoxFilter(const Properties &) {
+    explicit BoxFilter(const Properties &props) {
         m_radius = 0.5f;
         m_is_box = true; // image blocks evaluate it inline
+        check_weights(props);
     }
 
     /// Half-open [-0.5, 0.5): a sample on a pixel boundary belongs to exactly one pixel.

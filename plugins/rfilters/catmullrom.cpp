@@ -26,9 +26,10 @@ namespace facet {
 
 class CatmullRomFilter final : public ReconstructionFilter {
 public:
-    explicit CatmullRomFilter(const Properties &) {
+    explicit CatmullRomFilter(const Properties &props) {
         m_radius = 2.f;
         m_table.init(m_radius, exact);
+        check_weights(props);
     }
 
     float eval(float x) const override { return m_table.lookup(x); }

@@ -7,7 +7,7 @@ radius.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
-| stddev | float | 0.5 | Standard deviation in pixels (more than 0, at most 16); the radius is 4·stddev |
+| stddev | float | 0.5 | Standard deviation in pixels (1/256 to 16); the radius is 4·stddev |
 
 ```xml
 <rfilter type="gaussian">
@@ -25,18 +25,19 @@ class GaussianFilter final : public ReconstructionFilter {
 public:
     explicit GaussianFilter(const Properties &props) {
         double stddev = props.get_float("stddev", 0.5);
-        // A huge stddev used to overflow the border computation (a float to int conversion).
-        if (!(stddev > 0.0) || !(4.0 * stddev <= MaxFilterRadius))
+        // A huge stddev used to overflow the border computation (a float to int conversion), a
+        // tiny one gives (almost) every sample the weight 0: a black image.
+        if (!(4.0 * stddev >= MinFilterRadius) || !(4.0 * stddev <= MaxFilterRadius))
             FACET_THROW_AT(props.location("stddev"),
-                           "stddev must be a positive number of pixels, at most {} (the radius, "
-                           "4·stddev, is at most {}), got {}",
-                           MaxFilterRadius / 4.f, MaxFilterRadius, stddev);
+                           "stddev must be a number of pixels in [{}, {}] (the radius, 4·stddev, "
+                           "in [{}, {}]), got {}",
+                           MinFilterRadius / 4.f, MaxFilterRadius / 4.f, MinFilterRadius,
+                           MaxFilterRadius, stddev);
         m_stddev = float(stddev);
         m_radius = 4.f * m_stddev;
         m_alpha = -1.f / (2.f * m_stddev * m_stddev);
-        if (!std::isfinite(m_alpha))
-            FACET_THROW_AT(props.location("stddev"), "stddev {} is too small to evaluate", stddev);
         m_bias = std::exp(m_alpha * m_radius * m_radius);
+        check_weights(props);
     }
 
     float eval(float x) const override { return std::max(0.f, std::exp(m_alpha * x * x) - m_bias); }

@@ -36,6 +36,7 @@ public:
         m_lobes = int(lobes);
         m_radius = float(lobes);
         m_table.init(m_radius, [&](float x) { return exact(x, m_radius); });
+        check_weights(props);
     }
 
     float eval(float x) const override { return m_table.lookup(x); }

@@ -10,8 +10,8 @@ of 31 values over the radius (piecewise constant), so images match Mitsuba's at 
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
-| B | float | 1/3 | The B parameter of the cubic family (blurring) |
-| C | float | 1/3 | The C parameter of the cubic family (ringing) |
+| B | float | 1/3 | The B parameter of the cubic family (blurring), in [-2, 2] |
+| C | float | 1/3 | The C parameter of the cubic family (ringing), in [-2, 2] |
 
 ```xml
 <rfilter type="mitchell">
@@ -26,6 +26,7 @@ of 31 values over the radius (piecewise constant), so images match Mitsuba's at 
 #include <facet/rfilter.h>
 
 #include <cmath>
+#include <utility>
 
 namespace facet {
 
@@ -34,14 +35,18 @@ public:
     explicit MitchellFilter(const Properties &props) {
         double b = props.get_float("B", 1.0 / 3.0);
         double c = props.get_float("C", 1.0 / 3.0);
-        if (!std::isfinite(b))
-            FACET_THROW_AT(props.location("B"), "B must be a finite number, got {}", b);
-        if (!std::isfinite(c))
-            FACET_THROW_AT(props.location("C"), "C must be a finite number, got {}", c);
+        // The paper's filters have B and C in [0, 1]; within [-2, 2] the weight at the centre,
+        // 1 - B/3, stays positive and every weight small. B = 1e30 used to give weights whose
+        // products overflow: an all-NaN image.
+        for (auto [name, v] : {std::pair<const char *, double>{"B", b}, {"C", c}})
+            if (!(v >= -2.0 && v <= 2.0))
+                FACET_THROW_AT(props.location(name), "{} must be a number in [-2, 2], got {}", name,
+                               v);
         m_radius = 2.f;
         m_b = float(b);
         m_c = float(c);
         m_table.init(m_radius, [&](float x) { return cubic(x, m_b, m_c); });
+        check_weights(props);
     }
 
     float eval(float x) const override { return m_table.lookup(x); }

@@ -6,7 +6,7 @@ centre to 0 at `radius`.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
-| radius | float | 1.0 | Radius of the filter in pixels (more than 0, at most 64) |
+| radius | float | 1.0 | Radius of the filter in pixels (1/64 to 64) |
 
 ```xml
 <rfilter type="tent">
@@ -24,12 +24,14 @@ class TentFilter final : public ReconstructionFilter {
 public:
     explicit TentFilter(const Properties &props) {
         double radius = props.get_float("radius", 1.0);
-        if (!(radius > 0.0) || !(radius <= MaxFilterRadius) || !std::isfinite(1.f / float(radius)))
+        // A tiny radius gives (almost) every sample the weight 0: a black image.
+        if (!(radius >= MinFilterRadius) || !(radius <= MaxFilterRadius))
             FACET_THROW_AT(props.location("radius"),
-                           "radius must be a positive number of pixels, at most {}, got {}",
+                           "radius must be a number of pixels in [{}, {}], got {}", MinFilterRadius,
                            MaxFilterRadius, radius);
         m_radius = float(radius);
         m_inv_radius = 1.f / m_radius;
+        check_weights(props);
     }
 
     float eval(float x) const override { return std::max(0.f, 1.f - std::abs(x) * m_inv_radius); }

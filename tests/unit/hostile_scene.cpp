@@ -308,16 +308,16 @@ TEST(HostileScene, FilterRadiiAreBounded) {
     };
     expect_load_error(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e30\"/>"
                              "</rfilter>"),
-                      "stddev must be a positive number of pixels, at most 16", 4);
+                      "stddev must be a number of pixels in [0.00390625, 16]", 4);
     expect_load_error(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e5\"/>"
                              "</rfilter>"),
-                      "at most 16", 4);
+                      "in [0.00390625, 16]", 4);
     expect_load_error(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e-30\"/>"
                              "</rfilter>"),
-                      "too small", 4);
+                      "in [0.00390625, 16]", 4);
     expect_load_error(filter("<rfilter type=\"tent\"><float name=\"radius\" value=\"1e9\"/>"
                              "</rfilter>"),
-                      "at most 64", 4);
+                      "radius must be a number of pixels in [0.015625, 64]", 4);
     EXPECT_TRUE(load_string(filter("<rfilter type=\"gaussian\"><float name=\"stddev\" "
                                    "value=\"16\"/></rfilter>")));
 }

@@ -1,13 +1,22 @@
 // The cubic and windowed-sinc reconstruction filters (mitchell, catmullrom, lanczos): values at
 // known points, Mitsuba's tabulation, radii, normalisation, parameters, and how the film treats
-// their negative lobes.
+// their negative lobes; every filter's parameter ranges and weight checks.
 #include <facet/film.h>
+#include <facet/image.h>
 #include <facet/plugin.h>
+#include <facet/render.h>
+#include <facet/scene.h>
+#include <facet/sensor.h>
+#include <facet/xml.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
+#include <string>
+#include <utility>
+#include <vector>
 
 using namespace facet;
 
@@ -219,4 +228,107 @@ TEST(Filters, NegativeLobesAreSummedWithTheirSign) {
         EXPECT_NEAR(img.at(x, 0, 2), 0.5f, 1e-5f) << x;
     }
     EXPECT_EQ(img.at(1, 0, 0), 0.f); // no weight at all
+}
+
+namespace {
+
+/// A scene whose film uses `rfilter`: an 8 x 8 render of a lit diffuse sphere.
+std::string filter_scene(const std::string &rfilter) {
+    return R"(<scene version="3.0.0">
+<integrator type="path"><integer name="max_depth" value="3"/></integrator>
+<sensor type="perspective">
+    <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/>
+)" + rfilter +
+           R"(
+    </film>
+</sensor>
+<emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+<shape type="sphere"><bsdf type="diffuse"/></shape>
+</scene>)";
+}
+
+} // namespace
+
+TEST(Filters, ParametersOutsideTheirRangeAreLocatedErrors) {
+    // B = 1e30 used to load and give an all-NaN image (weights whose products overflow).
+    const std::pair<const char *, const char *> cases[] = {
+        {R"(<rfilter type="mitchell"><float name="B" value="1e30"/></rfilter>)",
+         "B must be a number in [-2, 2], got 1e+30"},
+        {R"(<rfilter type="mitchell"><float name="C" value="-3"/></rfilter>)",
+         "C must be a number in [-2, 2], got -3"},
+        {R"(<rfilter type="tent"><float name="radius" value="1e-30"/></rfilter>)",
+         "radius must be a number of pixels in [0.015625, 64]"},
+        {R"(<rfilter type="gaussian"><float name="stddev" value="0.001"/></rfilter>)",
+         "stddev must be a number of pixels in [0.00390625, 16]"},
+        {R"(<rfilter type="lanczos"><integer name="lobes" value="65"/></rfilter>)",
+         "lobes must be a whole number between 1 and 64"},
+    };
+    for (const auto &[rfilter, message] : cases) {
+        std::string error = error_of([&] { load_string(filter_scene(rfilter)); });
+        EXPECT_NE(error.find(message), std::string::npos) << error;
+        // Located at the parameter, on line 7 of the scene.
+        EXPECT_EQ(error.rfind("string:7:", 0), 0u) << error;
+    }
+}
+
+TEST(Filters, ExtremeLegalValuesGiveFiniteImages) {
+    std::vector<std::string> filters = {
+        R"(<rfilter type="box"/>)",
+        R"(<rfilter type="catmullrom"/>)",
+        R"(<rfilter type="gaussian"><float name="stddev" value="0.00390625"/></rfilter>)",
+        R"(<rfilter type="gaussian"><float name="stddev" value="16"/></rfilter>)",
+        R"(<rfilter type="tent"><float name="radius" value="0.015625"/></rfilter>)",
+        R"(<rfilter type="tent"><float name="radius" value="64"/></rfilter>)",
+        R"(<rfilter type="lanczos"><integer name="lobes" value="1"/></rfilter>)",
+        R"(<rfilter type="lanczos"><integer name="lobes" value="64"/></rfilter>)",
+    };
+    for (const char *b : {"-2", "2"})
+        for (const char *c : {"-2", "2"})
+            filters.push_back(fmt::format(
+                R"(<rfilter type="mitchell"><float name="B" value="{}"/><float name="C" value="{}"/></rfilter>)",
+                b, c));
+    for (const std::string &rfilter : filters) {
+        auto scene = std::dynamic_pointer_cast<Scene>(load_string(filter_scene(rfilter)));
+        ASSERT_TRUE(scene) << rfilter;
+        RenderOptions opts;
+        opts.threads = 1;
+        opts.progress = false;
+        Image img = render(*scene, *scene->sensors().at(0), opts).image;
+        ASSERT_EQ(img.width, 8) << rfilter;
+        for (float v : img.data) ASSERT_TRUE(std::isfinite(v)) << rfilter;
+    }
+}
+
+namespace {
+
+/// An out-of-tree filter whose weight is `value` everywhere: its constructor checks its weights
+/// as every filter does.
+class ConstantFilter final : public ReconstructionFilter {
+public:
+    ConstantFilter(const Properties &props, float value) : m_value(value) {
+        m_radius = 1.f;
+        check_weights(props);
+    }
+    float eval(float) const override { return m_value; }
+
+private:
+    float m_value;
+};
+
+} // namespace
+
+TEST(Filters, WeightsMustBeFiniteBoundedAndSumToMoreThanZero) {
+    Properties props;
+    props.set_location(Location{"scene.xml", 12, 5});
+    EXPECT_NO_THROW(ConstantFilter(props, 1.f));
+    EXPECT_NO_THROW(ConstantFilter(props, MaxFilterWeight));
+    for (float bad : {std::nanf(""), INFINITY, 2.f * MaxFilterWeight, 0.f, -1.f}) {
+        std::string error = error_of([&] { ConstantFilter(props, bad); });
+        EXPECT_EQ(error.rfind("scene.xml:12:5: ", 0), 0u) << bad << ": " << error;
+        EXPECT_NE(error.find(bad > 0.f || !(bad <= 0.f) ? "within +-1000" : "sum to"),
+                  std::string::npos)
+            << bad << ": " << error;
+    }
 }
