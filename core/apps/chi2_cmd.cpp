@@ -3,9 +3,11 @@
 
 #include "commands.h"
 
+#include <facet/checked.h>
 #include <facet/chi2.h>
 #include <facet/logger.h>
 #include <facet/plugin.h>
+#include <facet/render.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -104,8 +106,31 @@ std::string slug(const std::string &kind, const std::string &name, const std::st
     return fmt::format("{}-{:08x}", base.substr(0, 48), h);
 }
 
+/// Refuses, naming the option, a test whose tables would not fit in memory: before anything
+/// is allocated, rather than as a bare "out of memory" (or a swapping machine) later.
+void check_sizes(const CommonOptions &o) {
+    if (o.samples == 0 || o.samples > uint64_t(UINT32_MAX))
+        FACET_THROW("--samples {}: expected 1 to {} samples", o.samples, UINT32_MAX);
+    if (o.res < 2) FACET_THROW("--res {}: expected at least 2 cells along cos theta", o.res);
+    // Per cell: the observed and expected counts, the integral of the pdf with its checks, the
+    // pooling order, three heat-map pixels of three colours, 64 bytes for the text table and
+    // the image writer's copy, and one counter per thread.
+    const size_t res = size_t(o.res) + 1, per_cell = 8 + 8 + 48 + 8 + 3 * 3 * 4 + 64;
+    size_t cells, bytes;
+    if (!checked_mul(res, 2 * res, cells) ||
+        !checked_mul(size_t(4), size_t(hardware_threads()), bytes) ||
+        !checked_add(bytes, per_cell, bytes))
+        FACET_THROW("--res {}: too many cells", o.res);
+    allocation_bytes(cells, bytes, fmt::format("--res {}", o.res),
+                     "the cells of the chi-square tables (2 x res x res)");
+}
+
 /// Runs the test, prints the result and writes pictures when asked or on failure.
 int run(const Chi2Adapter &adapter, const CommonOptions &o, const std::string &file_base) {
+    check_sizes(o);
+    // What an out-of-memory error names (main() adds it), should the estimate above fall short.
+    cli::set_activity(
+        fmt::format("running the chi-square test (--res {}, --samples {})", o.res, o.samples));
     Chi2Options opts;
     opts.res = o.res;
     opts.samples = o.samples;

@@ -57,3 +57,26 @@ endforeach()
 
 # Bad input is an error (exit code 1 with facet's one-line error), not a verdict.
 run_chi2(1 "" bug=nonsense)
+
+# Sizes that would not fit in memory are refused before anything is allocated, in one line that
+# names the option (a bare "out of memory" used to name nothing).
+function(expect_option_error expect_text)
+    execute_process(COMMAND ${FACET} chi2 bsdf diffuse ${ARGN}
+                    WORKING_DIRECTORY ${WORK} RESULT_VARIABLE code OUTPUT_VARIABLE out
+                    ERROR_VARIABLE err)
+    message("${out}${err}")
+    string(REGEX MATCHALL "\n" newlines "${err}")
+    list(LENGTH newlines lines)
+    if(NOT code EQUAL 1 OR NOT lines EQUAL 1 OR NOT err MATCHES "^facet: error: ${expect_text}")
+        message(FATAL_ERROR "facet chi2 bsdf diffuse ${ARGN}: exit code ${code}, expected 1 "
+                            "and one line starting with \"facet: error: ${expect_text}\"")
+    endif()
+endfunction()
+expect_option_error("--res 100000: the cells of the chi-square tables" --res 100000)
+expect_option_error("--res 2000000000: " --res 2000000000)
+expect_option_error("--samples 10000000000: expected 1 to 4294967295 samples"
+                    --samples 10000000000)
+# What the allocation limit refuses, it refuses naming the option too.
+set(ENV{FACET_ALLOC_LIMIT_MB} 1)
+expect_option_error("--res 256: .* exceed the allocation limit of 1.0 MiB" --res 256)
+unset(ENV{FACET_ALLOC_LIMIT_MB})
