@@ -9,7 +9,10 @@
 
 The film is cut into ``tiles`` crop windows (columns, rows) and each window into ``passes`` parts
 of ``spp`` samples per pixel; every (window, pass) is one task that loads the scene on its worker
-(once per worker process and scene) and renders that part. The parts come back as arrays and are
+and renders that part. A worker keeps the last few scenes it loaded, each under the content hash
+of its files (the scene file, the files it includes and the meshes, images and spectra they
+name): a scene edited between two renders is loaded anew, and a worker whose files differ from
+the client's refuses the task. The parts come back as arrays and are
 merged as ``facet merge`` merges files: windows placed where they belong, passes combined by their
 raw sums (Σ w·L / Σ w over all their samples, whatever the filter). The result is bit-identical to
 ``facet.render(scene, passes=passes)`` of the whole film in one process (with one pass: to
@@ -17,13 +20,19 @@ raw sums (Σ w·L / Σ w over all their samples, whatever the filter). The resul
 The workers must see the scene file and its assets at the same path (a shared folder, or the same machine).
 """
 
+import collections
+import hashlib
 import os
+import re
+import xml.etree.ElementTree as ElementTree
 
 import facet
 
-__all__ = ["render", "tile_windows", "render_part"]
+__all__ = ["render", "tile_windows", "render_part", "scene_hash"]
 
-_scenes = {}
+# (path, params) -> (content hash, scene), least recently used first; at most _CACHE_SIZE.
+_CACHE_SIZE = 4
+_scenes = collections.OrderedDict()
 
 
 def tile_windows(width, height, tiles):
@@ -39,12 +48,86 @@ def tile_windows(width, height, tiles):
     return [(xs[i], ys[j], xs[i + 1], ys[j + 1]) for j in range(rows) for i in range(cols)]
 
 
-def _scene(path, params):
+_PARAM = re.compile(r"\$([A-Za-z_][A-Za-z0-9_]*)")
+
+
+def _scene_files(path, params):
+    """The scene file and the files it names, as the loader finds them: included files (and what
+    they name), and every ``filename`` (meshes, images, spectra), with ``$name`` values replaced.
+    Where a relative name could resolve in several folders, every existing candidate counts."""
+    path = os.path.abspath(path)
+    files, folders, names, todo = [], [os.path.dirname(path)], [], [path]
+    while todo:
+        current = todo.pop()
+        if current in files or not os.path.isfile(current):
+            continue  # seen, or missing (the load says so)
+        files.append(current)
+        try:
+            root = ElementTree.parse(current).getroot()
+        except (ElementTree.ParseError, OSError, ValueError):
+            continue  # not XML (the load says so): its bytes alone count
+        here = os.path.dirname(current)
+        values = dict(params)
+        for el in root.iter("default"):
+            values.setdefault(el.get("name", ""), el.get("value", ""))
+
+        def expand(text):
+            return _PARAM.sub(lambda m: str(values.get(m.group(1), m.group(0))), text)
+
+        folders += [os.path.join(here, expand(el.get("value", ""))) for el in root.iter("path")]
+        for el in root.iter():
+            if el.get("filename"):
+                name = expand(el.get("filename"))
+            elif el.get("name", "").endswith("filename") and el.get("value"):
+                name = expand(el.get("value"))
+            else:
+                continue
+            found = [os.path.abspath(os.path.join(f, name)) for f in [here] + folders]
+            found = [f for f in dict.fromkeys(found) if os.path.isfile(f)]
+            if el.tag == "include":
+                todo += found
+            else:
+                names += found
+    return sorted(set(files + names))
+
+
+def scene_hash(scene_path, params=None):
+    """Hex digest of the contents of a scene's files (see ``_scene_files``) and its ``params``:
+    it changes when any of them is edited."""
+    params = {k: facet._param_value(k, v) for k, v in (params or {}).items()}
+    h = hashlib.blake2b(digest_size=16)
+    for key in sorted(params):
+        h.update(f"{key}={params[key]}\0".encode())
+    for name in _scene_files(os.fspath(scene_path), params):
+        h.update(name.encode() + b"\0")
+        with open(name, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def _scene(path, params, content_hash):
+    """The worker's scene for (path, params) whose files hash to ``content_hash`` (None: as they
+    are now), loaded again when they have changed; the least recently used beyond _CACHE_SIZE go."""
     key = (path, tuple(sorted(params.items())))
-    scene = _scenes.get(key)
-    if scene is None:
-        scene = facet.load_file(path, **params)
-        _scenes[key] = scene
+    if content_hash is None:
+        content_hash = scene_hash(path, params)
+    entry = _scenes.get(key)
+    if entry is not None and entry[0] == content_hash:
+        _scenes.move_to_end(key)
+        return entry[1]
+    _scenes.pop(key, None)  # an older version: replaced
+    scene = facet.load_file(path, **params)
+    # After the load: the files it read are the ones hashed (or an edit since shows).
+    mine = scene_hash(path, params)
+    if mine != content_hash:
+        raise RuntimeError(
+            f"{path}: the scene's files on this worker differ from the client's (edited while "
+            "the render was submitted, or another copy of them): render again")
+    _scenes[key] = (mine, scene)
+    while len(_scenes) > _CACHE_SIZE:
+        _scenes.popitem(last=False)
     return scene
 
 
@@ -63,10 +146,11 @@ def _worker_threads():
 
 
 def render_part(scene_path, params, crop, pass_index, passes, spp=None, seed=0, sensor=0,
-                threads=None):
+                threads=None, content_hash=None):
     """One task: renders window ``crop`` of pass ``pass_index`` of ``passes`` and returns it as a
-    plain dict (what ``facet.merge`` takes back with ``facet.Image.from_part``)."""
-    scene = _scene(scene_path, params)
+    plain dict (what ``facet.merge`` takes back with ``facet.Image.from_part``). ``content_hash``
+    is the client's ``scene_hash()`` of the scene: the worker checks its files against it."""
+    scene = _scene(scene_path, params, content_hash)
     if threads is None:
         threads = _worker_threads()
     image = facet.render(scene, spp=spp, seed=seed, sensor=sensor, threads=threads, crop=crop,
@@ -84,6 +168,8 @@ def render(scene_path, client, tiles=(2, 2), passes=1, spp=None, seed=0, sensor=
     params = {k: facet._param_value(k, v) for k, v in (params or {}).items()}
     if int(passes) < 1:
         raise ValueError(f"passes={passes!r}: expected at least 1")
+    # The hash first: an edit while the client parses the scene then shows on the workers.
+    content_hash = scene_hash(scene_path, params)
     # The film size, from parsing the scene (no plugin, mesh or BVH on the client).
     sensors = facet.scene_info(scene_path, **params)["sensors"]
     if not 0 <= int(sensor) < len(sensors):
@@ -92,7 +178,7 @@ def render(scene_path, client, tiles=(2, 2), passes=1, spp=None, seed=0, sensor=
     windows = tile_windows(width, height, tiles)
     futures = [
         client.submit(render_part, scene_path, params, crop, p, int(passes), spp, seed, sensor,
-                      threads, pure=False)
+                      threads, content_hash, pure=False)
         for p in range(int(passes))
         for crop in windows
     ]

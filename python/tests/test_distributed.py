@@ -60,3 +60,85 @@ def test_passes_are_bit_identical_to_one_process(client, cornell):
     # ... which is also the merge of the two whole-film passes.
     local = facet.merge([facet.render(scene, pass_index=i, passes=2) for i in range(2)])
     assert np.array_equal(image.pixels, local.pixels)
+
+
+EDITABLE = """<scene version="3.0.0">
+    <default name="albedo" value="0.5"/>
+    <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+    <sensor type="perspective">
+        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="12"/></film>
+    </sensor>
+    <include filename="light.xml"/>
+    <shape type="obj">
+        <string name="filename" value="quad.obj"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="$albedo"/></bsdf>
+    </shape>
+</scene>
+"""
+
+LIGHT = """<scene version="3.0.0">
+    <emitter type="constant"><rgb name="radiance" value="{}"/></emitter>
+</scene>
+"""
+
+QUAD = """v -{s} -{s} 0
+v {s} -{s} 0
+v {s} {s} 0
+v -{s} {s} 0
+f 1 2 3
+f 1 3 4
+"""
+
+
+def test_an_edited_scene_is_rendered_anew(client, tmp_path):
+    """A worker used to keep a scene by its path: after an edit the same client got the old
+    image back. Edits of the scene file, of a file it includes and of a mesh it names each give
+    the image of the edited scene."""
+    scene = tmp_path / "scene.xml"
+    scene.write_text(EDITABLE)
+    (tmp_path / "light.xml").write_text(LIGHT.format(1))
+    (tmp_path / "quad.obj").write_text(QUAD.format(s=1))
+
+    def both():
+        dask = facet.distributed.render(scene, client, tiles=(2, 1))
+        local = facet.render(facet.load_file(scene))
+        assert np.array_equal(dask.pixels, local.pixels)
+        return dask.pixels
+
+    images = [both()]
+    scene.write_text(EDITABLE.replace('value="0.5"', 'value="0.9"'))
+    images.append(both())
+    (tmp_path / "light.xml").write_text(LIGHT.format(2))
+    images.append(both())
+    (tmp_path / "quad.obj").write_text(QUAD.format(s=0.5))
+    images.append(both())
+    for i in range(1, len(images)):
+        assert not np.array_equal(images[i - 1], images[i]), f"edit {i} changed nothing"
+
+
+def test_the_worker_cache_is_bounded(client, tmp_path):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(EDITABLE)
+    (tmp_path / "light.xml").write_text(LIGHT.format(1))
+    (tmp_path / "quad.obj").write_text(QUAD.format(s=1))
+    # Every albedo is another scene for the cache; each worker keeps a few.
+    for albedo in range(8):
+        facet.distributed.render(scene, client, tiles=(2, 1), params=dict(albedo=albedo / 8))
+    cached = client.run(lambda: len(facet.distributed._scenes))
+    assert all(1 <= n <= facet.distributed._CACHE_SIZE for n in cached.values()), cached
+
+
+def test_scene_hash_follows_the_files(tmp_path):
+    scene = tmp_path / "scene.xml"
+    scene.write_text(EDITABLE)
+    (tmp_path / "light.xml").write_text(LIGHT.format(1))
+    (tmp_path / "quad.obj").write_text(QUAD.format(s=1))
+    files = facet.distributed._scene_files(str(scene), {})
+    assert files == sorted(str(tmp_path / n) for n in ("scene.xml", "light.xml", "quad.obj"))
+    h = facet.distributed.scene_hash(scene)
+    assert h == facet.distributed.scene_hash(scene)
+    assert h != facet.distributed.scene_hash(scene, dict(albedo=0.25))
+    (tmp_path / "quad.obj").write_text(QUAD.format(s=2))
+    assert h != facet.distributed.scene_hash(scene)
