@@ -88,7 +88,7 @@ std::vector<Case> cases() {
         {"gaussian_huge",
          scene("", "<translate z=\"5\"/>",
                "<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"1e30\"/></rfilter>"),
-         "stddev must be a positive number", 4},
+         "stddev must be a number of pixels in [0.00390625, 16]", 4},
         {"nan_reflectance",
          scene("<shape type=\"sphere\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" "
                "value=\"nan\"/></bsdf></shape>"),
