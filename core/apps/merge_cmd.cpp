@@ -5,9 +5,14 @@
 #include "merge.h"
 
 #include <facet/logger.h>
+#include <facet/render.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
 
 int merge_main(int argc, char **argv) {
     std::vector<std::string> inputs;
@@ -31,7 +36,35 @@ int merge_main(int argc, char **argv) {
     facet::cli::set_activity(fmt::format("merging {} parts", parts.size()));
     facet::merge::Merged merged = facet::merge::merge_parts(parts);
     facet::cli::set_activity(fmt::format("writing \"{}\"", output));
-    facet::merge::write_merged(merged, output);
+    // A merge is the last step of a long render: a signal during the write (a Slurm time limit,
+    // a Ctrl-C) lets it finish, then facet exits 128 + the signal, as `facet render` does.
+    std::atomic<bool> interrupted{false};
+    facet::install_interrupt_handler(&interrupted);
+    facet::defer_interrupts();
+    struct HandlerGuard {
+        ~HandlerGuard() { facet::uninstall_interrupt_handler(); }
+    } handler_guard;
+    std::string write_error;
+    try {
+        facet::merge::write_merged(merged, output);
+    } catch (const std::exception &e) {
+        if (facet::interrupt_signal() == 0) throw;
+        write_error = e.what(); // said with the signal, below
+    }
+    if (const int sig = facet::interrupt_signal(); sig != 0) {
+        const char *verb = sig == SIGTERM  ? "terminated"
+                           : sig == SIGHUP ? "hung up"
+                                           : "interrupted";
+        if (write_error.empty())
+            std::fprintf(stderr, "facet: %s (%s) while writing: wrote the merged image to %s\n",
+                         verb, facet::interrupt_signal_name(sig), output.c_str());
+        else
+            std::fprintf(stderr,
+                         "facet: %s (%s) while writing: the merged image was not written: "
+                         "%s\n",
+                         verb, facet::interrupt_signal_name(sig), write_error.c_str());
+        return 128 + sig;
+    }
     if (!quiet)
         fmt::print("Merged {} part{} ({} pass{}) into {} ({}x{})\n", parts.size(),
                    parts.size() == 1 ? "" : "s", merged.passes, merged.passes == 1 ? "" : "es",

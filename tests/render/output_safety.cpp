@@ -306,6 +306,56 @@ TEST_F(OutputSafety, ARepeatedSignalDuringTheWriteIsNotFatalEither) {
     EXPECT_NE(r.err.find("still writing the image"), std::string::npos) << r.err;
 }
 
+TEST_F(OutputSafety, SigtermDuringTheWriteOfAMergeFinishesItThenExits143) {
+    // The merge of a split render is its last step: a Slurm time limit landing in its write
+    // lost the whole render (the merge died, the temporary file stayed).
+    bool landed = false;
+    int status = 0;
+    std::string err;
+    for (int attempt = 0; attempt < 4 && !landed; ++attempt) {
+        const std::string res = std::to_string(640 << (attempt / 2));
+        for (int i = 0; i < 2; ++i) {
+            facet::test::CommandResult r =
+                run("render scene.xml -q -t 2 -D res=" + res + " -D spp=1 --passes 2 --pass " +
+                    std::to_string(i) + " -o part" + std::to_string(i) + ".exr");
+            ASSERT_EQ(r.code, 0) << r.err;
+        }
+        fs::remove(m_dir / "merged.png");
+        Child child(m_dir, {"merge", "part0.exr", "part1.exr", "-o", "merged.png"});
+        ASSERT_NE(child.pid, 0) << "cannot start facet";
+        const fs::path tmp = m_dir / (".merged.png.tmp-" + std::to_string(child.pid));
+        const auto start = Clock::now();
+        while (!landed && Clock::now() - start < std::chrono::seconds(60)) {
+            if (waitpid(child.pid, &status, WNOHANG) != 0) break; // the write was missed
+            if (fs::exists(tmp)) landed = child.stopped_while_exists(tmp);
+            if (!landed) std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
+        if (landed) {
+            kill(child.pid, SIGTERM);
+            kill(child.pid, SIGCONT);
+            status = child.wait();
+        }
+        err = read_file(child.err);
+        fs::remove(child.out);
+        fs::remove(child.err);
+    }
+    ASSERT_TRUE(landed) << "the signal never reached the merge during its write";
+    ASSERT_TRUE(WIFEXITED(status))
+        << "the merge died from signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0) << "\n"
+        << err;
+    EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << err;
+    const std::vector<std::string> err_lines = lines(err);
+    ASSERT_FALSE(err_lines.empty());
+    EXPECT_NE(err_lines.back().find("SIGTERM"), std::string::npos) << err;
+    EXPECT_NE(err_lines.back().find("wrote the merged image to merged.png"), std::string::npos)
+        << err;
+    facet::Image img = facet::read_image(path("merged.png"));
+    EXPECT_GE(img.width, 640);
+    EXPECT_EQ(img.height, img.width);
+    EXPECT_EQ(files(),
+              (std::set<std::string>{"scene.xml", "part0.exr", "part1.exr", "merged.png"}));
+}
+
 TEST_F(OutputSafety, TimeoutAndSignalWriteThePartialImageTheSameWay) {
     // The integrator's timeout stops a render of far too many samples: the passes done are
     // written as a Ctrl-C writes them (same attributes), and the exit is a success.
