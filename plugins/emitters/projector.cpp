@@ -48,7 +48,7 @@ namespace facet {
 class Projector final : public Emitter {
 public:
     explicit Projector(const Properties &props) {
-        m_irradiance = props.texture("irradiance", 1.f);
+        m_irradiance = props.texture("irradiance", 1.f, SpectrumKind::Emission);
         const double scale = props.get_float("scale", 1.0);
         if (!std::isfinite(scale) || scale < 0.0)
             FACET_THROW_AT(props.location("scale"),

@@ -37,7 +37,8 @@ class SpotEmitter final : public Emitter {
 public:
     explicit SpotEmitter(const Properties &props) {
         m_intensity = props.get_color("intensity", Color3f(1.f), SpectrumKind::Emission);
-        m_texture = props.has("texture") ? props.texture("texture") : nullptr;
+        m_texture =
+            props.has("texture") ? props.texture("texture", SpectrumKind::Emission) : nullptr;
         m_to_world = props.get_transform("to_world", Transform());
         float cutoff = float(props.get_float("cutoff_angle", 20.0));
         float beam = float(props.get_float("beam_width", cutoff * 0.75));

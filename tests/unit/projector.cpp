@@ -8,6 +8,7 @@
 #include <facet/image.h>
 #include <facet/plugin.h>
 #include <facet/random.h>
+#include <facet/spectrum.h>
 #include <facet/texture.h>
 
 #include <gtest/gtest.h>
@@ -40,6 +41,22 @@ Color3f irradiance_at(const Emitter &e, const Point3f &p, const Vector3f &n) {
 double deg(double d) { return d * M_PI / 180.0; }
 
 } // namespace
+
+TEST(Projector, AnInlineSpectrumIrradianceIsAnEmittersSpectrum) {
+    // A <spectrum> given in an emitter is an emission spectrum (no D65, only clamped at 0), the
+    // projector's `irradiance` too: it was read as a reflectance (D65-weighted, clamped to 1).
+    const SpectrumData s = parse_spectrum_pairs("400:2.5, 500:1.5, 600:0.5, 700:0.2");
+    const Color3f emission = spectrum_to_rgb(s, SpectrumKind::Emission);
+    ASSERT_GT(std::abs(emission.b - spectrum_to_rgb(s, SpectrumKind::Reflectance).b), 0.1f);
+    Properties props;
+    props.set("irradiance", s);
+    auto proj = make_projector(props);
+    // E = π·irradiance on the axis at unit distance.
+    const Color3f e = irradiance_at(*proj, Point3f(0.f, 0.f, 1.f), Vector3f(0, 0, -1));
+    EXPECT_NEAR(e.r, Pi * emission.r, 1e-4f * Pi * emission.r);
+    EXPECT_NEAR(e.g, Pi * emission.g, 1e-4f * Pi * emission.g);
+    EXPECT_NEAR(e.b, Pi * emission.b, 1e-4f * Pi * emission.b);
+}
 
 TEST(Projector, FacingPlaneIsLitEvenlyByTheClosedForm) {
     Properties props;

@@ -3,6 +3,7 @@
 
 #include <facet/emitter.h>
 #include <facet/plugin.h>
+#include <facet/spectrum.h>
 
 #include <gtest/gtest.h>
 
@@ -48,6 +49,23 @@ TEST(Spot, FalloffAndInverseSquare) {
     EXPECT_NEAR(at(25.f), 1.5f, 1e-3f);
     EXPECT_EQ(at(31.f), 0.f);
     EXPECT_EQ(spot->pdf_direction(far, DirectionSample()), 0.f);
+}
+
+TEST(Spot, AnInlineSpectrumTextureIsAnEmittersSpectrum) {
+    // A <spectrum> given in an emitter is an emission spectrum (no D65, only clamped at 0), its
+    // `texture` too: it was read as a reflectance (D65-weighted, clamped to 1).
+    const SpectrumData s = parse_spectrum_pairs("400:2.5, 500:1.5, 600:0.5, 700:0.2");
+    const Color3f emission = spectrum_to_rgb(s, SpectrumKind::Emission);
+    const Color3f reflectance = spectrum_to_rgb(s, SpectrumKind::Reflectance);
+    ASSERT_GT(std::abs(emission.b - reflectance.b), 0.1f) << "the test cannot tell them apart";
+    Properties props("spot");
+    props.set_color("intensity", Color3f(2.f, 3.f, 4.f));
+    props.set("texture", s);
+    auto spot = PluginRegistry::instance().create_as<Emitter>(ObjectType::Emitter, props);
+    const Color3f on_axis = intensity_towards(*spot, Point3f(0.f), {0, 0, 1});
+    EXPECT_NEAR(on_axis.r, 2.f * emission.r, 1e-4f);
+    EXPECT_NEAR(on_axis.g, 3.f * emission.g, 1e-4f);
+    EXPECT_NEAR(on_axis.b, 4.f * emission.b, 1e-4f);
 }
 
 TEST(Spot, InvalidAnglesAreRefused) {
