@@ -1,3 +1,5 @@
+#include "scene_description.h"
+
 #include <facet/film.h>
 #include <facet/integrator.h>
 #include <facet/logger.h>
@@ -650,6 +652,14 @@ void append_raw_channels(Image &image, const Film &film) {
 
 } // namespace
 
+/// Where the scene file declares `object` (its tag); none for objects not loaded from a file.
+static Location declared_at(const Scene &scene, const Object *object) {
+    if (const std::shared_ptr<SceneDescription> &d = scene.description())
+        for (const SceneDescription::Node &node : d->nodes)
+            if (node.instance.get() == object) return node.location;
+    return {};
+}
+
 /// Every pass of opts.pass_count, one after the other, combined as a merge of the parts combines
 /// them: the raw sums of each pass rounded to float (what a part's file holds), added in pass
 /// order in double and developed once. The result is bit-identical to the merge of the parts.
@@ -735,8 +745,18 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
         film.set_crop_window(Point2i(c[0], c[1]), Point2i(c[2] - c[0], c[3] - c[1]));
     }
     const SampleRange range = render_sample_range(sensor, opts); // validates the options
-    if (opts.pass_count > 1 && opts.pass_index < 0) return render_all_passes(scene, sensor, opts);
-    RenderResult result = integrator.render(scene, sensor, opts);
+    RenderResult result;
+    try {
+        if (opts.pass_count > 1 && opts.pass_index < 0)
+            return render_all_passes(scene, sensor, opts);
+        result = integrator.render(scene, sensor, opts);
+    } catch (const Error &e) {
+        // An integrator's own error (its parameters against the render's sample count, say), at
+        // the integrator's place in the scene file.
+        const Location at = e.location().valid() ? Location() : declared_at(scene, &integrator);
+        if (!at.valid()) throw;
+        throw Error(at, e.message());
+    }
     if (result.spp_total == 0) {
         // An integrator that does not fill these in renders one whole part.
         if (opts.pass_count != 1)

@@ -343,3 +343,31 @@ TEST(HostileInput, SamplerErrorsAtRenderSetupCarryTheSamplersLocation) {
     EXPECT_EQ(e.location().to_string(), "string:4:4");
     EXPECT_CONTAINS(e.message(), "37^8 array rows do not fit 32 bits");
 }
+
+TEST(HostileInput, IntegratorErrorsAtRenderSetupCarryTheIntegratorsLocation) {
+    // samples_per_pass 3 loads; a render of 4 samples per pixel cannot be split into passes of
+    // 3: the error had no location. The light tracer's own check likewise.
+    for (const char *type : {"path", "ptracer"}) {
+        SCOPED_TRACE(type);
+        const std::string xml = std::string("<scene version=\"3.0.0\">\n") +
+                                "<sensor type=\"perspective\">\n"
+                                "  <film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/>"
+                                "<integer name=\"height\" value=\"4\"/></film>\n"
+                                "</sensor>\n"
+                                "  <integrator type=\"" +
+                                type +
+                                "\">\n"
+                                "    <integer name=\"samples_per_pass\" value=\"3\"/>\n"
+                                "  </integrator>\n"
+                                "<shape type=\"sphere\"/><emitter type=\"constant\"/>\n"
+                                "</scene>\n";
+        auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml));
+        ASSERT_TRUE(scene);
+        RenderOptions opts;
+        opts.spp = 4;
+        opts.progress = false;
+        Error e = error_of([&] { render(*scene, *scene->sensors().at(0), opts); });
+        EXPECT_EQ(e.location().to_string(), "string:5:4");
+        EXPECT_CONTAINS(e.message(), "must be a multiple of samples_per_pass (3)");
+    }
+}
