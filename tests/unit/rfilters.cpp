@@ -266,7 +266,8 @@ TEST(Filters, ParametersOutsideTheirRangeAreLocatedErrors) {
          "lobes must be a whole number between 1 and 64"},
     };
     for (const auto &[rfilter, message] : cases) {
-        std::string error = error_of([&] { load_string(filter_scene(rfilter)); });
+        const std::string scene = filter_scene(rfilter); // (C++17 lambdas capture no bindings)
+        std::string error = error_of([&] { load_string(scene); });
         EXPECT_NE(error.find(message), std::string::npos) << error;
         // Located at the parameter, on line 7 of the scene.
         EXPECT_EQ(error.rfind("string:7:", 0), 0u) << error;
