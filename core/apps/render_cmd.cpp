@@ -218,6 +218,9 @@ int render_main(int argc, char **argv) {
 
     CLI::App app("Render a Mitsuba 3 scene", "facet render");
     cli::add_scene_options(app, opts);
+    std::vector<std::string> more_scenes;
+    app.add_option("more_scenes", more_scenes,
+                   "Further scene files, rendered one after the other with the same options");
     app.add_option("-o,--output", output,
                    "Output image (default: the scene's name with .exr); .png/.jpg are tone mapped "
                    "through OpenColorIO");
@@ -250,195 +253,224 @@ int render_main(int argc, char **argv) {
     if (app.count("--spp") > 0 && spp < 1)
         FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", spp);
 
-    const auto load_start = std::chrono::steady_clock::now();
-    std::shared_ptr<Scene> scene = cli::load_scene(opts);
-    const double load_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-    const auto &sensors = scene->sensors();
-    if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
-        FACET_THROW("-s {}: the scene has {} sensor{} (valid indices 0..{})", opts.sensor,
-                    sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
-    const Sensor &sensor = *sensors[size_t(opts.sensor)];
-    Film &film = sensor.film();
+    // Several scenes, one after the other (Mitsuba's `mitsuba a.xml b.xml`): each writes its own
+    // image, so -o can only be a folder; the first error or signal ends the sequence.
+    std::vector<std::string> scenes{opts.scene};
+    scenes.insert(scenes.end(), more_scenes.begin(), more_scenes.end());
+    if (scenes.size() > 1 && !output.empty() && output.back() != '/') {
+        std::error_code ec;
+        if (!fs::is_directory(output, ec))
+            FACET_THROW("-o {}: {} scenes are rendered, each to its own image: -o must name a "
+                        "folder (an existing one, or ending in '/'), or be left out",
+                        output, scenes.size());
+    }
 
-    std::string out = output_path(opts.scene, output, film);
-    ImageWriteOptions wopts;
-    wopts.ocio_config = ocio_config;
-    wopts.display = display;
-    wopts.view = view;
-    wopts.looks = looks;
-    const bool part = pass_count > 1 && app.count("--pass") > 0; // raw sums follow
-    check_output(out, wopts, *scene, sensor, opts.scene, part);
+    const auto render_one = [&]() -> int {
+        const auto load_start = std::chrono::steady_clock::now();
+        std::shared_ptr<Scene> scene = cli::load_scene(opts);
+        const double load_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+        const auto &sensors = scene->sensors();
+        if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
+            FACET_THROW("-s {}: the scene has {} sensor{} (valid indices 0..{})", opts.sensor,
+                        sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
+        const Sensor &sensor = *sensors[size_t(opts.sensor)];
+        Film &film = sensor.film();
 
-    RenderOptions ropts;
-    ropts.threads = opts.threads;
-    ropts.seed = seed;
-    ropts.spp = spp;
-    ropts.progress = !opts.quiet;
-    if (!crop.empty()) {
-        const Point2i size = film.size();
-        if (crop[0] < 0 || crop[1] < 0 || crop[2] > size.x || crop[3] > size.y ||
-            crop[2] <= crop[0] || crop[3] <= crop[1])
-            FACET_THROW("--crop {} {} {} {}: expected X0 Y0 X1 Y1 with 0 <= X0 < X1 <= {} and "
-                        "0 <= Y0 < Y1 <= {} (the film is {}x{}; X1 and Y1 are exclusive)",
-                        crop[0], crop[1], crop[2], crop[3], size.x, size.y, size.x, size.y);
-        ropts.crop = {{crop[0], crop[1], crop[2], crop[3]}};
-    }
-    if (pass_count != 0 || pass_index >= 0) {
-        // --passes N alone: all N parts in this process (pass index -1).
-        if (pass_count >= 1 && app.count("--pass") == 0) pass_index = -1;
-        if (pass_count < 1 || pass_index < -1 || pass_index >= pass_count ||
-            (pass_index == -1 && app.count("--pass") > 0))
-            FACET_THROW("--pass I --passes N: expected N >= 1 and 0 <= I < N (or --passes N "
-                        "alone for all the parts), got --pass {} --passes {}",
-                        pass_index < 0 ? std::string("(none)") : std::to_string(pass_index),
-                        pass_count == 0 ? std::string("(none)") : std::to_string(pass_count));
-        ropts.pass_index = pass_index;
-        ropts.pass_count = pass_count;
-    }
-    std::atomic<bool> cancel{false};
-    ropts.cancel = &cancel;
-    SampleRange range;
-    try {
-        range = render_sample_range(sensor, ropts);
-    } catch (const Error &e) {
-        if (e.location().valid()) throw; // a sampler's error, at its place in the scene
-        // Else the sample count and the parts come from these options: name them.
-        const std::string count =
-            spp > 0 ? fmt::format("--spp {}", spp)
-                    : fmt::format("the sampler's sample_count {}", sensor.sampler().sample_count());
-        const std::string parts = pass_count > 0 ? fmt::format(", --passes {}", pass_count) : "";
-        FACET_THROW("{}{}: {}", count, parts, e.message());
-    }
-    const uint64_t asked = uint64_t(spp > 0 ? uint32_t(spp) : sensor.sampler().sample_count()) *
-                           uint64_t(ropts.pass_count);
-    // The sampler's rounding, said where the spp is printed.
-    const std::string rounding =
-        range.total != asked ? fmt::format(" (the sampler rounds {} up to {})", asked, range.total)
-                             : "";
-    int threads = cli::effective_threads(opts.threads);
+        std::string out = output_path(opts.scene, output, film);
+        ImageWriteOptions wopts;
+        wopts.ocio_config = ocio_config;
+        wopts.display = display;
+        wopts.view = view;
+        wopts.looks = looks;
+        const bool part = pass_count > 1 && app.count("--pass") > 0; // raw sums follow
+        check_output(out, wopts, *scene, sensor, opts.scene, part);
 
-    // What ties the parts of one render together (checked by a merge).
-    std::map<std::string, std::string> params;
-    for (const std::string &define : opts.defines) {
-        size_t eq = define.find('=');
-        params[define.substr(0, eq)] = define.substr(eq + 1);
-    }
-    std::ifstream scene_file(opts.scene, std::ios::binary);
-    std::string scene_text((std::istreambuf_iterator<char>(scene_file)),
-                           std::istreambuf_iterator<char>());
-    const std::string scene_hash = scene_identity(scene_text, params, film.size().x, film.size().y);
-
-    // From here on Ctrl-C, SIGTERM and SIGHUP stop the render and the partial image is written;
-    // from the end of the render to the rename of the output, no signal is fatal (the write
-    // finishes, or removes its temporary file), and facet exits 128 + the signal after it.
-    install_interrupt_handler(&cancel);
-    struct HandlerGuard {
-        ~HandlerGuard() { uninstall_interrupt_handler(); }
-    } handler_guard;
-    if (!opts.quiet) {
-        const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
-        const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
-        fmt::print(
-            "Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", opts.scene, w, h,
-            crop.empty() ? ""
-                         : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1], crop[2],
-                                       crop[3], film.size().x, film.size().y),
-            range.count, rounding,
-            ropts.pass_count > 1 && ropts.pass_index < 0
-                ? fmt::format(" (in {} parts, combined as a merge of them)", ropts.pass_count)
-            : ropts.pass_count > 1 ? fmt::format(" (part {} of {}: samples {}..{} of {})",
-                                                 ropts.pass_index, ropts.pass_count, range.first,
-                                                 range.first + range.count - 1, range.total)
-                                   : "",
-            threads, threads == 1 ? "" : "s");
-        std::fflush(stdout);
-    }
-    cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
-                                  film.crop_size().x, film.crop_size().y, range.count));
-    RenderResult result;
-    // The module that writes the output loads while the render runs, from its first pixels on.
-    ropts.on_first_block = [out] { preload_image_writer(out); };
-    result = render(*scene, sensor, ropts);
-    defer_interrupts();
-    const bool signal_in_render = interrupt_signal() != 0;
-    result.load_seconds = load_seconds;
-
-    wopts.metadata = render_metadata(result);
-    wopts.metadata["facet:scene_hash"] = scene_hash;
-    wopts.metadata["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
-    wopts.metadata["facet:scene"] = fs::absolute(opts.scene).lexically_normal().string();
-    wopts.metadata["facet:seed"] = std::to_string(seed);
-    add_render_metadata(wopts, sensor, int(result.spp), result.seconds); // typed, as pbrt-v4 writes
-    if (result.cancelled)
-        wopts.metadata["facet:blocks"] =
-            fmt::format("{}/{}", result.blocks_done, result.blocks_total);
-    cli::set_activity(fmt::format("writing \"{}\"", out));
-    const auto write_start = std::chrono::steady_clock::now();
-    std::string write_error;
-    try {
-        film.write(result.image, out, wopts);
-    } catch (const std::exception &e) {
-        if (interrupt_signal() == 0) throw;
-        write_error = e.what(); // said with the signal, below
-    }
-    const double write_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
-    if (!opts.quiet) {
-        // The summary of where the time went (-v: every phase).
-        fmt::print("Times: load {} (acceleration structure {}), render {}\n",
-                   format_seconds(result.load_seconds), format_seconds(result.accel_seconds),
-                   format_seconds(result.seconds));
-        if (opts.verbose > 0) {
-            fmt::print("  scene file and plugins  {}\n",
-                       format_seconds(std::max(0.0, result.load_seconds - result.accel_seconds)));
-            fmt::print("  acceleration structure  {}\n", format_seconds(result.accel_seconds));
-            const double rate = result.sampling_seconds > 0.0
-                                    ? double(result.samples) / result.sampling_seconds
-                                    : 0.0;
-            fmt::print("  sampling                {} ({} of {} work units, {:.3g} samples/s)\n",
-                       format_seconds(result.sampling_seconds), result.blocks_done,
-                       result.blocks_total, rate);
-            if (result.first_block_cpu_seconds > 0.0)
-                fmt::print("  first pixels            {:.3f} s CPU from the start of the process "
-                           "(every thread)\n",
-                           result.first_block_cpu_seconds);
-            fmt::print("  developing the film     {}\n", format_seconds(result.develop_seconds));
-            fmt::print("  writing the image       {}\n", format_seconds(write_seconds));
+        RenderOptions ropts;
+        ropts.threads = opts.threads;
+        ropts.seed = seed;
+        ropts.spp = spp;
+        ropts.progress = !opts.quiet;
+        if (!crop.empty()) {
+            const Point2i size = film.size();
+            if (crop[0] < 0 || crop[1] < 0 || crop[2] > size.x || crop[3] > size.y ||
+                crop[2] <= crop[0] || crop[3] <= crop[1])
+                FACET_THROW("--crop {} {} {} {}: expected X0 Y0 X1 Y1 with 0 <= X0 < X1 <= {} and "
+                            "0 <= Y0 < Y1 <= {} (the film is {}x{}; X1 and Y1 are exclusive)",
+                            crop[0], crop[1], crop[2], crop[3], size.x, size.y, size.x, size.y);
+            ropts.crop = {{crop[0], crop[1], crop[2], crop[3]}};
         }
-        std::fflush(stdout);
-    }
+        if (pass_count != 0 || pass_index >= 0) {
+            // --passes N alone: all N parts in this process (pass index -1).
+            if (pass_count >= 1 && app.count("--pass") == 0) pass_index = -1;
+            if (pass_count < 1 || pass_index < -1 || pass_index >= pass_count ||
+                (pass_index == -1 && app.count("--pass") > 0))
+                FACET_THROW("--pass I --passes N: expected N >= 1 and 0 <= I < N (or --passes N "
+                            "alone for all the parts), got --pass {} --passes {}",
+                            pass_index < 0 ? std::string("(none)") : std::to_string(pass_index),
+                            pass_count == 0 ? std::string("(none)") : std::to_string(pass_count));
+            ropts.pass_index = pass_index;
+            ropts.pass_count = pass_count;
+        }
+        std::atomic<bool> cancel{false};
+        ropts.cancel = &cancel;
+        SampleRange range;
+        try {
+            range = render_sample_range(sensor, ropts);
+        } catch (const Error &e) {
+            if (e.location().valid()) throw; // a sampler's error, at its place in the scene
+            // Else the sample count and the parts come from these options: name them.
+            const std::string count = spp > 0 ? fmt::format("--spp {}", spp)
+                                              : fmt::format("the sampler's sample_count {}",
+                                                            sensor.sampler().sample_count());
+            const std::string parts =
+                pass_count > 0 ? fmt::format(", --passes {}", pass_count) : "";
+            FACET_THROW("{}{}: {}", count, parts, e.message());
+        }
+        const uint64_t asked = uint64_t(spp > 0 ? uint32_t(spp) : sensor.sampler().sample_count()) *
+                               uint64_t(ropts.pass_count);
+        // The sampler's rounding, said where the spp is printed.
+        const std::string rounding =
+            range.total != asked
+                ? fmt::format(" (the sampler rounds {} up to {})", asked, range.total)
+                : "";
+        int threads = cli::effective_threads(opts.threads);
 
-    const std::string reached =
-        fmt::format("{} of {} spp{}", result.spp, result.spp_target,
-                    result.spp == 0 ? ", no pass finished: the image is black" : "");
-    if (const int sig = interrupt_signal(); sig != 0) {
-        // One line: the signal, when it came, and what is in the output file.
-        const std::string what =
-            result.cancelled && !result.timed_out ? fmt::format("the partial image ({})", reached)
-            : result.timed_out ? fmt::format("the image of the timeout ({})", reached)
-                               : fmt::format("the complete image ({})", reached);
-        const std::string when =
-            signal_in_render ? "after " + format_seconds(result.seconds) : "while writing";
-        const char *verb = sig == SIGTERM  ? "terminated"
-                           : sig == SIGHUP ? "hung up"
-                                           : "interrupted";
-        if (write_error.empty())
-            std::fprintf(stderr, "facet: %s (%s) %s: wrote %s to %s\n", verb,
-                         interrupt_signal_name(sig), when.c_str(), what.c_str(), out.c_str());
-        else
-            std::fprintf(stderr, "facet: %s (%s) %s: %s was not written: %s\n", verb,
-                         interrupt_signal_name(sig), when.c_str(), what.c_str(),
-                         write_error.c_str());
-        return 128 + sig;
-    }
-    if (result.timed_out) {
-        // The integrator's `timeout` is a request, not an interruption: success.
+        // What ties the parts of one render together (checked by a merge).
+        std::map<std::string, std::string> params;
+        for (const std::string &define : opts.defines) {
+            size_t eq = define.find('=');
+            params[define.substr(0, eq)] = define.substr(eq + 1);
+        }
+        std::ifstream scene_file(opts.scene, std::ios::binary);
+        std::string scene_text((std::istreambuf_iterator<char>(scene_file)),
+                               std::istreambuf_iterator<char>());
+        const std::string scene_hash =
+            scene_identity(scene_text, params, film.size().x, film.size().y);
+
+        // From here on Ctrl-C, SIGTERM and SIGHUP stop the render and the partial image is written;
+        // from the end of the render to the rename of the output, no signal is fatal (the write
+        // finishes, or removes its temporary file), and facet exits 128 + the signal after it.
+        install_interrupt_handler(&cancel);
+        struct HandlerGuard {
+            ~HandlerGuard() { uninstall_interrupt_handler(); }
+        } handler_guard;
+        if (!opts.quiet) {
+            const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
+            const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
+            fmt::print(
+                "Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", opts.scene, w, h,
+                crop.empty() ? ""
+                             : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1],
+                                           crop[2], crop[3], film.size().x, film.size().y),
+                range.count, rounding,
+                ropts.pass_count > 1 && ropts.pass_index < 0
+                    ? fmt::format(" (in {} parts, combined as a merge of them)", ropts.pass_count)
+                : ropts.pass_count > 1
+                    ? fmt::format(" (part {} of {}: samples {}..{} of {})", ropts.pass_index,
+                                  ropts.pass_count, range.first, range.first + range.count - 1,
+                                  range.total)
+                    : "",
+                threads, threads == 1 ? "" : "s");
+            std::fflush(stdout);
+        }
+        cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
+                                      film.crop_size().x, film.crop_size().y, range.count));
+        RenderResult result;
+        // The module that writes the output loads while the render runs, from its first pixels on.
+        ropts.on_first_block = [out] { preload_image_writer(out); };
+        result = render(*scene, sensor, ropts);
+        defer_interrupts();
+        const bool signal_in_render = interrupt_signal() != 0;
+        result.load_seconds = load_seconds;
+
+        wopts.metadata = render_metadata(result);
+        wopts.metadata["facet:scene_hash"] = scene_hash;
+        wopts.metadata["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
+        wopts.metadata["facet:scene"] = fs::absolute(opts.scene).lexically_normal().string();
+        wopts.metadata["facet:seed"] = std::to_string(seed);
+        add_render_metadata(wopts, sensor, int(result.spp),
+                            result.seconds); // typed, as pbrt-v4 writes
+        if (result.cancelled)
+            wopts.metadata["facet:blocks"] =
+                fmt::format("{}/{}", result.blocks_done, result.blocks_total);
+        cli::set_activity(fmt::format("writing \"{}\"", out));
+        const auto write_start = std::chrono::steady_clock::now();
+        std::string write_error;
+        try {
+            film.write(result.image, out, wopts);
+        } catch (const std::exception &e) {
+            if (interrupt_signal() == 0) throw;
+            write_error = e.what(); // said with the signal, below
+        }
+        const double write_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+        if (!opts.quiet) {
+            // The summary of where the time went (-v: every phase).
+            fmt::print("Times: load {} (acceleration structure {}), render {}\n",
+                       format_seconds(result.load_seconds), format_seconds(result.accel_seconds),
+                       format_seconds(result.seconds));
+            if (opts.verbose > 0) {
+                fmt::print(
+                    "  scene file and plugins  {}\n",
+                    format_seconds(std::max(0.0, result.load_seconds - result.accel_seconds)));
+                fmt::print("  acceleration structure  {}\n", format_seconds(result.accel_seconds));
+                const double rate = result.sampling_seconds > 0.0
+                                        ? double(result.samples) / result.sampling_seconds
+                                        : 0.0;
+                fmt::print("  sampling                {} ({} of {} work units, {:.3g} samples/s)\n",
+                           format_seconds(result.sampling_seconds), result.blocks_done,
+                           result.blocks_total, rate);
+                if (result.first_block_cpu_seconds > 0.0)
+                    fmt::print(
+                        "  first pixels            {:.3f} s CPU from the start of the process "
+                        "(every thread)\n",
+                        result.first_block_cpu_seconds);
+                fmt::print("  developing the film     {}\n",
+                           format_seconds(result.develop_seconds));
+                fmt::print("  writing the image       {}\n", format_seconds(write_seconds));
+            }
+            std::fflush(stdout);
+        }
+
+        const std::string reached =
+            fmt::format("{} of {} spp{}", result.spp, result.spp_target,
+                        result.spp == 0 ? ", no pass finished: the image is black" : "");
+        if (const int sig = interrupt_signal(); sig != 0) {
+            // One line: the signal, when it came, and what is in the output file.
+            const std::string what = result.cancelled && !result.timed_out
+                                         ? fmt::format("the partial image ({})", reached)
+                                     : result.timed_out
+                                         ? fmt::format("the image of the timeout ({})", reached)
+                                         : fmt::format("the complete image ({})", reached);
+            const std::string when =
+                signal_in_render ? "after " + format_seconds(result.seconds) : "while writing";
+            const char *verb = sig == SIGTERM  ? "terminated"
+                               : sig == SIGHUP ? "hung up"
+                                               : "interrupted";
+            if (write_error.empty())
+                std::fprintf(stderr, "facet: %s (%s) %s: wrote %s to %s\n", verb,
+                             interrupt_signal_name(sig), when.c_str(), what.c_str(), out.c_str());
+            else
+                std::fprintf(stderr, "facet: %s (%s) %s: %s was not written: %s\n", verb,
+                             interrupt_signal_name(sig), when.c_str(), what.c_str(),
+                             write_error.c_str());
+            return 128 + sig;
+        }
+        if (result.timed_out) {
+            // The integrator's `timeout` is a request, not an interruption: success.
+            if (!opts.quiet)
+                fmt::print("Timeout reached after {} ({}), wrote {}\n",
+                           format_seconds(result.seconds), reached, out);
+            return 0;
+        }
         if (!opts.quiet)
-            fmt::print("Timeout reached after {} ({}), wrote {}\n", format_seconds(result.seconds),
-                       reached, out);
+            fmt::print("Rendered in {}, wrote {}\n", format_seconds(result.seconds), out);
         return 0;
+    };
+    for (const std::string &scene_path : scenes) {
+        opts.scene = scene_path;
+        if (const int code = render_one(); code != 0) return code;
     }
-    if (!opts.quiet) fmt::print("Rendered in {}, wrote {}\n", format_seconds(result.seconds), out);
     return 0;
 }

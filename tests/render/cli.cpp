@@ -137,6 +137,39 @@ TEST_F(CliTest, OutputNames) {
     EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", "out.exr", "picture.png"}));
 }
 
+TEST_F(CliTest, SeveralScenesRenderOneAfterTheOther) {
+    // Mitsuba's `mitsuba a.xml b.xml`: each scene to its own image, the image it gets alone.
+    std::string red = read_file(m_dir / "scene.xml");
+    const std::string albedo = "0.2, 0.5, 0.7";
+    red.replace(red.find(albedo), albedo.size(), "0.9, 0.1, 0.1");
+    write_file(m_dir / "red.xml", red);
+    Result r = run("render scene.xml red.xml -t 2");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("Rendering scene.xml"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Rendering red.xml"), std::string::npos) << r.out;
+    ASSERT_EQ(run("render red.xml -q -t 2 -o alone.exr").code, 0);
+    const facet::Image both = facet::read_image(path("red.exr"));
+    EXPECT_EQ(both.data, facet::read_image(path("alone.exr")).data);
+    EXPECT_NE(both.data, facet::read_image(path("scene.exr")).data);
+    // -o a folder takes each scene's name.
+    fs::create_directories(m_dir / "out");
+    fs::create_directories(m_dir / "seq");
+    ASSERT_EQ(run("render scene.xml red.xml -q -o out/").code, 0);
+    EXPECT_EQ(facet::read_image(path("out/red.exr")).data, both.data);
+    EXPECT_TRUE(fs::exists(m_dir / "out" / "scene.exr"));
+    // -o one file for several scenes is refused before anything renders.
+    const std::string err = expect_one_line_error("render scene.xml red.xml -o one.exr");
+    EXPECT_NE(err.find("-o must name a folder"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(m_dir / "one.exr"));
+    // The first error ends the sequence: the scenes before it keep their images.
+    fs::remove(m_dir / "scene.exr");
+    r = run("render scene.xml missing.xml red.xml -q -o seq/");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("missing.xml"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(m_dir / "seq" / "scene.exr"));
+    EXPECT_FALSE(fs::exists(m_dir / "seq" / "red.exr"));
+}
+
 TEST_F(CliTest, DefineSetsSceneParameters) {
     Result r = run("render scene.xml -q -D res=16 -D spp=2 -o small.exr");
     ASSERT_EQ(r.code, 0) << r.err;
