@@ -43,18 +43,18 @@ const char *SCENE_TEMPLATE =
     <default name="res" value="64"/>
 
 @INTEGRATOR@
-    <sensor type="perspective">
+    <sensor type="@SENSOR@">
         <float name="fov" value="40"/>
         <transform name="to_world">
             <lookat origin="0, 1.5, 4" target="0, 0.5, 0" up="0, 1, 0"/>
         </transform>
-        <sampler type="independent">
+        <sampler type="@SAMPLER@">
             <integer name="sample_count" value="$spp"/>
         </sampler>
-        <film type="hdrfilm">
+        <film type="@FILM@">
             <integer name="width" value="$res"/>
             <integer name="height" value="$res"/>
-        </film>
+@FILM_LINES@        </film>
     </sensor>
 
     <shape type="sphere">
@@ -70,7 +70,7 @@ const char *SCENE_TEMPLATE =
         </transform>
 @FLOOR_BSDF@
     </shape>
-
+@SHAPE@
 @EMITTER@
 </scene>
 )XML";
@@ -473,13 +473,383 @@ private:
 FACET_EXPORT_PLUGIN(facet::@CLASS@, Integrator, "@NAME@", "An integrator plugin (so far ambient occlusion)", DOC)
 )CPP";
 
+const char *RFILTER_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: a reconstruction filter plugin (so far a Hann window)
+
+Describe the filter here. Until you change it this is a Hann (raised cosine) window: the weight
+of a sample at distance x from a pixel centre is (1 + cos(π x / radius)) / 2 inside `radius`
+and 0 beyond. The film weighs a sample by eval(x) · eval(y) and divides each pixel by the sum of
+the weights it received.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| radius | float | 1.5 | Radius in pixels (1/64 to 64) |
+
+```xml
+<film type="hdrfilm">
+    <rfilter type="@NAME@">
+        <float name="radius" value="2"/>
+    </rfilter>
+</film>
+```
+)DOC";
+
+// Conventions (facet/rfilter.h): the filter is separable, eval(x) is the weight at distance x
+// (in pixels, either sign) from a pixel centre and must be 0 beyond m_radius. Weights may be
+// negative (a sharpening filter) but must stay finite and sum to a positive number over the
+// radius: check_weights() at the end of the constructor checks that, at the filter's place in
+// the scene.
+
+#include <facet/logger.h>
+#include <facet/plugin.h>
+#include <facet/rfilter.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace facet {
+
+class @CLASS@ final : public ReconstructionFilter {
+public:
+    explicit @CLASS@(const Properties &props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        const double radius = props.get_float("radius", 1.5);
+        if (!(radius >= MinFilterRadius && radius <= MaxFilterRadius))
+            FACET_THROW_AT(props.location("radius"),
+                           "@NAME@: radius must be a number of pixels in [{}, {}], got {}",
+                           MinFilterRadius, MaxFilterRadius, radius);
+        m_radius = float(radius);
+        check_weights(props);
+    }
+
+    float eval(float x) const override {
+        if (std::abs(x) >= m_radius) return 0.f;
+        return 0.5f * (1.f + std::cos(3.14159265358979f * x / m_radius));
+    }
+
+    std::string to_string() const override { return fmt::format("@CLASS@[radius = {}]", m_radius); }
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, ReconstructionFilter, "@NAME@", "A reconstruction filter plugin (so far a Hann window)", DOC)
+)CPP";
+
+const char *SAMPLER_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: a sampler plugin (so far independent random numbers)
+
+Describe the sample values here. Until you change it every sample of every pixel draws
+independent uniform numbers from its own PCG32 stream, seeded from the pixel, the sample index
+and `seed`.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| sample_count | integer | 4 | Samples per pixel |
+| seed | integer | 0 | Base seed: other seeds give statistically independent images |
+
+```xml
+<sampler type="@NAME@">
+    <integer name="sample_count" value="64"/>
+</sampler>
+```
+)DOC";
+
+// Conventions (facet/sampler.h): the render clones the sampler per thread, calls seed() once
+// per pixel and set_sample_index() for each sample it takes. The values of sample i of a pixel
+// must depend only on (the pixel's seed, i, sample_count, the base seed), never on the samples
+// taken before: renders split into passes, crops and threads then give the same image. The base
+// class reads sample_count and seed; clone() must copy everything a sample's values depend on.
+
+#include <facet/plugin.h>
+#include <facet/random.h>
+#include <facet/sampler.h>
+
+#include <fmt/format.h>
+
+#include <memory>
+
+namespace facet {
+
+class @CLASS@ final : public Sampler {
+public:
+    explicit @CLASS@(const Properties &props) : Sampler(props) {}
+
+    std::unique_ptr<Sampler> clone() const override { return std::make_unique<@CLASS@>(*this); }
+
+    void seed(uint64_t seed_value) override {
+        m_pixel_seed = seed_value;
+        set_sample_index(0);
+    }
+
+    void set_sample_index(uint32_t index) override {
+        Sampler::set_sample_index(index);
+        // One stream per (pixel, sample, base seed): hash them into PCG32's state and stream.
+        const uint64_t v = m_pixel_seed ^ (uint64_t(index) * 0x9e3779b97f4a7c15ull) ^
+                           (m_base_seed * 0xd1b54a32d192ed03ull);
+        m_rng.seed(mix64(v), mix64(v ^ 0x6a09e667f3bcc908ull));
+    }
+
+    float next_1d() override {
+        ++m_dimension;
+        return m_rng.next_float();
+    }
+
+    Point2f next_2d() override {
+        m_dimension += 2;
+        const float x = m_rng.next_float();
+        return {x, m_rng.next_float()};
+    }
+
+    std::string to_string() const override {
+        return fmt::format("@CLASS@[sample_count = {}, seed = {}]", m_sample_count, m_base_seed);
+    }
+
+private:
+    PCG32 m_rng;
+    uint64_t m_pixel_seed = 0;
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Sampler, "@NAME@", "A sampler plugin (so far independent random numbers)", DOC)
+)CPP";
+
+const char *FILM_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: a film plugin (so far an exposure control)
+
+Describe what the film does to the image here. Until you change it this film develops like
+facet's base film and scales the colour by 2^`exposure` (photographic stops) before writing.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| width | integer | 768 | Image width in pixels |
+| height | integer | 576 | Image height in pixels |
+| crop_offset_x | integer | 0 | Left column of the crop window |
+| crop_offset_y | integer | 0 | Top row of the crop window |
+| crop_width | integer | width - crop_offset_x | Width of the crop window |
+| crop_height | integer | height - crop_offset_y | Height of the crop window |
+| exposure | float | 0 | Exposure in stops: the colour is multiplied by 2^exposure |
+| (rfilter) | rfilter | gaussian | Nested reconstruction filter |
+
+```xml
+<film type="@NAME@">
+    <integer name="width" value="640"/>
+    <integer name="height" value="480"/>
+    <float name="exposure" value="1"/>
+</film>
+```
+)DOC";
+
+// Conventions (facet/film.h): the base class reads the size, the crop window and the nested
+// rfilter, owns the pixel sums and develops them (develop(): linear RGB, alpha, then the AOVs of
+// the render). A film changes what develop() returns or how write() stores it. A render of
+// several passes in one process or a merge develops the pass sums with the base class's
+// develop_sums(), without this develop(): keep changes of the image to what a merge may skip, or
+// render such films in one pass.
+
+#include <facet/film.h>
+#include <facet/image.h>
+#include <facet/logger.h>
+#include <facet/plugin.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace facet {
+
+class @CLASS@ final : public Film {
+public:
+    explicit @CLASS@(const Properties &props) : Film(props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        const double exposure = props.get_float("exposure", 0.0);
+        if (!(std::abs(exposure) <= 64.0))
+            FACET_THROW_AT(props.location("exposure"),
+                           "@NAME@: exposure must be a number of stops in [-64, 64], got {}",
+                           exposure);
+        m_gain = float(std::exp2(exposure));
+    }
+
+    Image develop() const override {
+        Image image = Film::develop();
+        // The colour channels (R, G, B) come first; alpha and the AOVs keep their values.
+        const int colour = std::min(image.channels, 3);
+        for (size_t i = 0; i < image.data.size(); i += size_t(image.channels))
+            for (int c = 0; c < colour; ++c) image.data[i + size_t(c)] *= m_gain;
+        return image;
+    }
+
+    std::string to_string() const override {
+        return fmt::format("@CLASS@[{}x{}, gain = {}]", size().x, size().y, m_gain);
+    }
+
+private:
+    float m_gain = 1.f;
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Film, "@NAME@", "A film plugin (so far an exposure control)", DOC)
+)CPP";
+
+const char *SENSOR_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: a sensor plugin (so far a pinhole camera)
+
+Describe the camera here. Until you change it this is a pinhole camera at the origin of its
+`to_world` frame looking down +Z, with `fov` degrees across the film's width.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| fov | float | 40 | Horizontal field of view in degrees (0 to 180, exclusive) |
+| to_world | transform | identity | Camera-to-world transform |
+| shutter_open | float | 0 | Accepted for compatibility (still images) |
+| shutter_close | float | 0 | Accepted for compatibility (>= shutter_open) |
+| (film) | film | hdrfilm | Nested film |
+| (sampler) | sampler | independent | Nested sampler |
+
+```xml
+<sensor type="@NAME@">
+    <float name="fov" value="45"/>
+    <transform name="to_world">
+        <lookat origin="0, 1, 4" target="0, 0, 0" up="0, 1, 0"/>
+    </transform>
+    <film type="hdrfilm"/>
+</sensor>
+```
+)DOC";
+
+// Conventions (facet/sensor.h): the base class reads to_world, the shutter and the nested film
+// and sampler. sample_ray() turns a position on the full film (x right, y down, in [0, 1]²)
+// into a world-space ray with a unit direction and its weight. The camera looks down its local
+// +Z with +Y up, so film x growing to the right is local -X (Mitsuba's convention). A sensor that
+// implements sample_direction() and pdf_direction() can also be used by the light tracer.
+
+#include <facet/logger.h>
+#include <facet/plugin.h>
+#include <facet/ray.h>
+#include <facet/sensor.h>
+#include <facet/film.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace facet {
+
+class @CLASS@ final : public Sensor {
+public:
+    explicit @CLASS@(const Properties &props) : Sensor(props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        const double fov = props.get_float("fov", 40.0);
+        if (!(fov > 0.0 && fov < 180.0))
+            FACET_THROW_AT(props.location("fov"), "@NAME@: fov must be in (0, 180) degrees, got {}",
+                           fov);
+        const Point2i size = film().size();
+        m_tan_x = float(std::tan(fov * 0.5 * 3.14159265358979 / 180.0));
+        m_tan_y = m_tan_x * float(size.y) / float(size.x);
+    }
+
+    std::pair<Ray, Color3f> sample_ray(float time, const Point2f &film_pos,
+                                       const Point2f &) const override {
+        const Vector3f local((1.f - 2.f * film_pos.x) * m_tan_x,
+                             (1.f - 2.f * film_pos.y) * m_tan_y, 1.f);
+        Ray ray(m_to_world.apply_point(Point3f(0.f)),
+                normalize(m_to_world.apply_vector(normalize(local))), 0.f, Infinity);
+        ray.time = time;
+        return {ray, Color3f(1.f)};
+    }
+
+    std::string to_string() const override {
+        return fmt::format("@CLASS@[tan_x = {}, tan_y = {}]", m_tan_x, m_tan_y);
+    }
+
+private:
+    float m_tan_x = 1.f, m_tan_y = 1.f;
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Sensor, "@NAME@", "A sensor plugin (so far a pinhole camera)", DOC)
+)CPP";
+
+const char *SHAPE_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
+# @NAME@: a shape plugin (so far a square pyramid)
+
+Describe the shape here. Until you change it this is a pyramid over the square [-1, 1]² of the
+plane y = 0 with its apex at (0, `height`, 0), as 6 triangles whose normals point outwards,
+placed by `to_world`.
+
+| Parameter | Type | Default | Description |
+|-----------|------|---------|-------------|
+| height | float | 1 | Height of the apex above the base (> 0) |
+| flip_normals | boolean | false | Make the normals point inwards |
+| to_world | transform | identity | Object-to-world transform |
+
+```xml
+<shape type="@NAME@">
+    <float name="height" value="1.5"/>
+    <bsdf type="diffuse"/>
+</shape>
+```
+)DOC";
+
+// Conventions (facet/mesh.h, facet/shape.h): a shape made of triangles derives from Mesh, fills
+// m_positions (3 floats per vertex), m_faces (3 indices per triangle, counter-clockwise around
+// the outward normal) and optionally m_normals and m_uvs, then calls initialize(), which checks
+// the arrays, applies to_world and prepares sampling. Embree, area lights and instancing then work
+// as for facet's own meshes. A shape that is not made of triangles derives from Shape and gives
+// Embree a user geometry (facet/user_geometry.h).
+
+#include <facet/logger.h>
+#include <facet/mesh.h>
+#include <facet/plugin.h>
+
+#include <cmath>
+
+namespace facet {
+
+class @CLASS@ final : public Mesh {
+public:
+    explicit @CLASS@(const Properties &props) : Mesh(props) {
+        // Read every parameter of the table, with its default; unread ones are reported.
+        const double height = props.get_float("height", 1.0);
+        if (!(height > 0.0) || !std::isfinite(height))
+            FACET_THROW_AT(props.location("height"), "@NAME@: height must be positive, got {}",
+                           height);
+        const bool flip_normals = props.get_bool("flip_normals", false);
+        const Transform to_world = props.get_transform("to_world", Transform());
+        const float h = float(height);
+        // The base corners 0..3, the apex 4 (no vertex normals: each face is flat).
+        m_positions = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1, 0, h, 0};
+        m_faces = {0, 1, 2, 0, 2, 3,                     // the base, facing down
+                   0, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0}; // the sides
+        initialize(to_world, /*face_normals=*/true, flip_normals);
+    }
+};
+
+} // namespace facet
+
+// Name = the XML type = the library's file name (@NAME@.so).
+FACET_EXPORT_PLUGIN(facet::@CLASS@, Shape, "@NAME@", "A shape plugin (so far a square pyramid)", DOC)
+)CPP";
+
 /// One kind of plugin `facet new-plugin` can write.
 struct Template {
     const char *kind;
     const char *source;
     const char *check; ///< the CMakeLists line of the chi2 command, if the kind has one
-    // The scene's parts: the integrator, the sphere's and the floor's BSDF, the emitters.
+    // The scene's parts: the integrator, the sphere's and the floor's BSDF, the emitters, and
+    // (for the kinds that take their place) the sensor, sampler and film types, more lines
+    // inside the film (its rfilter) and one more shape.
     const char *integrator, *sphere_bsdf, *floor_bsdf, *emitter;
+    const char *sensor = "perspective", *sampler = "independent", *film = "hdrfilm";
+    const char *film_lines = "", *shape = "";
 };
 
 const Template TEMPLATES[] = {
@@ -508,6 +878,28 @@ const Template TEMPLATES[] = {
     </integrator>
 )",
      DIFFUSE_BSDF, DIFFUSE_BSDF, SKY},
+    {"shape", SHAPE_TEMPLATE, "", PATH_INTEGRATOR, DIFFUSE_BSDF, DIFFUSE_BSDF, SKY, "perspective",
+     "independent", "hdrfilm", "", R"(
+    <shape type="@NAME@">
+        <float name="height" value="1.2"/>
+        <transform name="to_world">
+            <scale value="0.5"/>
+            <translate x="1.3" z="-0.5"/>
+        </transform>
+        <bsdf type="diffuse">
+            <rgb name="reflectance" value="0.7, 0.3, 0.2"/>
+        </bsdf>
+    </shape>
+)"},
+    {"sensor", SENSOR_TEMPLATE, "", PATH_INTEGRATOR, DIFFUSE_BSDF, DIFFUSE_BSDF, SKY, "@NAME@"},
+    {"sampler", SAMPLER_TEMPLATE, "", PATH_INTEGRATOR, DIFFUSE_BSDF, DIFFUSE_BSDF, SKY,
+     "perspective", "@NAME@"},
+    {"film", FILM_TEMPLATE, "", PATH_INTEGRATOR, DIFFUSE_BSDF, DIFFUSE_BSDF, SKY, "perspective",
+     "independent", "@NAME@", R"(            <float name="exposure" value="0.5"/>
+)"},
+    {"rfilter", RFILTER_TEMPLATE, "", PATH_INTEGRATOR, DIFFUSE_BSDF, DIFFUSE_BSDF, SKY,
+     "perspective", "independent", "hdrfilm", R"(            <rfilter type="@NAME@"/>
+)"},
 };
 
 std::string substitute(std::string text, const std::string &key, const std::string &value) {
@@ -587,6 +979,11 @@ int new_plugin_main(int argc, char **argv) {
     scene = substitute(scene, "@SPHERE_BSDF@", tpl->sphere_bsdf);
     scene = substitute(scene, "@FLOOR_BSDF@", tpl->floor_bsdf);
     scene = substitute(scene, "@EMITTER@", tpl->emitter);
+    scene = substitute(scene, "@SENSOR@", tpl->sensor);
+    scene = substitute(scene, "@SAMPLER@", tpl->sampler);
+    scene = substitute(scene, "@FILM@", tpl->film);
+    scene = substitute(scene, "@FILM_LINES@", tpl->film_lines);
+    scene = substitute(scene, "@SHAPE@", tpl->shape);
     scene = substitute(scene, "@NAME@", name);
     write_file(cmake_file, cmake);
     write_file(source_file, source);
