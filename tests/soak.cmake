@@ -1,9 +1,9 @@
 # Soak runs (label soak): long renders and chi-square runs that draw the rare sample values short
-# tests never reach (tests/soak/soak.py says what each does). About 15 minutes on 2 cores, so they
+# tests never reach (tests/soak/soak.py says what each does). About 7 minutes on 2 cores, so they
 # are registered only with -DFACET_SOAK=ON and are not part of CI's suite:
 #   cmake -S . -B build -DFACET_SOAK=ON && cmake --build build -j2 && ctest --test-dir build -L soak
-# Together: 5 renders of 128x128 pixels x 64 spp x 256 emitter samples (1.3e9 emitter samples,
-# each sampler once), one light-tracing render, and `facet chi2` with 1e8 samples on every emitter
+# Together: 5 renders of 128x128 pixels x 64 spp x 256 emitter samples (1.6e9 emitter samples:
+# orthogonal rounds the spp up; each sampler once), one light-tracing render, and `facet chi2` with 1e8 samples on every emitter
 # configuration of tests/chi2/configs.txt.
 option(FACET_SOAK "Register the soak tests (label soak; long)" OFF)
 if(NOT FACET_SOAK)
@@ -35,10 +35,13 @@ foreach(_line IN LISTS _lines)
     endif()
 endforeach()
 list(LENGTH _emitter_lines _count)
+# In the work folder: the pictures of a rejection (chi2-failures/) go there, not into the sources.
+file(MAKE_DIRECTORY ${_work})
 foreach(_number IN LISTS _emitter_lines) # Sidak-corrected over the soak's chi2 runs
     add_test(NAME soak.chi2.line${_number}
              COMMAND ${Python3_EXECUTABLE} ${_soak} chi2 $<TARGET_FILE:facet_cli> ${_configs}
-                     ${_number} 100000000 ${_count})
+                     ${_number} 100000000 ${_count}
+             WORKING_DIRECTORY ${_work})
 endforeach()
 get_property(_soak_tests DIRECTORY PROPERTY TESTS)
 list(FILTER _soak_tests INCLUDE REGEX "^soak\\.")

@@ -120,7 +120,7 @@ def chi2(facet, configs, line, samples, tests):
         del args[at:at + 2]
     start = time.monotonic()
     p = subprocess.run([facet, 'chi2', *args, '--samples', str(samples), '--tests', str(tests)],
-                       cwd=os.path.dirname(os.path.abspath(configs)), stdout=subprocess.PIPE,
+                       stdout=subprocess.PIPE,
                        text=True)
     print(p.stdout, end='')
     print(f'chi2 line {line}: {samples:,} samples in {time.monotonic() - start:.1f} s, '
