@@ -264,6 +264,13 @@ int render_main(int argc, char **argv) {
                         "folder (an existing one, or ending in '/'), or be left out",
                         output, scenes.size());
     }
+    // A mistyped name is refused before the first scene renders, not after it.
+    for (size_t i = 1; i < scenes.size(); ++i) {
+        std::error_code exists_error;
+        if (!fs::exists(scenes[i], exists_error))
+            FACET_THROW("scene file \"{}\" {} (nothing was rendered)", scenes[i],
+                        exists_error ? exists_error.message() : std::string("does not exist"));
+    }
 
     const auto render_one = [&]() -> int {
         const auto load_start = std::chrono::steady_clock::now();

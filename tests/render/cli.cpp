@@ -161,11 +161,18 @@ TEST_F(CliTest, SeveralScenesRenderOneAfterTheOther) {
     const std::string err = expect_one_line_error("render scene.xml red.xml -o one.exr");
     EXPECT_NE(err.find("-o must name a folder"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(m_dir / "one.exr"));
-    // The first error ends the sequence: the scenes before it keep their images.
-    fs::remove(m_dir / "scene.exr");
+    // A missing scene is refused before anything renders; the first error while loading or
+    // rendering ends the sequence, and the scenes before it keep their images.
     r = run("render scene.xml missing.xml red.xml -q -o seq/");
     EXPECT_EQ(r.code, 1);
-    EXPECT_NE(r.err.find("missing.xml"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"missing.xml\" does not exist (nothing was rendered)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(fs::is_empty(m_dir / "seq"));
+    write_file(m_dir / "broken.xml", "<scene version=\"3.0.0\"><shape type=\"sphere\">");
+    r = run("render scene.xml broken.xml red.xml -q -o seq/");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("broken.xml:1:"), std::string::npos) << r.err;
     EXPECT_TRUE(fs::exists(m_dir / "seq" / "scene.exr"));
     EXPECT_FALSE(fs::exists(m_dir / "seq" / "red.exr"));
 }
