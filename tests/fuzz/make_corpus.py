@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Writes the seed corpora of the fuzz targets (tests/fuzz/corpus/<target>/) from the repository's
-scenes, meshes and textures, plus small hand-made files for the formats the repository has no
-example of. Run from anywhere; the output is committed. Needs oiiotool for the image seeds.
+"""Writes the seed corpora of the fuzz targets (tests/data/fuzz/<target>/corpus/) and the xml
+target's dictionary (tests/data/fuzz/xml/xml.dict) from the repository's scenes, meshes and
+textures, plus small hand-made files for the formats the repository has no example of. Run from
+anywhere; the output is committed. Needs oiiotool for the image seeds.
 
     python3 tests/fuzz/make_corpus.py
 """
@@ -15,11 +16,11 @@ import tempfile
 import zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-OUT = os.path.join(ROOT, "tests", "fuzz", "corpus")
+OUT = os.path.join(ROOT, "tests", "data", "fuzz")
 
 
 def out_dir(target):
-    d = os.path.join(OUT, target)
+    d = os.path.join(OUT, target, "corpus")
     shutil.rmtree(d, ignore_errors=True)
     os.makedirs(d)
     return d
@@ -191,7 +192,8 @@ def write_dict():
                                 open(path, encoding="utf-8").read()))
     words.update(["true", "false", "0", "1", "-1", "0.5", "1e-3", "inf", "nan", "$", "/>", ">",
                   "3.0.0", "0 0 1", "1, 2, 3", "400:1, 700:2"])
-    with open(os.path.join(ROOT, "tests", "fuzz", "xml.dict"), "w") as f:
+    os.makedirs(os.path.join(OUT, "xml"), exist_ok=True)
+    with open(os.path.join(OUT, "xml", "xml.dict"), "w") as f:
         f.write("# libFuzzer dictionary of the xml target (written by make_corpus.py)\n")
         for w in sorted(words):
             f.write('"%s"\n' % w.replace("\\", "\\\\").replace('"', '\\"'))
@@ -205,6 +207,7 @@ if __name__ == "__main__":
     serialized_corpus()
     image_corpus()
     for t in sorted(os.listdir(OUT)):
-        files = os.listdir(os.path.join(OUT, t))
-        size = sum(os.path.getsize(os.path.join(OUT, t, f)) for f in files)
+        d = os.path.join(OUT, t, "corpus")
+        files = os.listdir(d)
+        size = sum(os.path.getsize(os.path.join(d, f)) for f in files)
         print(f"{t}: {len(files)} files, {size} bytes")
