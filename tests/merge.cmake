@@ -17,22 +17,10 @@ elseif(TARGET facet_cli)
     message(WARNING "idiff (openimageio-tools) not found: the merge tests are not registered")
 endif()
 
-# The C++ part tests merge in memory with the code of `facet merge`.
-if(TARGET render_parts)
-    target_sources(render_parts PRIVATE ${PROJECT_SOURCE_DIR}/core/apps/merge.cpp)
-    target_include_directories(render_parts PRIVATE ${PROJECT_SOURCE_DIR}/core/apps)
-endif()
-
 # What the merge refuses in the parts themselves (non-finite values, display windows the parts
-# do not cover, named allocations): one GoogleTest program on the code of `facet merge`.
-if(TARGET facet_cli)
-    add_executable(merge_checks ${CMAKE_CURRENT_SOURCE_DIR}/merge/checks.cpp
-                                ${PROJECT_SOURCE_DIR}/core/apps/merge.cpp)
-    target_include_directories(merge_checks PRIVATE ${PROJECT_SOURCE_DIR}/core/apps)
-    target_compile_options(merge_checks PRIVATE ${FACET_TEST_COMPILE_OPTIONS})
-    target_link_libraries(merge_checks PRIVATE facet facet_warnings GTest::gtest
-                          GTest::gtest_main)
-    add_dependencies(merge_checks facet_cli)
-    add_test(NAME merge.checks COMMAND merge_checks)
-    set_tests_properties(merge.checks PROPERTIES LABELS merge TIMEOUT 300)
-endif()
+# do not cover, named allocations): one GoogleTest program on libfacet's merge (facet/merge.h).
+add_executable(merge_checks ${CMAKE_CURRENT_SOURCE_DIR}/merge/checks.cpp)
+target_compile_options(merge_checks PRIVATE ${FACET_TEST_COMPILE_OPTIONS})
+target_link_libraries(merge_checks PRIVATE facet facet_warnings GTest::gtest GTest::gtest_main)
+add_test(NAME merge.checks COMMAND merge_checks)
+set_tests_properties(merge.checks PROPERTIES LABELS merge TIMEOUT 300)

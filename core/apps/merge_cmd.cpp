@@ -1,10 +1,10 @@
 // `facet merge parts... -o out.exr`: puts the parts of a render split by crop windows and
-// passes (`facet render --crop ... --pass I --passes N`) back together (merge.h).
+// passes (`facet render --crop ... --pass I --passes N`) back together (facet/merge.h).
 
 #include "commands.h"
-#include "merge.h"
 
 #include <facet/logger.h>
+#include <facet/merge.h>
 #include <facet/render.h>
 
 #include <CLI/CLI.hpp>

@@ -1,14 +1,13 @@
 // facet._facet: the compiled half of the `facet` Python package (python/facet/__init__.py is the
 // public API). Loads scenes, renders them with the GIL released (Ctrl-C cancels the render and
 // raises KeyboardInterrupt), writes images through facet's writer, lists plugins, runs the
-// chi-square test of facet::testing and merges render parts (core/apps/merge.h).
-
-#include "merge.h"
+// chi-square test of facet::testing and merges render parts (facet/merge.h).
 
 #include <facet/chi2.h>
 #include <facet/film.h>
 #include <facet/image.h>
 #include <facet/logger.h>
+#include <facet/merge.h>
 #include <facet/params.h>
 #include <facet/plugin.h>
 #include <facet/render.h>

@@ -3,12 +3,11 @@
 // do not cover (refused without a buffer of the display window's size, however large it
 // claims to be), a data window outside its display window (refused from the header), and
 // allocations over the limit (named). Parts are built in memory or written by the test.
-#include "merge.h"
-
 #include <facet/checked.h>
 #include <facet/image.h>
 #include <facet/logger.h>
 #include <facet/math.h>
+#include <facet/merge.h>
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>

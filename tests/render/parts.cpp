@@ -3,10 +3,9 @@
 // merge by their raw sums (Σ w·L, Σ w) into the render of all their samples, bit-identical to
 // the render of all the passes in one process for every reconstruction filter, crop split and
 // integrator (path, aov, ptracer).
-#include "merge.h"
-
 #include <facet/film.h>
 #include <facet/image.h>
+#include <facet/merge.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>

@@ -1,7 +1,7 @@
 #pragma once
 
-// Merging the parts of a render split across processes or machines (`facet merge`, and
-// facet.merge / facet.distributed in Python, which compile this file too).
+// Merging the parts of a render split across processes or machines: the library behind
+// `facet merge` and facet.merge / facet.distributed in Python.
 //
 // A part is an image of a rectangle of the full image (its data window inside the display
 // window) from one pass of a render split into passes. Parts of one pass must cover the full

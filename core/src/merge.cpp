@@ -1,8 +1,7 @@
-#include "merge.h"
-
 #include <facet/checked.h>
 #include <facet/film.h>
 #include <facet/logger.h>
+#include <facet/merge.h>
 
 #include <fmt/format.h>
 
