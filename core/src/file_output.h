@@ -1,7 +1,8 @@
 #pragma once
 
-// Writing an output file so that it is never left half written: both image writers (image.cpp,
-// OpenImageIO; exr.cpp, OpenEXR) encode to memory and hand the bytes to replace_image_file().
+// Writing an output file so that it is never left half written: both image writers
+// (image/write.cpp, OpenImageIO; exr.cpp, OpenEXR) encode to memory and hand the bytes to
+// replace_image_file().
 
 #include <functional>
 #include <string>

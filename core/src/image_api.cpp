@@ -1,4 +1,4 @@
-// The functions of facet/image.h in libfacet: they load libfacet_image (image.cpp, every use of
+// The functions of facet/image.h in libfacet: they load libfacet_image (image/, every use of
 // OpenImageIO and OpenColorIO) the first time one needs it and forward to it. See
 // image_library.h for the structure.
 

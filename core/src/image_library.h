@@ -1,7 +1,7 @@
 #pragma once
 
 // The interface between libfacet and its two image modules: libfacet_image, which holds every
-// use of OpenImageIO and OpenColorIO (image.cpp), and libfacet_exr, the EXR writer on OpenEXR
+// use of OpenImageIO and OpenColorIO (image/), and libfacet_exr, the EXR writer on OpenEXR
 // alone (exr.cpp). OpenImageIO, OpenColorIO and their dependencies are some 260 shared objects
 // and 120 MiB of memory; libfacet loads libfacet_image with dlopen() the first time an image is
 // read or a non-EXR image written or a display transform is resolved, so that a process pays
@@ -10,7 +10,7 @@
 //
 //   libfacet.so  --dlopen on first use-->  libfacet_image.so  --links-->  OpenImageIO, OpenColorIO
 //                --dlopen to write .exr->  libfacet_exr.so    --links-->  OpenEXR
-//   image_api.cpp: the functions of            image.cpp, exr.cpp: the implementations (their
+//   image_api.cpp: the functions of            image/*.cpp, exr.cpp: the implementations (their
 //   facet/image.h, forwarding to the tables    symbols are local to the module but for the table)
 //
 // Both sides are built from the same tree: a table is checked by its layout version only.

@@ -53,10 +53,10 @@ struct ImageWriteOptions {
 
 /// Writes with OpenEXR (.exr), OpenImageIO (other formats) or facet's own writer (PFM) to a
 /// temporary file next to `path`, checks that file (read back; see verify_written in exr.cpp and
-/// image.cpp), then renames it over `path`: a failed write throws and leaves an existing `path`
-/// untouched. .exr/.hdr/.pfm stay scene-linear (an RGB
-/// EXR is tagged with the Rec.709 chromaticities); 8-bit formats (.png, .jpg, ...) go through
-/// the OpenColorIO display/view transform of the chosen config.
+/// image/write.cpp), then renames it over `path`: a failed write throws and leaves an existing
+/// `path` untouched. .exr/.hdr/.pfm stay scene-linear (an RGB EXR is tagged with the Rec.709
+/// chromaticities); 8-bit formats (.png, .jpg, ...) go through the OpenColorIO display/view
+/// transform of the chosen config.
 void write_image(const std::string &path, const Image &image, const ImageWriteOptions &opts = {});
 /// Throws the error write_image() would give for `path` before any pixel exists: a missing folder
 /// or an extension no writer knows (.pfm is written by facet itself, the rest by OpenImageIO).
