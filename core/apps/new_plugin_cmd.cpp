@@ -478,8 +478,8 @@ const char *RFILTER_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
 
 Describe the filter here. Until you change it this is a Hann (raised cosine) window: the weight
 of a sample at distance x from a pixel centre is (1 + cos(π x / radius)) / 2 inside `radius`
-and 0 beyond. The film weighs a sample by eval(x) · eval(y) and divides each pixel by the sum of
-the weights it received.
+and 0 beyond. The film weighs a sample by w(x) · w(y), where w is eval() tabulated once over the
+radius (as for every filter), and divides each pixel by the sum of the weights it received.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -495,7 +495,8 @@ the weights it received.
 )DOC";
 
 // Conventions (facet/rfilter.h): the filter is separable, eval(x) is the weight at distance x
-// (in pixels, either sign) from a pixel centre and must be 0 beyond m_radius. Weights may be
+// (in pixels, either sign) from a pixel centre, the same at -x and x, and must be 0 beyond
+// m_radius; the film tabulates it once (ReconstructionFilter::weight()). Weights may be
 // negative (a sharpening filter) but must stay finite and sum to a positive number over the
 // radius: check_weights() at the end of the constructor checks that, at the filter's place in
 // the scene.

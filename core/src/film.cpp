@@ -1,3 +1,5 @@
+#include "tabulated_filter.h"
+
 #include <facet/film.h>
 #include <facet/plugin.h>
 
@@ -56,22 +58,12 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
     if (m_wx.size() < fp.nx) m_wx.resize(fp.nx);
     if (m_wy.size() < fp.ny) m_wy.resize(fp.ny);
     // The filter argument is the sample's offset from the pixel centre.
+    const TabulatedFilter &w = filter.table();
     fp.sum_x = fp.sum_y = 0.f;
-    if (filter.is_box() && fp.nx <= 2 && fp.ny <= 2) {
-        // A radius of 0.5 reaches at most two pixels per axis: the same weights as the loops
-        // below, without a virtual call per pixel (nor the loops' vectorised set-up).
-        fp.sum_x = m_wx[0] = ReconstructionFilter::box_eval(px - float(fp.ox + fp.x0));
-        if (fp.nx == 2)
-            fp.sum_x += (m_wx[1] = ReconstructionFilter::box_eval(px - float(fp.ox + fp.x0 + 1)));
-        fp.sum_y = m_wy[0] = ReconstructionFilter::box_eval(py - float(fp.oy + fp.y0));
-        if (fp.ny == 2)
-            fp.sum_y += (m_wy[1] = ReconstructionFilter::box_eval(py - float(fp.oy + fp.y0 + 1)));
-        return true;
-    }
     for (size_t i = 0; i < fp.nx; ++i)
-        fp.sum_x += (m_wx[i] = filter.eval(px - float(fp.ox + fp.x0 + int(i))));
+        fp.sum_x += (m_wx[i] = w(px - float(fp.ox + fp.x0 + int(i))));
     for (size_t j = 0; j < fp.ny; ++j)
-        fp.sum_y += (m_wy[j] = filter.eval(py - float(fp.oy + fp.y0 + int(j))));
+        fp.sum_y += (m_wy[j] = w(py - float(fp.oy + fp.y0 + int(j))));
     return true;
 }
 
@@ -91,18 +83,20 @@ inline void add_sample(float *p, float w, const Color3f &L, const float *aovs, i
 
 void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
                      const ReconstructionFilter &filter) {
-    // The box filter at film positions in [0, 2^22) (every sample of a film, short of absurd
-    // sizes): there pos - 0.5 and its offset from any pixel are exact in float, so the one
-    // pixel box_eval() gives weight 1 is floor(pos), the pixel the sample lies in.
-    // put_footprint() takes the rest, with the same rule in footprint() and box_eval().
-    if (filter.is_box() && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
+    // A filter whose weight is a constant c on [-1/2, 1/2) and 0 elsewhere (the box), at film
+    // positions in [0, 2^22) (every sample of a film, short of absurd sizes): there pos - 0.5
+    // and its offset from any pixel are exact in float, so the one pixel of the footprint with
+    // a non-zero weight is floor(pos), the pixel the sample lies in, with the weight c·c.
+    // put_footprint() takes the rest, with the same weights.
+    const float c = filter.table().single_pixel_weight();
+    if (c != 0.f && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
         const Point2i s = storage_size();
         const int x = int(pos.x) - (m_offset.x - m_border),
                   y = int(pos.y) - (m_offset.y - m_border);
         if (x >= 0 && x < s.x && y >= 0 && y < s.y)
             add_sample(m_data.data() +
                            (size_t(y) * size_t(s.x) + size_t(x)) * size_t(channel_count()),
-                       1.f, L, aovs, m_aov_count);
+                       c * c, L, aovs, m_aov_count);
         return;
     }
     put_footprint(pos, L, aovs, filter);
@@ -136,12 +130,13 @@ void ImageBlock::splat(const Point2f &pos, const Color3f &L, const Reconstructio
     // pixels beyond the edge belong to another block, or to none): the sums run over the whole
     // footprint, in the same order as when nothing is cut, so a crop window's pixels receive
     // the same splats as in a render of the whole film.
-    auto whole_sum = [&filter](float p, int o, int u0, int u1, int c0, size_t n, float clipped,
+    const TabulatedFilter &weight = filter.table();
+    auto whole_sum = [&weight](float p, int o, int u0, int u1, int c0, size_t n, float clipped,
                                const std::vector<float> &w) {
         if (u0 == c0 && u1 == c0 + int(n) - 1) return clipped;
         float sum = 0.f;
         for (int i = u0; i <= u1; ++i)
-            sum += i >= c0 && i < c0 + int(n) ? w[size_t(i - c0)] : filter.eval(p - float(o + i));
+            sum += i >= c0 && i < c0 + int(n) ? w[size_t(i - c0)] : weight(p - float(o + i));
         return sum;
     };
     const float sx = whole_sum(fp.px, fp.ox, fp.ux0, fp.ux1, x0, nx, fp.sum_x, m_wx);

@@ -22,12 +22,11 @@ class BoxFilter final : public ReconstructionFilter {
 public:
     explicit BoxFilter(const Properties &props) {
         m_radius = 0.5f;
-        m_is_box = true; // image blocks evaluate it inline
         check_weights(props);
     }
 
     /// Half-open [-0.5, 0.5): a sample on a pixel boundary belongs to exactly one pixel.
-    float eval(float x) const override { return box_eval(x); }
+    float eval(float x) const override { return (x >= -0.5f && x < 0.5f) ? 1.f : 0.f; }
 
     std::string to_string() const override { return "BoxFilter[radius=0.5]"; }
 };

@@ -4,8 +4,8 @@ static const char *DOC = R"DOC(
 Catmull–Rom reconstruction filter: the Mitchell–Netravali cubic with B = 0, C = 1/2. Sharper
 than `mitchell`, with more ringing. The radius is 2 pixels; the negative lobes between 1 and 2
 pixels are summed with their sign by the film.
-Like every filter that Mitsuba 3's scalar renderer applies, the weight is looked up in a table
-of 31 values over the radius (piecewise constant), so images match Mitsuba's at sharp edges.
+Like every filter, the film looks the weight up in a table of 31 values over the radius
+(piecewise constant), as Mitsuba 3's scalar renderer does, so images match Mitsuba's at sharp edges.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
@@ -16,7 +16,6 @@ of 31 values over the radius (piecewise constant), so images match Mitsuba's at 
 ```
 )DOC";
 
-#include <facet/filter_table.h>
 #include <facet/plugin.h>
 #include <facet/rfilter.h>
 
@@ -28,11 +27,10 @@ class CatmullRomFilter final : public ReconstructionFilter {
 public:
     explicit CatmullRomFilter(const Properties &props) {
         m_radius = 2.f;
-        m_table.init(m_radius, exact);
         check_weights(props);
     }
 
-    float eval(float x) const override { return m_table.lookup(x); }
+    float eval(float x) const override { return exact(x); }
 
     /// The Mitchell–Netravali cubic with B = 0, C = 1/2, written out.
     static float exact(float x) {
@@ -44,9 +42,6 @@ public:
     }
 
     std::string to_string() const override { return "CatmullRomFilter[radius=2]"; }
-
-private:
-    FilterTable m_table;
 };
 
 } // namespace facet

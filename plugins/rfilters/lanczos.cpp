@@ -4,8 +4,8 @@ static const char *DOC = R"DOC(
 Lanczos-windowed sinc reconstruction filter: sinc(x)·sinc(x / lobes) for |x| < lobes, zero
 beyond. The radius equals the number of lobes. Sharp, but it rings around bright edges (a
 directly visible light gets dark fringes); the film sums the negative weights with their sign.
-Like every filter that Mitsuba 3's scalar renderer applies, the weight is looked up in a table
-of 31 values over the radius (piecewise constant), so images match Mitsuba's at sharp edges.
+Like every filter, the film looks the weight up in a table of 31 values over the radius
+(piecewise constant), as Mitsuba 3's scalar renderer does, so images match Mitsuba's at sharp edges.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
@@ -18,7 +18,6 @@ of 31 values over the radius (piecewise constant), so images match Mitsuba's at 
 ```
 )DOC";
 
-#include <facet/filter_table.h>
 #include <facet/plugin.h>
 #include <facet/rfilter.h>
 
@@ -35,11 +34,10 @@ public:
                            "lobes must be a whole number between 1 and 64, got {}", lobes);
         m_lobes = int(lobes);
         m_radius = float(lobes);
-        m_table.init(m_radius, [&](float x) { return exact(x, m_radius); });
         check_weights(props);
     }
 
-    float eval(float x) const override { return m_table.lookup(x); }
+    float eval(float x) const override { return exact(x, m_radius); }
 
     /// sinc(x)·sinc(x / lobes) with sinc(x) = sin(πx)/(πx), zero from |x| = lobes on.
     static float exact(float x, float lobes) {
@@ -56,7 +54,6 @@ public:
 
 private:
     int m_lobes = 3;
-    FilterTable m_table;
 };
 
 } // namespace facet

@@ -5,8 +5,8 @@ Mitchell–Netravali separable cubic reconstruction filter (Mitchell & Netravali
 compromise between sharpness and ringing. The radius is 2 pixels. With the default B = C = 1/3
 the filter has small negative lobes between 1 and 2 pixels; the film sums the weights with their
 sign and divides by that sum.
-Like every filter that Mitsuba 3's scalar renderer applies, the weight is looked up in a table
-of 31 values over the radius (piecewise constant), so images match Mitsuba's at sharp edges.
+Like every filter, the film looks the weight up in a table of 31 values over the radius
+(piecewise constant), as Mitsuba 3's scalar renderer does, so images match Mitsuba's at sharp edges.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
@@ -21,7 +21,6 @@ of 31 values over the radius (piecewise constant), so images match Mitsuba's at 
 ```
 )DOC";
 
-#include <facet/filter_table.h>
 #include <facet/plugin.h>
 #include <facet/rfilter.h>
 
@@ -45,11 +44,10 @@ public:
         m_radius = 2.f;
         m_b = float(b);
         m_c = float(c);
-        m_table.init(m_radius, [&](float x) { return cubic(x, m_b, m_c); });
         check_weights(props);
     }
 
-    float eval(float x) const override { return m_table.lookup(x); }
+    float eval(float x) const override { return cubic(std::abs(x), m_b, m_c); }
 
     /// The Mitchell–Netravali cubic k(x) for x = |offset| (paper eq. 8), zero from 2 on.
     static float cubic(float x, float b, float c) {
@@ -71,7 +69,6 @@ public:
 
 private:
     float m_b = 1.f / 3.f, m_c = 1.f / 3.f;
-    FilterTable m_table;
 };
 
 } // namespace facet

@@ -116,20 +116,24 @@ TEST(ImageBlock, BoxSampleLandsInOnePixel) {
     EXPECT_EQ(p[2], 3.f);
 }
 
-/// The box filter's weights through the general footprint code (not marked as the box).
-class UnmarkedBox final : public ReconstructionFilter {
+/// A user's filter with the box's weights, not made by the plugin registry.
+class UserBox final : public ReconstructionFilter {
 public:
-    float eval(float x) const override { return box_eval(x); }
-    std::string to_string() const override { return "UnmarkedBox"; }
+    float eval(float x) const override { return (x >= -0.5f && x < 0.5f) ? 1.f : 0.f; }
+    std::string to_string() const override { return "UserBox"; }
 };
 
-TEST(ImageBlock, BoxShortcutPutsEverySampleWhereTheFootprintDoes) {
-    // put() sends a box sample straight to the pixel it lies in; the general footprint code,
-    // with the same weights, must agree bit for bit: on pixel edges, just below them, at 0, at
-    // the block's edges (border included), beyond the block, and past 2^23 (where pos - 0.5
-    // is rounded, so the pixel is no longer floor(pos)).
+TEST(ImageBlock, BoxPutsEverySampleIntoTheOnePixelOfItsHalfOpenFootprint) {
+    // put() sends a sample of a filter with weight 1 on [-1/2, 1/2) straight to the pixel it
+    // lies in; it must agree bit for bit with the footprint rule, here written out: the weight
+    // of storage pixel i is 1 when the offset (pos - 0.5) - (its film pixel) is in
+    // [-0.5, 0.5). Checked on pixel edges, just below them, at 0, at the block's edges (border
+    // included), beyond the block, and past 2^23 (where pos - 0.5 is rounded, so the pixel is
+    // no longer floor(pos)).
+    // An out-of-tree filter with the same weights takes the same path.
     auto box = make_filter("box");
-    const UnmarkedBox unmarked;
+    const UserBox user_box;
+    auto half_open = [](float x) { return (x >= -0.5f && x < 0.5f) ? 1.f : 0.f; };
     std::vector<float> coords = {0.f,         1e-30f,    0.25f,     0.5f,     3.f,
                                  4194303.75f, 4194304.f, 4194305.f, 8388609.f};
     for (int i = 6; i <= 30; ++i) {
@@ -142,21 +146,36 @@ TEST(ImageBlock, BoxShortcutPutsEverySampleWhereTheFootprintDoes) {
          {Point2i(0, 0), Point2i(3, 4), Point2i(4194300, 4194301), Point2i(8388609, 8388609)}) {
         std::vector<float> shifted;
         for (float c : coords) shifted.push_back(c + float(offset.x));
-        ImageBlock fast, general;
+        ImageBlock fast, user;
         fast.reset(offset, {3, 3}, ImageBlock::border_for(*box));
-        general.reset(offset, {3, 3}, ImageBlock::border_for(unmarked));
+        user.reset(offset, {3, 3}, ImageBlock::border_for(user_box));
+        const Point2i s = fast.storage_size();
+        const int nc = fast.channel_count();
+        std::vector<float> expected(fast.data().size(), 0.f);
         float value = 1.f;
         for (float x : shifted)
             for (float y : shifted) {
                 const Point2f pos(x, y + float(offset.y - offset.x));
-                fast.put(pos, Color3f(value, 2.f * value, 0.5f), *box);
-                general.put(pos, Color3f(value, 2.f * value, 0.5f), unmarked);
+                const Color3f L(value, 2.f * value, 0.5f);
+                fast.put(pos, L, *box);
+                user.put(pos, L, user_box);
+                for (int j = 0; j < s.y; ++j)
+                    for (int i = 0; i < s.x; ++i) {
+                        const float w = half_open((pos.x - 0.5f) - float(offset.x - 1 + i)) *
+                                        half_open((pos.y - 0.5f) - float(offset.y - 1 + j));
+                        if (w == 0.f) continue;
+                        float *p = expected.data() + (size_t(j) * size_t(s.x) + size_t(i)) * nc;
+                        p[0] += w * L.r;
+                        p[1] += w * L.g;
+                        p[2] += w * L.b;
+                        p[3] += w;
+                    }
                 value += 1.f;
             }
-        ASSERT_EQ(fast.data().size(), general.data().size());
         float total = 0.f;
         for (size_t k = 0; k < fast.data().size(); ++k) {
-            EXPECT_EQ(fast.data()[k], general.data()[k]) << "offset " << offset.x << ", " << k;
+            EXPECT_EQ(fast.data()[k], expected[k]) << "offset " << offset.x << ", " << k;
+            EXPECT_EQ(user.data()[k], expected[k]) << "offset " << offset.x << ", " << k;
             total += fast.data()[k];
         }
         EXPECT_GT(total, 0.f) << "offset " << offset.x; // some samples landed
@@ -170,13 +189,13 @@ TEST(ImageBlock, GaussianSpreadsSymmetricallyAndDevelopsToTheSample) {
     // A sample at the centre of film pixel (4, 4) = storage pixel (6, 6).
     block.put({4.5f, 4.5f}, Color3f(2.f, 1.f, 0.5f), *g);
     const float w0 = block_weight(block, 6, 6);
-    EXPECT_NEAR(w0, g->eval(0.f) * g->eval(0.f), 1e-6f);
+    EXPECT_NEAR(w0, g->weight(0.f) * g->weight(0.f), 1e-6f);
     // Separable weights, symmetric around the centre, reaching 1 pixel in each direction
     // (pixel centres 2 away sit on the radius and get zero).
-    EXPECT_NEAR(block_weight(block, 7, 6), g->eval(1.f) * g->eval(0.f), 1e-6f);
+    EXPECT_NEAR(block_weight(block, 7, 6), g->weight(1.f) * g->weight(0.f), 1e-6f);
     EXPECT_EQ(block_weight(block, 7, 6), block_weight(block, 5, 6));
     EXPECT_EQ(block_weight(block, 6, 7), block_weight(block, 6, 5));
-    EXPECT_NEAR(block_weight(block, 7, 7), g->eval(1.f) * g->eval(1.f), 1e-6f);
+    EXPECT_NEAR(block_weight(block, 7, 7), g->weight(1.f) * g->weight(1.f), 1e-6f);
     EXPECT_EQ(block_weight(block, 8, 6), 0.f);
     int touched = 0;
     for (int y = 0; y < block.storage_size().y; ++y)
@@ -209,7 +228,7 @@ TEST(ImageBlock, OffCentreGaussianWeightsFollowTheFilter) {
     // Film pixel (x, y) is storage (x + 2, y + 2); the filter argument is pos - centre.
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
-            float expected = g->eval(3.2f - (x + 0.5f)) * g->eval(5.9f - (y + 0.5f));
+            float expected = g->weight(3.2f - (x + 0.5f)) * g->weight(5.9f - (y + 0.5f));
             EXPECT_NEAR(block_weight(block, x + 2, y + 2), expected, 1e-6f) << x << "," << y;
         }
 }

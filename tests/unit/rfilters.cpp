@@ -1,6 +1,7 @@
 // The cubic and windowed-sinc reconstruction filters (mitchell, catmullrom, lanczos): values at
-// known points, Mitsuba's tabulation, radii, normalisation, parameters, and how the film treats
-// their negative lobes; every filter's parameter ranges and weight checks.
+// known points, the film's tabulation of every filter (as Mitsuba's), radii, normalisation,
+// parameters, and how the film treats their negative lobes; every filter's parameter ranges and
+// weight checks.
 #include <facet/film.h>
 #include <facet/image.h>
 #include <facet/plugin.h>
@@ -12,6 +13,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -75,19 +77,20 @@ double tabulated(const std::function<double(double)> &exact, double r, double x)
     return exact(r * std::floor(s) / 31.0);
 }
 
-/// Checks eval() against the tabulated reference over [-1.2 r, 1.2 r]: in the middle of every
-/// table interval and on a sweep (points within rounding of an interval end are skipped).
+/// Checks the weight the film applies against the tabulated reference over [-1.2 r, 1.2 r]: in the
+/// middle of every table interval and on a sweep (points within rounding of an interval end are
+/// skipped).
 void expect_tabulates(const ReconstructionFilter &f, const std::function<double(double)> &exact) {
     const double r = f.radius();
     for (int i = -37; i < 37; ++i) {
         const double mid = r * (i + 0.5) / 31.0;
-        EXPECT_NEAR(f.eval(float(mid)), tabulated(exact, r, mid), 2e-6)
+        EXPECT_NEAR(f.weight(float(mid)), tabulated(exact, r, mid), 2e-6)
             << f.to_string() << " " << mid;
     }
     for (double x = -1.2 * r; x <= 1.2 * r; x += 0.0137) {
         const double s = std::abs(x) * 31.0 / r;
         if (std::abs(s - std::round(s)) < 1e-3) continue;
-        EXPECT_NEAR(f.eval(float(x)), tabulated(exact, r, x), 2e-6) << f.to_string() << " " << x;
+        EXPECT_NEAR(f.weight(float(x)), tabulated(exact, r, x), 2e-6) << f.to_string() << " " << x;
     }
 }
 
@@ -164,6 +167,27 @@ TEST(Filters, LanczosValuesAndRadius) {
     EXPECT_NE(error_of([&] { make_filter("lanczos", bad); }).find("lobes"), std::string::npos);
 }
 
+TEST(Filters, EveryFilterIsAppliedThroughTheSameTable) {
+    // The film tabulates every filter's eval() alike, the smooth ones too.
+    auto g = make_filter("gaussian");
+    expect_tabulates(*g, [](double x) {
+        return std::max(0.0, std::exp(-2.0 * x * x) - std::exp(-8.0)); // stddev 0.5, radius 2
+    });
+    Properties p;
+    p.set_float("radius", 1.5);
+    auto tent = make_filter("tent", p);
+    expect_tabulates(*tent, [](double x) { return std::max(0.0, 1.0 - std::abs(x) / 1.5); });
+    // eval() itself at exactly -radius and radius: the box keeps its half-open support, so a
+    // sample on a pixel edge counts for exactly one pixel.
+    auto box = make_filter("box");
+    EXPECT_EQ(box->weight(-0.5f), 1.f);
+    EXPECT_EQ(box->weight(0.5f), 0.f);
+    EXPECT_EQ(box->weight(std::nextafter(0.5f, 0.f)), 1.f);
+    EXPECT_EQ(box->weight(std::nextafter(-0.5f, -1.f)), 0.f);
+    EXPECT_EQ(box->weight(std::nanf("")), 0.f);
+    EXPECT_EQ(g->weight(-2.f), 0.f);
+}
+
 TEST(Filters, IntegralNormalisation) {
     // The exact functions the tables hold: every Mitchell–Netravali cubic has unit integral and
     // sums to one over unit-spaced pixels; the Lanczos window comes close.
@@ -183,8 +207,8 @@ TEST(Filters, IntegralNormalisation) {
     for (auto f : {make_filter("mitchell"), make_filter("catmullrom"), make_filter("lanczos")}) {
         const double r = f->radius(), h = r / 31.0;
         double riemann = 0.0;
-        for (int i = 0; i < 31; ++i) riemann += 2.0 * h * f->eval(float(r * (i + 0.5) / 31.0));
-        const double numeric = integral([&](double x) { return f->eval(float(x)); }, r);
+        for (int i = 0; i < 31; ++i) riemann += 2.0 * h * f->weight(float(r * (i + 0.5) / 31.0));
+        const double numeric = integral([&](double x) { return f->weight(float(x)); }, r);
         EXPECT_NEAR(numeric, riemann, 1e-3) << f->to_string();
         // Left ends overestimate a falling filter by about h·k(0) over the unit integral.
         EXPECT_NEAR(riemann, 1.0 + h * f->eval(0.f), 0.015) << f->to_string();

@@ -68,8 +68,8 @@ private:
     /// False when the sample (non-finite, beyond 1e9 pixels, or outside the block) reaches no
     /// pixel.
     bool footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp);
-    /// put() of another filter than the box, or of a box sample outside put()'s shortcut: out
-    /// of line, so that put()'s usual case (one box pixel) saves no registers.
+    /// put() of a sample that reaches more than one pixel, or outside put()'s one-pixel
+    /// shortcut: out of line, so that put()'s shortcut saves no registers.
     void put_footprint(const Point2f &pos, const Color3f &L, const float *aovs,
                        const ReconstructionFilter &filter);
 

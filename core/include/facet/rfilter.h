@@ -4,6 +4,7 @@
 #include <facet/object.h>
 #include <facet/properties.h>
 
+#include <atomic>
 #include <cmath>
 
 namespace facet {
@@ -19,18 +20,27 @@ constexpr float MinFilterRadius = 1.f / 64.f;
 /// the film sums them over every sample of a pixel: huge weights overflow to infinity and NaN.
 constexpr float MaxFilterWeight = 1000.f;
 
-/// Separable pixel reconstruction filter: weight(x, y) = eval(x)·eval(y), zero beyond radius().
+class TabulatedFilter;
+
+/// Separable pixel reconstruction filter: weight(x, y) = w(x)·w(y), zero beyond radius().
+///
+/// A filter only describes its weight: eval(x) at the offset x (in pixels) from a pixel centre,
+/// the same at -x and x (eval(-radius) and eval(radius) may differ, for a filter whose support
+/// is half-open). The image blocks never call eval() per sample: libfacet tabulates it once
+/// (weight()) and applies the table to every filter alike.
 class ReconstructionFilter : public Object {
 public:
+    ReconstructionFilter() = default;
+    ~ReconstructionFilter() override;
     ObjectType type() const override { return ObjectType::ReconstructionFilter; }
     virtual float eval(float x) const = 0;
     float radius() const { return m_radius; }
-    /// True for the `box` filter, whose weight the image blocks compute inline with box_eval()
-    /// (no virtual call per pixel of a sample's footprint).
-    bool is_box() const { return m_is_box; }
-    /// The box filter's weight: half-open [-0.5, 0.5), so a sample on a pixel boundary belongs
-    /// to exactly one pixel.
-    static float box_eval(float x) { return (x >= -0.5f && x < 0.5f) ? 1.f : 0.f; }
+    /// The weight the image blocks apply at offset x: eval() taken once at |x| = radius·i/31
+    /// for i = 0..30, each value kept over [radius·i/31, radius·(i+1)/31) (as Mitsuba 3's
+    /// scalar image block applies every filter), eval() itself at exactly -radius and radius
+    /// (so a sample on a pixel edge counts for one pixel only when the support is half-open),
+    /// and 0 beyond. Built on the first call, after the constructor.
+    float weight(float x) const;
 
 protected:
     /// Throws, at the filter's place in the scene, unless eval() is finite and within
@@ -57,7 +67,12 @@ protected:
     }
 
     float m_radius = 0.5f;
-    bool m_is_box = false; ///< set by the box filter only (its eval() must be box_eval())
+
+private:
+    friend class ImageBlock;
+    /// weight()'s table, built by the first caller (any thread).
+    const TabulatedFilter &table() const;
+    mutable std::atomic<const TabulatedFilter *> m_table{nullptr};
 };
 
 } // namespace facet
