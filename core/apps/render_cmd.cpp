@@ -391,16 +391,9 @@ int render_main(int argc, char **argv) {
         const bool signal_in_render = interrupt_signal() != 0;
         result.load_seconds = load_seconds;
 
-        wopts.metadata = render_metadata(result);
-        wopts.metadata["facet:scene_hash"] = scene_hash;
-        wopts.metadata["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
-        wopts.metadata["facet:scene"] = fs::absolute(opts.scene).lexically_normal().string();
-        wopts.metadata["facet:seed"] = std::to_string(seed);
-        add_render_metadata(wopts, sensor, int(result.spp),
-                            result.seconds); // typed, as pbrt-v4 writes
-        if (result.cancelled)
-            wopts.metadata["facet:blocks"] =
-                fmt::format("{}/{}", result.blocks_done, result.blocks_total);
+        add_metadata(wopts, render_file_metadata(render_file_info(
+                                result, sensor, scene_hash,
+                                fs::absolute(opts.scene).lexically_normal().string(), seed)));
         cli::set_activity(fmt::format("writing \"{}\"", out));
         const auto write_start = std::chrono::steady_clock::now();
         std::string write_error;

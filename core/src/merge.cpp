@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <new>
+#include <optional>
 
 namespace fs = std::filesystem;
 
@@ -19,13 +20,13 @@ namespace facet::merge {
 namespace {
 
 std::string get(const Part &p, const char *key, const std::string &fallback = "") {
-    auto it = p.metadata.find(key);
-    return it == p.metadata.end() ? fallback : it->second;
+    auto it = p.metadata.strings.find(key);
+    return it == p.metadata.strings.end() ? fallback : it->second;
 }
 
 long long get_int(const Part &p, const char *key, long long fallback) {
-    auto it = p.metadata.find(key);
-    if (it == p.metadata.end()) return fallback;
+    auto it = p.metadata.strings.find(key);
+    if (it == p.metadata.strings.end()) return fallback;
     try {
         size_t used = 0;
         long long v = std::stoll(it->second, &used);
@@ -178,6 +179,32 @@ std::array<int, 4> uncovered(const std::vector<const Part *> &in_pass, int W, in
     return box;
 }
 
+/// A 4×4 matrix from its 16 row-major elements as text ("1, 0, 0, ..."), as an image file's
+/// attribute reads; empty when the text is not that.
+std::optional<Matrix4f> parse_matrix(const std::string &text) {
+    float v[16];
+    const char *at = text.c_str();
+    for (float &x : v) {
+        while (*at == ',' || *at == ' ') ++at;
+        char *end = nullptr;
+        x = std::strtof(at, &end);
+        if (end == at) return std::nullopt;
+        at = end;
+    }
+    return Matrix4f::from_rows(v);
+}
+
+/// Equal up to the 6 significant digits with which a matrix read from a file was written out
+/// (a part from a file and one from memory carry the same camera).
+bool same_matrix(const Matrix4f &a, const Matrix4f &b) {
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            const float x = a.m[i][j], y = b.m[i][j];
+            if (!(std::abs(x - y) <= 1e-5f * std::max(std::abs(x), std::abs(y)))) return false;
+        }
+    return true;
+}
+
 /// `count` values of `size` bytes for `what`, checked against the allocation limit; running
 /// out of memory is a facet::Error that names them.
 template <typename T> void allocate(std::vector<T> &v, size_t count, const std::string &what) {
@@ -188,6 +215,63 @@ template <typename T> void allocate(std::vector<T> &v, size_t count, const std::
         FACET_THROW("facet merge: out of memory for {} ({:.1f} MiB)", what,
                     double(bytes) / double(1 << 20));
     }
+}
+
+/// The merge's metadata: what all parts agree on, and the attributes of one render of the whole
+/// W x H film with `spp` samples per pixel (0: unknown, the parts do not say) in the parts'
+/// summed render time.
+FileMetadata merged_metadata(const std::vector<Part> &parts, int W, int H, long long spp) {
+    const Part &first = parts[0];
+    FileMetadata out;
+    for (const auto &entry : first.metadata.strings) {
+        // Not a structured binding: C++17 lambdas cannot capture those (clang rejects it).
+        const std::string &key = entry.first, &value = entry.second;
+        if (key == attr::spp || key == attr::render_time || key == attr::blocks)
+            continue; // the merge's own, below
+        bool shared = std::all_of(parts.begin(), parts.end(), [&](const Part &p) {
+            auto it = p.metadata.strings.find(key);
+            return it != p.metadata.strings.end() && it->second == value;
+        });
+        if (shared) out.strings[key] = value;
+    }
+    RenderFileInfo info;
+    info.spp = info.spp_target = info.spp_total = uint32_t(spp);
+    info.crop = {{0, 0, W, H}};
+    info.film_width = W;
+    info.film_height = H;
+    double seconds = 0.0;
+    bool timed = true;
+    for (const Part &p : parts) {
+        std::string t = get(p, attr::render_time);
+        timed = timed && !t.empty();
+        seconds += std::atof(t.c_str());
+    }
+    if (timed) info.seconds = seconds;
+    for (const char *key : {attr::world_to_camera, attr::world_to_ndc}) {
+        auto a = first.metadata.matrices.find(key);
+        if (a == first.metadata.matrices.end()) continue;
+        const Matrix4f &m = a->second;
+        const bool shared = std::all_of(parts.begin(), parts.end(), [&](const Part &p) {
+            auto it = p.metadata.matrices.find(key);
+            return it != p.metadata.matrices.end() && same_matrix(it->second, m);
+        });
+        if (shared)
+            (std::strcmp(key, attr::world_to_camera) == 0 ? info.world_to_camera
+                                                          : info.world_to_ndc) = m;
+    }
+    // The shared scene, scene hash and seed stay as the parts wrote them.
+    const FileMetadata own = render_file_metadata(info);
+    for (const auto &[key, value] : own.strings) out.strings[key] = value;
+    out.ints = own.ints;
+    out.floats = own.floats;
+    out.matrices = own.matrices;
+    if (spp <= 0) {
+        // Parts without a sample count (not written by facet): none is claimed for the merge.
+        for (const char *key : {attr::spp, attr::spp_total}) out.strings.erase(key);
+        out.ints.erase(attr::samples_per_pixel);
+    }
+    out.strings[attr::merged_parts] = std::to_string(parts.size());
+    return out;
 }
 
 } // namespace
@@ -221,8 +305,11 @@ Part read_part(const std::string &path) {
     part.y = file.image.y;
     part.half = file.half;
     part.image = std::move(file.image);
-    for (auto &[name, value] : file.attributes)
-        if (name.rfind("facet:", 0) == 0) part.metadata[name] = value;
+    for (auto &[name, value] : file.attributes) {
+        if (name.rfind("facet:", 0) == 0) part.metadata.strings[name] = value;
+        if (name == attr::world_to_camera || name == attr::world_to_ndc) // typed: by name
+            if (auto m = parse_matrix(value)) part.metadata.matrices[name] = *m;
+    }
     return part;
 }
 
@@ -253,8 +340,10 @@ Merged merge_parts(const std::vector<Part> &parts) {
             FACET_THROW("{} has the channels {}, {} has {}: parts of different renders", p.name,
                         join(p.image.channel_names), first.name, join(first.image.channel_names));
         for (const char *key : {attr::scene_hash, attr::seed, attr::spp_total}) {
-            auto a = first.metadata.find(key), b = p.metadata.find(key);
-            bool has_a = a != first.metadata.end(), has_b = b != p.metadata.end();
+            const std::map<std::string, std::string> &of_first = first.metadata.strings,
+                                                     &of_p = p.metadata.strings;
+            auto a = of_first.find(key), b = of_p.find(key);
+            bool has_a = a != of_first.end(), has_b = b != of_p.end();
             if (has_a != has_b || (has_a && a->second != b->second))
                 FACET_THROW("{} has {} {}, {} has {}: parts of different {}", p.name, key,
                             has_b ? b->second : "(none)", first.name, has_a ? a->second : "(none)",
@@ -262,7 +351,7 @@ Merged merge_parts(const std::vector<Part> &parts) {
                             : std::strcmp(key, attr::spp_total) == 0 ? "sample counts"
                                                                      : "scenes");
         }
-        if (auto it = p.metadata.find(attr::spp_target); it != p.metadata.end())
+        if (auto it = p.metadata.strings.find(attr::spp_target); it != p.metadata.strings.end())
             FACET_THROW("{} is incomplete: its render was stopped after {} of {} samples per "
                         "pixel",
                         p.name, get(p, attr::spp, "?"), it->second);
@@ -395,44 +484,14 @@ Merged merge_parts(const std::vector<Part> &parts) {
         }
     }
 
-    // Metadata: what all parts agree on, the total sample count and the summed render time.
-    for (const auto &entry : first.metadata) {
-        // Not a structured binding: C++17 lambdas cannot capture those (clang rejects it).
-        const std::string &key = entry.first, &value = entry.second;
-        if (key == attr::pass || key == attr::passes || key == attr::crop || key == attr::spp ||
-            key == attr::render_time || key == attr::sample_offset)
-            continue;
-        bool shared = std::all_of(parts.begin(), parts.end(), [&](const Part &p) {
-            auto it = p.metadata.find(key);
-            return it != p.metadata.end() && it->second == value;
-        });
-        if (shared) out.metadata[key] = value;
-    }
-    // The merged image reads as one render of the whole film.
-    if (uniform_spp && total_spp > 0) out.metadata[attr::spp] = std::to_string(total_spp);
-    out.metadata[attr::pass] = "0";
-    out.metadata[attr::passes] = "1";
-    out.metadata[attr::sample_offset] = "0";
-    out.metadata[attr::crop] = fmt::format("0 0 {} {}", W, H);
-    double seconds = 0.0;
-    bool timed = true;
-    for (const Part &p : parts) {
-        std::string t = get(p, attr::render_time);
-        if (t.empty()) {
-            timed = false;
-            break;
-        }
-        seconds += std::atof(t.c_str());
-    }
-    if (timed) out.metadata[attr::render_time] = fmt::format("{:.3f}", seconds);
-    out.metadata["facet:merged_parts"] = std::to_string(parts.size());
+    out.metadata = merged_metadata(parts, W, H, uniform_spp ? total_spp : 0);
     return out;
 }
 
 void write_merged(const Merged &merged, const std::string &path) {
     ImageWriteOptions opts;
     opts.half = merged.half;
-    opts.metadata = merged.metadata;
+    add_metadata(opts, merged.metadata);
     write_image(path, merged.image, opts);
 }
 

@@ -1,5 +1,8 @@
 #include <facet/output_metadata.h>
+#include <facet/render.h>
 #include <facet/sensor.h>
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -111,11 +114,78 @@ std::optional<Matrix4f> sensor_world_to_ndc(const Sensor &sensor) {
     return p * world_to_camera.matrix;
 }
 
-void add_render_metadata(ImageWriteOptions &opts, const Sensor &sensor, int spp, double seconds) {
-    opts.int_metadata["samplesPerPixel"] = spp;
-    opts.float_metadata["renderTimeSeconds"] = float(seconds);
-    opts.matrix_metadata["worldToCamera"] = sensor.to_world().inverse_matrix;
-    if (auto ndc = sensor_world_to_ndc(sensor)) opts.matrix_metadata["worldToNDC"] = *ndc;
+void add_metadata(ImageWriteOptions &opts, const FileMetadata &metadata) {
+    for (const auto &[key, value] : metadata.strings) opts.metadata[key] = value;
+    for (const auto &[key, value] : metadata.ints) opts.int_metadata[key] = value;
+    for (const auto &[key, value] : metadata.floats) opts.float_metadata[key] = value;
+    for (const auto &[key, value] : metadata.matrices) opts.matrix_metadata[key] = value;
+}
+
+RenderFileInfo render_file_info(const RenderResult &result, const Sensor &sensor,
+                                const std::string &scene_hash, const std::string &scene_path,
+                                uint64_t seed) {
+    RenderFileInfo info;
+    info.spp = result.spp;
+    info.spp_target = result.spp_target;
+    info.sample_offset = result.sample_offset;
+    info.spp_total = result.spp_total;
+    info.pass_index = result.pass_index;
+    info.pass_count = result.pass_count;
+    info.crop = result.crop;
+    info.film_width = result.film_width;
+    info.film_height = result.film_height;
+    info.seconds = result.seconds;
+    if (result.cancelled) info.blocks = {result.blocks_done, result.blocks_total};
+    info.scene_hash = scene_hash;
+    info.scene_path = scene_path;
+    info.seed = seed;
+    info.world_to_camera = sensor.to_world().inverse_matrix;
+    info.world_to_ndc = sensor_world_to_ndc(sensor);
+    return info;
+}
+
+FileMetadata render_file_metadata(const RenderFileInfo &info) {
+    FileMetadata m;
+    std::map<std::string, std::string> &s = m.strings;
+    s[attr::spp] = std::to_string(info.spp);
+    if (info.spp != info.spp_target) s[attr::spp_target] = std::to_string(info.spp_target);
+    s[attr::spp_total] = std::to_string(info.spp_total);
+    s[attr::sample_offset] = std::to_string(info.sample_offset);
+    s[attr::pass] = std::to_string(info.pass_index);
+    s[attr::passes] = std::to_string(info.pass_count);
+    const std::array<int, 4> &c = info.crop;
+    s[attr::crop] = fmt::format("{} {} {} {}", c[0], c[1], c[2], c[3]);
+    s[attr::film_size] = fmt::format("{} {}", info.film_width, info.film_height);
+    if (!info.scene_hash.empty()) s[attr::scene_hash] = info.scene_hash;
+    if (!info.scene_path.empty()) s[attr::scene] = info.scene_path;
+    if (info.seed) s[attr::seed] = std::to_string(*info.seed);
+    if (info.seconds) s[attr::render_time] = fmt::format("{:.3f}", *info.seconds);
+    if (info.blocks)
+        s[attr::blocks] = fmt::format("{}/{}", info.blocks->first, info.blocks->second);
+
+    m.ints[attr::samples_per_pixel] = int(info.spp);
+    if (info.seconds) m.floats[attr::render_time_seconds] = float(*info.seconds);
+    if (info.world_to_camera) m.matrices[attr::world_to_camera] = *info.world_to_camera;
+    if (info.world_to_ndc) m.matrices[attr::world_to_ndc] = *info.world_to_ndc;
+    return m;
+}
+
+std::string scene_identity(const std::string &scene_text,
+                           const std::map<std::string, std::string> &params, int film_width,
+                           int film_height) {
+    uint64_t h = 0xcbf29ce484222325ull; // FNV-1a, 64 bits
+    auto add = [&h](const std::string &bytes) {
+        for (unsigned char ch : bytes) {
+            h ^= ch;
+            h *= 0x100000001b3ull;
+        }
+        h ^= 0xff; // separator: ("ab", "c") and ("a", "bc") differ
+        h *= 0x100000001b3ull;
+    };
+    add(scene_text);
+    for (const auto &[key, value] : params) add(key + "=" + value);
+    add(fmt::format("{}x{}", film_width, film_height));
+    return fmt::format("{:016x}", h);
 }
 
 } // namespace facet

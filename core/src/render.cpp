@@ -780,36 +780,6 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     return result;
 }
 
-std::map<std::string, std::string> render_metadata(const RenderResult &r) {
-    std::map<std::string, std::string> m;
-    m["facet:spp"] = std::to_string(r.spp);
-    if (r.spp != r.spp_target) m["facet:spp_target"] = std::to_string(r.spp_target);
-    m["facet:spp_total"] = std::to_string(r.spp_total);
-    m["facet:sample_offset"] = std::to_string(r.sample_offset);
-    m["facet:pass_index"] = std::to_string(r.pass_index);
-    m["facet:pass_count"] = std::to_string(r.pass_count);
-    m["facet:crop"] = fmt::format("{} {} {} {}", r.crop[0], r.crop[1], r.crop[2], r.crop[3]);
-    m["facet:film_size"] = fmt::format("{} {}", r.film_width, r.film_height);
-    return m;
-}
-
-std::string scene_identity(const std::string &scene_text,
-                           const std::map<std::string, std::string> &params, int film_width,
-                           int film_height) {
-    uint64_t h = 0xcbf29ce484222325ull; // FNV-1a, 64 bits
-    auto add = [&h](const std::string &bytes) {
-        for (unsigned char ch : bytes) {
-            h ^= ch;
-            h *= 0x100000001b3ull;
-        }
-        h ^= 0xff; // separator: ("ab", "c") and ("a", "bc") differ
-        h *= 0x100000001b3ull;
-    };
-    add(scene_text);
-    for (const auto &[key, value] : params) add(key + "=" + value);
-    add(fmt::format("{}x{}", film_width, film_height));
-    return fmt::format("{:016x}", h);
-}
 // ---------------------------------------------------------------------------------------------
 // Interrupt handling
 

@@ -325,8 +325,10 @@ def load_dict(d, *, lenient=False, search_path=()):
 class Image(tuple):
     """What ``render`` returns: an array-like (``np.asarray(image)`` is the float32 pixels of shape
     (height, width, channels), named by ``image.channels``) that is also the pair ``(pixels,
-    channels)`` (so ``pixels, channels = facet.render(...)`` works) and carries ``metadata`` (the ``facet:`` attributes the CLI
-    writes into an EXR), ``half`` (the film's component_format is float16) and ``window``:
+    channels)`` (so ``pixels, channels = facet.render(...)`` works) and carries ``metadata`` (the
+    attributes the CLI writes into an EXR: the ``facet:`` strings, ``samplesPerPixel`` (int),
+    ``renderTimeSeconds`` (float), ``worldToCamera`` and ``worldToNDC`` (4x4 matrices as a tuple
+    of rows)), ``half`` (the film's component_format is float16) and ``window``:
     ``(x, y, full_width, full_height)``, where the pixels lie in the whole film (a crop's data
     window inside its display window)."""
 

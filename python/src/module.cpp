@@ -8,6 +8,7 @@
 #include <facet/image.h>
 #include <facet/logger.h>
 #include <facet/merge.h>
+#include <facet/output_metadata.h>
 #include <facet/params.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
@@ -20,6 +21,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -181,10 +183,49 @@ template <typename Fn> auto run_interruptible(std::atomic<bool> &cancel,
     }
 }
 
-py::dict metadata_dict(const std::map<std::string, std::string> &m) {
+/// A file's attributes as a Python dict: str, int and float values, and 4×4 matrices as a tuple
+/// of their 4 rows.
+py::dict metadata_dict(const FileMetadata &m) {
     py::dict d;
-    for (const auto &[k, v] : m) d[py::str(k)] = py::str(v);
+    for (const auto &[k, v] : m.strings) d[py::str(k)] = py::str(v);
+    for (const auto &[k, v] : m.ints) d[py::str(k)] = py::int_(v);
+    for (const auto &[k, v] : m.floats) d[py::str(k)] = py::float_(v);
+    for (const auto &[k, v] : m.matrices)
+        d[py::str(k)] = py::make_tuple(py::make_tuple(v.m[0][0], v.m[0][1], v.m[0][2], v.m[0][3]),
+                                       py::make_tuple(v.m[1][0], v.m[1][1], v.m[1][2], v.m[1][3]),
+                                       py::make_tuple(v.m[2][0], v.m[2][1], v.m[2][2], v.m[2][3]),
+                                       py::make_tuple(v.m[3][0], v.m[3][1], v.m[3][2], v.m[3][3]));
     return d;
+}
+
+/// The attributes of a dict as metadata_dict() makes them (and any str values).
+FileMetadata metadata_of(const py::dict &d) {
+    FileMetadata m;
+    for (const auto &[k, v] : d) {
+        const std::string key = py::str(k);
+        if (py::isinstance<py::str>(v)) {
+            m.strings[key] = v.cast<std::string>();
+        } else if (py::isinstance<py::bool_>(v)) {
+            FACET_THROW("metadata {}: expected a str, int, float or 4x4 matrix, not a bool", key);
+        } else if (py::isinstance<py::int_>(v)) {
+            m.ints[key] = v.cast<int>();
+        } else if (py::isinstance<py::float_>(v)) {
+            m.floats[key] = v.cast<float>();
+        } else {
+            std::vector<std::vector<float>> rows;
+            try {
+                rows = v.cast<std::vector<std::vector<float>>>();
+            } catch (const py::cast_error &) {}
+            if (rows.size() != 4 ||
+                std::any_of(rows.begin(), rows.end(), [](const auto &r) { return r.size() != 4; }))
+                FACET_THROW("metadata {}: expected a str, int, float or 4x4 matrix", key);
+            Matrix4f matrix;
+            for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j) matrix.m[i][j] = rows[size_t(i)][size_t(j)];
+            m.matrices[key] = matrix;
+        }
+    }
+    return m;
 }
 
 py::tuple window_of(const Image &img) {
@@ -244,14 +285,10 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     if (callback && reported < 1.0 && !result.cancelled) progress(1.0);
 
     // The attributes `facet render` writes, so that parts from here and from the CLI merge.
-    std::map<std::string, std::string> meta = render_metadata(result);
-    meta["facet:scene_hash"] =
+    const std::string scene_hash =
         scene_identity(s.text + s.edits, s.params, result.film_width, result.film_height);
-    meta["facet:render_time"] = fmt::format("{:.3f}", result.seconds);
-    if (!s.path.empty()) meta["facet:scene"] = s.path;
-    meta["facet:seed"] = std::to_string(seed);
-    if (result.cancelled)
-        meta["facet:blocks"] = fmt::format("{}/{}", result.blocks_done, result.blocks_total);
+    const FileMetadata meta =
+        render_file_metadata(render_file_info(result, sensor, scene_hash, s.path, seed));
     py::tuple image =
         py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
                        sensor.film().half(), window_of(result.image));
@@ -270,9 +307,8 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
 
 void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast> &pixels,
               const std::vector<std::string> &channels, const std::string &path, bool half,
-              const std::map<std::string, std::string> &metadata, const std::string &ocio_config,
-              const std::string &display, const std::string &view, const std::string &looks,
-              const std::array<int, 4> &window) {
+              const py::dict &metadata, const std::string &ocio_config, const std::string &display,
+              const std::string &view, const std::string &looks, const std::array<int, 4> &window) {
     checked_path(path, "write");
     checked_path(ocio_config, "write: ocio_config");
     Image img = from_array(pixels, channels);
@@ -282,7 +318,7 @@ void write_py(const py::array_t<float, py::array::c_style | py::array::forcecast
     img.full_height = window[3];
     ImageWriteOptions opts;
     opts.half = half;
-    opts.metadata = metadata;
+    add_metadata(opts, metadata_of(metadata));
     opts.ocio_config = ocio_config;
     opts.display = display;
     opts.view = view;
@@ -322,7 +358,7 @@ py::tuple merge_py(const py::list &items) {
         p.image =
             from_array(t[0].cast<py::array_t<float, py::array::c_style | py::array::forcecast>>(),
                        t[1].cast<std::vector<std::string>>());
-        p.metadata = t[2].cast<std::map<std::string, std::string>>();
+        p.metadata = metadata_of(t[2].cast<py::dict>());
         p.half = t[3].cast<bool>();
         auto w = t[4].cast<std::array<int, 4>>();
         p.x = w[0];

@@ -44,9 +44,9 @@ merge::Part part(const std::string &name, int pass, int passes, int x, int y, in
         for (int px = 0; px < w; ++px)
             for (int c = 0; c < p.image.channels; ++c)
                 p.image.at(px, py, c) = c < 3 ? 0.5f : c < 6 ? 1.f : 2.f;
-    p.metadata[merge::attr::pass] = std::to_string(pass);
-    p.metadata[merge::attr::passes] = std::to_string(passes);
-    p.metadata[merge::attr::spp] = "4";
+    p.metadata.strings[attr::pass] = std::to_string(pass);
+    p.metadata.strings[attr::passes] = std::to_string(passes);
+    p.metadata.strings[attr::spp] = "4";
     return p;
 }
 
@@ -91,7 +91,7 @@ protected:
         img.full_width = p.full_width;
         img.full_height = p.full_height;
         ImageWriteOptions opts;
-        opts.metadata = p.metadata;
+        add_metadata(opts, p.metadata);
         const std::string path = (m_dir / name).string();
         write_image(path, img, opts);
         return path;

@@ -6,6 +6,7 @@
 #include <facet/film.h>
 #include <facet/image.h>
 #include <facet/merge.h>
+#include <facet/output_metadata.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
@@ -159,7 +160,7 @@ bool same_pixels(const Image &crop, const Image &full, int x0, int y0) {
 }
 
 /// A part as `facet render` writes it: the image and the attributes a merge checks.
-merge::Part part_of(const RenderResult &r, const std::string &name) {
+merge::Part part_of(const RenderResult &r, const Sensor &sensor, const std::string &name) {
     merge::Part p;
     p.name = name;
     p.full_width = r.image.full_width;
@@ -167,9 +168,7 @@ merge::Part part_of(const RenderResult &r, const std::string &name) {
     p.x = r.image.x;
     p.y = r.image.y;
     p.image = r.image;
-    p.metadata = render_metadata(r);
-    p.metadata["facet:scene_hash"] = "0123456789abcdef";
-    p.metadata["facet:seed"] = "0";
+    p.metadata = render_file_metadata(render_file_info(r, sensor, "0123456789abcdef", "", 0));
     return p;
 }
 
@@ -216,7 +215,8 @@ void expect_exact_pass_merge(const std::string &what, const std::string &xml, in
             opts.crop = crop;
             RenderResult r = render(*scene, sensor, opts);
             ASSERT_FALSE(r.cancelled);
-            parts.push_back(part_of(r, fmt::format("pass {} crop {} {}", i, crop[0], crop[1])));
+            parts.push_back(
+                part_of(r, sensor, fmt::format("pass {} crop {} {}", i, crop[0], crop[1])));
         }
         RenderOptions opts = options(1);
         opts.pass_index = i;
@@ -230,7 +230,7 @@ void expect_exact_pass_merge(const std::string &what, const std::string &xml, in
     all.pass_count = passes;
     const RenderResult single = render(*scene, sensor, all);
     EXPECT_EQ(single.spp, single.spp_total);
-    EXPECT_EQ(merged.metadata.at("facet:spp"), std::to_string(single.spp));
+    EXPECT_EQ(merged.metadata.strings.at("facet:spp"), std::to_string(single.spp));
     ASSERT_EQ(merged.image.channels, single.image.channels);
     const size_t exact = differing_values(merged.image, single.image);
     EXPECT_EQ(exact, 0u) << "values of the merge that differ from the render of all the passes";
@@ -315,7 +315,7 @@ TEST(RenderParts, PartFilesMergeExactly) {
             const std::string path =
                 (temp_dir() / fmt::format("part-{}-{}-{}.exr", i, crop[0], crop[1])).string();
             ImageWriteOptions w;
-            w.metadata = part_of(r, path).metadata;
+            add_metadata(w, part_of(r, sensor, path).metadata);
             sensor.film().write(r.image, path, w);
             parts.push_back(merge::read_part(path));
             EXPECT_TRUE(parts.back().half);
@@ -474,8 +474,9 @@ TEST(RenderParts, MetadataNamesThePart) {
     opts.pass_index = 1;
     opts.pass_count = 2;
     opts.crop = {{2, 1, 9, 8}};
-    RenderResult r = render(*scene, *scene->sensors().at(0), opts);
-    auto m = render_metadata(r);
+    const Sensor &sensor = *scene->sensors().at(0);
+    RenderResult r = render(*scene, sensor, opts);
+    auto m = render_file_metadata(render_file_info(r, sensor, "", "", 0)).strings;
     EXPECT_EQ(m["facet:spp"], "3");
     EXPECT_EQ(m["facet:spp_total"], "6");
     EXPECT_EQ(m["facet:sample_offset"], "3");

@@ -13,6 +13,7 @@
 // (RenderOptions::pass_index -1, `facet render --passes N` without --pass).
 
 #include <facet/image.h>
+#include <facet/output_metadata.h>
 
 #include <map>
 #include <string>
@@ -20,37 +21,26 @@
 
 namespace facet::merge {
 
-/// Names of the EXR attributes a part carries (written by `facet render`).
-namespace attr {
-inline constexpr const char *spp = "facet:spp";
-inline constexpr const char *pass = "facet:pass_index";
-inline constexpr const char *passes = "facet:pass_count";
-inline constexpr const char *spp_total = "facet:spp_total";
-inline constexpr const char *spp_target = "facet:spp_target";
-inline constexpr const char *sample_offset = "facet:sample_offset";
-inline constexpr const char *film_size = "facet:film_size";
-inline constexpr const char *crop = "facet:crop";
-inline constexpr const char *scene_hash = "facet:scene_hash";
-inline constexpr const char *seed = "facet:seed";
-inline constexpr const char *render_time = "facet:render_time";
-} // namespace attr
-
 struct Part {
-    std::string name;                            ///< file name (or "part N") for messages
-    int full_width = 0, full_height = 0;         ///< display window
-    int x = 0, y = 0;                            ///< data window origin inside the display window
-    Image image;                                 ///< the data window's pixels
-    bool half = false;                           ///< colour stored as float16
-    std::map<std::string, std::string> metadata; ///< the facet:* string attributes
+    std::string name;                    ///< file name (or "part N") for messages
+    int full_width = 0, full_height = 0; ///< display window
+    int x = 0, y = 0;                    ///< data window origin inside the display window
+    Image image;                         ///< the data window's pixels
+    bool half = false;                   ///< colour stored as float16
+    /// The facet:* string attributes and the camera matrices (attr::world_to_camera and
+    /// attr::world_to_ndc; read from a file to the 6 digits its text form keeps).
+    FileMetadata metadata;
 };
 
-/// Reads a part (display and data windows, channels, facet:* attributes).
+/// Reads a part (display and data windows, channels, facet:* attributes, camera matrices).
 Part read_part(const std::string &path);
 
 struct Merged {
     Image image; ///< the full image
     bool half = false;
-    std::map<std::string, std::string> metadata;
+    /// What all parts agree on, and the attributes of one render of the whole film
+    /// (render_file_metadata()) with all the parts' samples and render time.
+    FileMetadata metadata;
     int passes = 1;
 };
 
@@ -58,7 +48,8 @@ struct Merged {
 /// no overlaps, no holes) and merges them; a facet::Error names the offending parts otherwise.
 Merged merge_parts(const std::vector<Part> &parts);
 
-/// Writes the merged image through facet's writer (EXR: float16 when the parts were).
+/// Writes the merged image and its metadata through facet's writer (EXR: float16 when the
+/// parts were).
 void write_merged(const Merged &merged, const std::string &path);
 
 } // namespace facet::merge

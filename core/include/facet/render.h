@@ -96,19 +96,6 @@ struct RenderResult {
 /// the same scene, seed and spp give the same image for any thread count.
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts);
 
-/// What a merge of parts of one render needs, as EXR attributes: facet:spp (of this image),
-/// facet:spp_total, facet:sample_offset, facet:pass_index, facet:pass_count, facet:crop
-/// ("x0 y0 x1 y1"), facet:film_size ("width height"), and facet:spp_target when the render was
-/// stopped before it.
-std::map<std::string, std::string> render_metadata(const RenderResult &result);
-
-/// Identity of a render's input, for checking that parts belong together: 16 hex digits of a
-/// 64-bit FNV-1a hash of `scene_text` (the scene file's bytes), the parameters (key=value, in
-/// key order) and the film size. Stored as facet:scene_hash.
-std::string scene_identity(const std::string &scene_text,
-                           const std::map<std::string, std::string> &params, int film_width,
-                           int film_height);
-
 /// Installs SIGINT/SIGHUP/SIGTERM handlers that set `flag` and record the first signal (restored
 /// by uninstall_interrupt_handler). While rendering, a second signal of the same kind takes its
 /// default action (force quit); after defer_interrupts() no signal is fatal any more.
