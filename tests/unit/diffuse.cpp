@@ -8,6 +8,7 @@
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/random.h>
+#include <facet/texture.h>
 #include <facet/warp.h>
 #include <facet/xml.h>
 
@@ -200,3 +201,46 @@ TEST(BSDFEval, DiffuseRespectsContext) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+namespace {
+
+/// A user's texture, not made by the plugin registry: the same colour everywhere, or one that
+/// varies with u.
+class UserTexture final : public Texture {
+public:
+    UserTexture(const Color3f &value, bool varying) : m_value(value), m_varying(varying) {}
+    Color3f eval(const SurfaceInteraction &si) const override {
+        return m_varying ? m_value * si.uv.x : m_value;
+    }
+    Color3f mean() const override { return m_varying ? m_value * 0.5f : m_value; }
+    bool is_spatially_varying() const override { return m_varying; }
+
+private:
+    Color3f m_value;
+    bool m_varying;
+};
+
+} // namespace
+
+TEST(BSDFEval, DiffuseTakesAnyTexturesConstantTheSameWay) {
+    // A texture that is not spatially varying is evaluated once (its mean()), whichever class it
+    // is: a user's constant gives bit for bit the BSDF values of a plain rgb; a varying one is
+    // evaluated at every point.
+    const Color3f rho(0.2f, 0.5f, 0.9f);
+    auto plain = make_diffuse(rho);
+    Properties constant("diffuse"), varying("diffuse");
+    constant.set_object("reflectance", std::make_shared<UserTexture>(rho, false));
+    varying.set_object("reflectance", std::make_shared<UserTexture>(rho, true));
+    auto user = PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, constant);
+    auto user_varying = PluginRegistry::instance().create_as<BSDF>(ObjectType::BSDF, varying);
+    SurfaceInteraction si = make_si(normalize(Vector3f(0.3f, -0.2f, 0.8f)));
+    const Vector3f wo = normalize(Vector3f(-0.5f, 0.1f, 0.4f));
+    for (float u : {0.f, 0.25f, 1.f}) {
+        si.uv = Point2f(u, 0.5f);
+        const Color3f a = plain->eval(BSDFContext(), si, wo), b = user->eval(BSDFContext(), si, wo);
+        EXPECT_EQ(a.r, b.r);
+        EXPECT_EQ(a.g, b.g);
+        EXPECT_EQ(a.b, b.b);
+        expect_color_near(user_varying->eval_diffuse_reflectance(si), rho * u, 1e-7f);
+    }
+}

@@ -22,6 +22,8 @@ public:
     /// Average over the texture's domain.
     virtual Color3f mean() const = 0;
     virtual float max() const { return mean().max(); }
+    /// False promises that eval(si) is mean() at every point: BSDFs and emitters may then take
+    /// mean() once instead of calling eval() (see BakedTexture).
     virtual bool is_spatially_varying() const { return true; }
     /// Called by the scene loader for every shape whose BSDF or emitter uses this texture
     /// (directly or nested); throws facet::Error when the texture cannot be evaluated on it
@@ -52,18 +54,17 @@ private:
     Color3f m_value;
 };
 
-/// A texture parameter of a BSDF with its constant value baked in: eval() of a ConstantTexture
-/// (a plain number or rgb, the common case) is a load and a branch, not a virtual call. The
-/// texture itself stays reachable (to_string, mean, gradients).
+/// A texture parameter of a BSDF with its constant value baked in: eval() of a texture that is
+/// not spatially varying (a plain number or rgb, the common case) is a load and a branch, not a
+/// virtual call. The texture itself stays reachable (to_string, mean, gradients).
 class BakedTexture {
 public:
     BakedTexture() = default;
     explicit BakedTexture(std::shared_ptr<Texture> texture) { *this = std::move(texture); }
     BakedTexture &operator=(std::shared_ptr<Texture> texture) {
         m_texture = std::move(texture);
-        const auto *c = dynamic_cast<const ConstantTexture *>(m_texture.get());
-        m_constant = c != nullptr;
-        if (c) m_value = c->mean();
+        m_constant = m_texture && !m_texture->is_spatially_varying();
+        if (m_constant) m_value = m_texture->mean();
         return *this;
     }
     Color3f eval(const SurfaceInteraction &si) const {
