@@ -106,6 +106,8 @@ Image read_pixels(const std::string &path, PixelRead &how) {
     if (!checked_mul(size_t(spec.width), size_t(spec.nchannels), row) ||
         !checked_mul(row, size_t(spec.height), values))
         values = std::numeric_limits<size_t>::max();
+    // OpenImageIO's limits:imagesize_MB would say so for a TIFF only (header_checks.cpp); needed
+    // by HostileImages.HeaderDimensionsAreCheckedBeforeAllocating (a PFM).
     allocation_bytes(values, sizeof(float), path, "image pixels");
     // OpenImageIO's TIFF reader buffers whole strips (check_tiff_strips(), and the row-by-row
     // reading of MinIsWhite files below).
@@ -120,6 +122,7 @@ Image read_pixels(const std::string &path, PixelRead &how) {
             !checked_mul(tiles_x, th, tile_values) || !checked_mul(tile_values, td, tile_values) ||
             !checked_mul(tile_values, size_t(spec.nchannels), tile_values))
             tile_values = std::numeric_limits<size_t>::max();
+        // Needed by HostileImages.TilesArePaddingOnlyWithinReason (a tiled TIFF).
         allocation_bytes(tile_values, sizeof(float), path, "a row of image tiles");
     }
 
