@@ -22,3 +22,18 @@ if(TARGET facet_cli)
         set_tests_properties(bench.embree_share.${_dir} PROPERTIES LABELS bench TIMEOUT 300)
     endforeach()
 endif()
+
+# The statistics counters and the recording and replay of Embree queries behind `facet bench`:
+# one GoogleTest program on the code of the command (core/apps/ray_recording.cpp) and libfacet's
+# private headers it uses (labels unit and bench: it takes a fraction of a second).
+if(TARGET facet_cli)
+    add_executable(bench_checks ${CMAKE_CURRENT_SOURCE_DIR}/bench/checks.cpp
+                                ${PROJECT_SOURCE_DIR}/core/apps/ray_recording.cpp)
+    target_include_directories(bench_checks PRIVATE ${PROJECT_SOURCE_DIR}/core/apps
+                               ${PROJECT_SOURCE_DIR}/core/src)
+    target_compile_options(bench_checks PRIVATE ${FACET_TEST_COMPILE_OPTIONS})
+    target_link_libraries(bench_checks PRIVATE facet facet_warnings GTest::gtest GTest::gtest_main)
+    add_dependencies(bench_checks facet_plugins)
+    add_test(NAME bench.checks COMMAND bench_checks)
+    set_tests_properties(bench.checks PROPERTIES LABELS "unit;bench" TIMEOUT 300)
+endif()

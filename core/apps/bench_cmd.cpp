@@ -9,14 +9,16 @@
 // 1 / (RMSE² · CPU time): an estimator that reaches the same error sooner is faster even if each
 // sample costs more.
 //
-// Rays of the render are counted exactly: Scene::ray_count() sums per-thread counts of every
-// ray_intersect() and ray_test() call (plain thread-local increments, no locks or atomics in the
-// hot path). Embree's share is measured, not attributed by a profiler: a second render, at fewer
-// samples, records the queries it sends to Embree (Scene::start_ray_recording()), and they are
-// sent again, on one thread with nothing else around them. Their CPU time per ray, times the
+// Rays of the render are counted exactly: libfacet's statistics counters (stats.h) count every
+// ray_intersect() and ray_test() call per thread (plain thread-local increments, no locks or
+// atomics in the hot path). Embree's share is measured, not attributed by a profiler: a second
+// render, at fewer samples, records the queries it sends to Embree (ray_recording.h), and they
+// are sent again, on one thread with nothing else around them. Their CPU time per ray, times the
 // render's rays, is Embree's own work in the render; the rest of the render's CPU time is facet's.
 
 #include "commands.h"
+#include "ray_recording.h"
+#include "stats.h"
 
 #include <facet/logger.h>
 #include <facet/render.h>
@@ -95,24 +97,37 @@ private:
     std::string m_error = "perf events unavailable";
 };
 
+/// The rays traced so far, all threads together: ray_intersect() calls (closest hit) and
+/// ray_test() calls (any hit, for shadow rays).
+struct RayCount {
+    uint64_t intersect = 0;
+    uint64_t test = 0;
+
+    static RayCount now() {
+        return {stats::total("scene.ray_intersect"), stats::total("scene.ray_test")};
+    }
+    uint64_t total() const { return intersect + test; }
+    RayCount operator-(const RayCount &o) const { return {intersect - o.intersect, test - o.test}; }
+};
+
 /// A render with its cost: wall and CPU seconds, instructions (0 when not counted), rays.
 struct Measured {
     RenderResult result;
     double cpu_seconds = 0.0;
     uint64_t instructions = 0;
-    uint64_t rays = 0;
+    RayCount rays;
 };
 
 Measured measure_render(const Scene &scene, const Sensor &sensor, const RenderOptions &ropts,
                         const InstructionCounter *counter) {
     Measured m;
-    uint64_t rays_before = Scene::ray_count();
+    const RayCount rays_before = RayCount::now();
     uint64_t instr_before = counter ? counter->read() : 0;
     double cpu_before = process_cpu_seconds();
     m.result = render(scene, sensor, ropts);
     m.cpu_seconds = process_cpu_seconds() - cpu_before;
     m.instructions = counter ? counter->read() - instr_before : 0;
-    m.rays = Scene::ray_count() - rays_before;
+    m.rays = RayCount::now() - rays_before;
     return m;
 }
 
@@ -207,7 +222,7 @@ int bench_main(int argc, char **argv) {
     }
 
     const RenderResult &result = m.result;
-    const uint64_t rays = m.rays;
+    const uint64_t rays = m.rays.total();
     const double samples = std::max<double>(1.0, double(result.samples));
     double cpu = std::max(m.cpu_seconds, 1e-9);
     fmt::print("render      : {}samples in {:.3f} CPU-s ({:.3f} CPU-s per thread; wall {:.3f} s) "
@@ -215,8 +230,10 @@ int bench_main(int argc, char **argv) {
                mega(double(result.samples)), m.cpu_seconds, m.cpu_seconds / threads, result.seconds,
                mega(double(result.samples) / cpu), 1e9 * cpu / samples);
     fmt::print("              {}rays (ray_intersect + ray_test calls, counted exactly; "
-               "{:.2f} per sample) = {}rays per CPU-s\n",
-               mega(double(rays)), double(rays) / samples, mega(double(rays) / cpu));
+               "{:.2f} per sample, {:.1f}% of them ray_test) = {}rays per CPU-s\n",
+               mega(double(rays)), double(rays) / samples,
+               100.0 * double(m.rays.test) / std::max<double>(1.0, double(rays)),
+               mega(double(rays) / cpu));
     if (counter.available())
         fmt::print("instructions: {:.0f} per sample ({:.0f} per ray; user space, all threads)\n",
                    double(m.instructions) / samples,
@@ -279,30 +296,26 @@ int bench_main(int argc, char **argv) {
     RenderOptions record = ropts;
     record.spp =
         int(std::clamp(double(spp) * double(RecordBudget) / double(rays), 1.0, double(spp)));
-    Scene::start_ray_recording(RecordBudget);
+    RayRecording recording(RecordBudget);
     RenderResult recorded = render(*scene, sensor, record);
-    Scene::stop_ray_recording();
+    recording.stop();
     uninstall_interrupt_handler();
-    if (recorded.cancelled) {
-        Scene::discard_recorded_rays();
-        FACET_THROW("interrupted");
-    }
+    if (recorded.cancelled) FACET_THROW("interrupted");
     // A first pass counts the rays (and warms the caches, as the render had them); the timed
     // passes send as many rays as the render traced (at most 64 passes), for a CPU time long
     // enough to measure.
-    const Scene::RayReplay first = scene->replay_recorded_rays();
+    const RayRecording::Replay first = recording.replay(*scene);
     const uint64_t passes =
         first.rays == 0 ? 0 : std::clamp<uint64_t>((rays + first.rays - 1) / first.rays, 1, 64);
-    Scene::RayReplay replay;
+    RayRecording::Replay replay;
     const double replay_before = thread_cpu_seconds();
     for (uint64_t i = 0; i < passes; ++i) {
-        const Scene::RayReplay pass = scene->replay_recorded_rays();
+        const RayRecording::Replay pass = recording.replay(*scene);
         replay.rays += pass.rays;
         replay.differing += pass.differing;
     }
     const double replay_cpu = thread_cpu_seconds() - replay_before;
     replay.differing += first.differing;
-    Scene::discard_recorded_rays();
     if (replay.rays == 0) {
         fmt::print("embree alone: skipped (no ray recorded)\n");
         return 0;

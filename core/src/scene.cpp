@@ -1,3 +1,6 @@
+#include "scene_queries.h"
+#include "stats.h"
+
 #include <facet/assert.h>
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
@@ -26,76 +29,22 @@ SceneSensor::~SceneSensor() = default;
 
 namespace {
 
-/// A thread's recorded Embree queries (Scene::start_ray_recording()): each ray as the scene
-/// passed it to Embree, whether it was an occlusion query, and Embree's answer. Written only by
-/// its thread, read by replay_recorded_rays() after the render.
-struct RecordedRay {
-    float words[8]; ///< ray_words(): o, d, mint, maxt
-    bool occlusion; ///< rtcOccluded1, else rtcIntersect1
-    bool hit;
-};
-struct RayLog {
-    std::vector<RecordedRay> rays;
-    size_t room = 0; ///< rays of the shared budget this log has claimed and not used yet
-};
+/// Rays traced, for `facet bench`: every ray_intersect() and ray_test() call, the ones Embree
+/// cannot trace included.
+const stats::Counter g_intersect_calls("scene.ray_intersect");
+const stats::Counter g_test_calls("scene.ray_test");
 
-/// Per-thread count of ray_intersect() and ray_test() calls, summed by Scene::ray_count() for
-/// `facet bench`. The hot path only does a relaxed load and store on its own thread's slot (plain
-/// moves: no lock, no read-modify-write). A thread registers its slot on its first ray. Slots and
-/// their list are never freed, so nothing needs destroying when threads or the process end (TBB
-/// workers can outlive static destructors).
-struct alignas(64) RayCounter {
-    std::atomic<uint64_t> count{0};
-    /// The thread's log while a recording is on, else null: a load of the same cache line and
-    /// a branch the predictor always gets right, when not recording.
-    std::atomic<RayLog *> log{nullptr};
-};
-std::mutex g_ray_counter_mutex;
-std::vector<RayCounter *> *g_ray_counters = new std::vector<RayCounter *>();
-// initial-exec: a plain thread-pointer-relative load instead of a __tls_get_addr call per ray
-// (libfacet is loaded with the program, or early enough that its few bytes of static TLS fit).
-thread_local RayCounter *t_ray_counter __attribute__((tls_model("initial-exec"))) = nullptr;
-// The recording: on or off, and the logs, under g_ray_counter_mutex; the rays that may still be
-// recorded, all threads together.
-bool g_recording = false;
-std::vector<RayLog *> *g_ray_logs = new std::vector<RayLog *>();
-std::atomic<size_t> g_record_budget{0};
+/// What sees the queries sent to Embree (SceneQueries::set_observer()), null when nothing does:
+/// a load that stays in the cache and a branch the predictor always gets right.
+std::atomic<detail::RayQueryObserver *> g_query_observer{nullptr};
 
-/// Gives thread slot `c` a log of its own (under g_ray_counter_mutex, while recording).
-void attach_ray_log(RayCounter &c) {
-    g_ray_logs->push_back(new RayLog());
-    c.log.store(g_ray_logs->back(), std::memory_order_relaxed);
-}
-
-inline RayCounter *count_ray() {
-    RayCounter *c = t_ray_counter;
-    if (!c) {
-        c = t_ray_counter = new RayCounter();
-        std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
-        g_ray_counters->push_back(c);
-        if (g_recording) attach_ray_log(*c);
-    }
-    c->count.store(c->count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-    return c;
-}
-
-/// Appends a query that Embree has answered to the thread's log, while the budget lasts. Out of
-/// line: only a recording render comes here. The budget is claimed 4096 rays at a time, one
-/// atomic operation per block; the log grows as vectors do.
-__attribute__((noinline)) void record_ray(RayLog &log, const Ray &ray, bool occlusion, bool hit) {
-    if (log.room == 0) {
-        size_t budget = g_record_budget.load(std::memory_order_relaxed), claim = 0;
-        do {
-            claim = std::min<size_t>(budget, 4096);
-            if (claim == 0) return;
-        } while (!g_record_budget.compare_exchange_weak(budget, budget - claim,
-                                                        std::memory_order_relaxed));
-        log.room = claim;
-    }
-    log.rays.push_back({{ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z, ray.mint, ray.maxt},
-                        occlusion,
-                        hit});
-    --log.room;
+/// Shows a query Embree has answered to the observer. Out of line: only a recording render
+/// comes here.
+__attribute__((noinline)) void observe_query(detail::RayQueryObserver &observer, const Ray &ray,
+                                             bool occlusion, bool hit) {
+    observer.observe({{ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z, ray.mint, ray.maxt},
+                      occlusion,
+                      hit});
 }
 
 const char *embree_error_name(RTCError code) {
@@ -166,7 +115,7 @@ inline void set_embree_ray(__m128 a, __m128 b, RTCRay &r) {
     const __m128 row2 = _mm_castsi128_ps(_mm_setr_epi32(0, -1, 0, 0));
     _mm_store_ps(out + 8, _mm_move_ss(row2, _mm_shuffle_ps(b, b, _MM_SHUFFLE(3, 3, 3, 3))));
 }
-/// The closest-hit query of ray_intersect(), and of the replay of recorded rays.
+/// The closest-hit query of ray_intersect(), and of SceneQueries::resend().
 inline void embree_intersect(RTCScene scene, __m128 a, __m128 b, RTCRayHit &rh) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -177,7 +126,8 @@ inline void embree_intersect(RTCScene scene, __m128 a, __m128 b, RTCRayHit &rh) 
     rtcIntersect1(scene, &context, &rh);
 }
 
-/// The any-hit query of occluded(), and of the replay: true when something blocks the ray.
+/// The any-hit query of occluded(), and of SceneQueries::resend(): true when something blocks
+/// the ray.
 inline bool embree_occluded(RTCScene scene, __m128 a, __m128 b) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -417,58 +367,33 @@ Scene::~Scene() {
     if (m_device) rtcReleaseDevice(m_device);
 }
 
-uint64_t Scene::ray_count() {
-    std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
-    uint64_t total = 0;
-    for (const RayCounter *c : *g_ray_counters) total += c->count.load(std::memory_order_relaxed);
-    return total;
+detail::RayQueryObserver::~RayQueryObserver() = default;
+
+detail::RayQueryObserver *detail::SceneQueries::set_observer(RayQueryObserver *observer) {
+    return g_query_observer.exchange(observer, std::memory_order_relaxed);
 }
 
-void Scene::start_ray_recording(size_t max_rays) {
-    discard_recorded_rays();
-    std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
-    g_record_budget.store(max_rays, std::memory_order_relaxed);
-    g_recording = true;
-    for (RayCounter *c : *g_ray_counters) attach_ray_log(*c);
-}
-
-void Scene::stop_ray_recording() {
-    std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
-    g_recording = false;
-    for (RayCounter *c : *g_ray_counters) c->log.store(nullptr, std::memory_order_relaxed);
-}
-
-void Scene::discard_recorded_rays() {
-    stop_ray_recording();
-    std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
-    for (RayLog *log : *g_ray_logs) delete log;
-    g_ray_logs->clear();
-}
-
-Scene::RayReplay Scene::replay_recorded_rays() const {
-    std::lock_guard<std::mutex> lock(g_ray_counter_mutex);
-    RayReplay replay;
-    for (const RayLog *log : *g_ray_logs) {
-        for (const RecordedRay &rec : log->rays) {
-            // The queries of ray_intersect() and occluded(), from the same words.
-            const __m128 a = _mm_loadu_ps(rec.words), b = _mm_loadu_ps(rec.words + 4);
-            bool hit;
-            if (rec.occlusion) {
-                hit = embree_occluded(m_rtc_scene, a, b);
-            } else {
-                RTCRayHit rh;
-                embree_intersect(m_rtc_scene, a, b, rh);
-                hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-            }
-            ++replay.rays;
-            replay.differing += hit != rec.hit;
+uint64_t detail::SceneQueries::resend(const Scene &scene, const RayQuery *queries, size_t count) {
+    uint64_t differing = 0;
+    for (size_t i = 0; i < count; ++i) {
+        // The queries of ray_intersect() and occluded(), from the same words.
+        const RayQuery &query = queries[i];
+        const __m128 a = _mm_loadu_ps(query.words), b = _mm_loadu_ps(query.words + 4);
+        bool hit;
+        if (query.occlusion) {
+            hit = embree_occluded(scene.m_rtc_scene, a, b);
+        } else {
+            RTCRayHit rh;
+            embree_intersect(scene.m_rtc_scene, a, b, rh);
+            hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
         }
+        differing += hit != query.hit;
     }
-    return replay;
+    return differing;
 }
 
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
-    RayCounter *counter = count_ray();
+    g_intersect_calls.add();
     __m128 a, b;
     ray_words(ray, a, b);
     if (!embree_can_trace(a, b)) {
@@ -477,8 +402,8 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     }
     RTCRayHit rh;
     embree_intersect(m_rtc_scene, a, b, rh);
-    if (RayLog *log = counter->log.load(std::memory_order_relaxed))
-        record_ray(*log, ray, false, rh.hit.geomID != RTC_INVALID_GEOMETRY_ID);
+    if (detail::RayQueryObserver *observer = g_query_observer.load(std::memory_order_relaxed))
+        observe_query(*observer, ray, false, rh.hit.geomID != RTC_INVALID_GEOMETRY_ID);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         escaped(ray, si);
         return false;
@@ -512,13 +437,13 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
 bool Scene::ray_test(const Ray &ray) const { return occluded(ray); }
 
 inline bool Scene::occluded(const Ray &ray) const {
-    RayCounter *counter = count_ray();
+    g_test_calls.add();
     __m128 a, b;
     ray_words(ray, a, b);
     if (!embree_can_trace(a, b)) return false;
     const bool hit = embree_occluded(m_rtc_scene, a, b);
-    if (RayLog *log = counter->log.load(std::memory_order_relaxed))
-        record_ray(*log, ray, true, hit);
+    if (detail::RayQueryObserver *observer = g_query_observer.load(std::memory_order_relaxed))
+        observe_query(*observer, ray, true, hit);
     return hit;
 }
 

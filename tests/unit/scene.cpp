@@ -16,7 +16,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <limits>
 
 using namespace facet;
 
@@ -192,49 +191,6 @@ TEST(SceneQuery, IntersectionRecords) {
     ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-4, 0, 2), Vector3f(1, 0, 0), 0.f, 10.f), si));
     EXPECT_NEAR(si.t, 3.5f, 1e-5f);
     expect_near_vec(si.n, Vector3f(-1, 0, 0), 1e-5f);
-}
-
-TEST(SceneQuery, RecordedRaysReplayAsTraced) {
-    Scene scene(rect_and_sphere());
-    SurfaceInteraction si;
-    // Hits and misses of both kinds of query, and a NaN ray that never reaches Embree.
-    auto trace = [&](const Scene &target) {
-        EXPECT_TRUE(target.ray_intersect(Ray(Point3f(1, 0.5f, 3), Vector3f(0, 0, -1)), si));
-        EXPECT_TRUE(target.ray_intersect(Ray(Point3f(5, 0, 2), Vector3f(-1, 0, 0)), si));
-        EXPECT_TRUE(target.ray_intersect(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 3.f, 10.f), si));
-        EXPECT_FALSE(target.ray_intersect(Ray(Point3f(5, 5, 5), Vector3f(0, 0, 1)), si));
-        EXPECT_TRUE(target.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1))));
-        EXPECT_FALSE(target.ray_test(Ray(Point3f(0, 0, 5), Vector3f(0, 0, -1), 0.f, 2.4f)));
-        EXPECT_FALSE(target.ray_intersect(
-            Ray(Point3f(0, 0, 0), Vector3f(std::numeric_limits<float>::quiet_NaN(), 0, 0)), si));
-    };
-    trace(scene); // not recorded
-    Scene::start_ray_recording(100);
-    trace(scene);
-    Scene::stop_ray_recording();
-    trace(scene); // not recorded
-    Scene::RayReplay replay = scene.replay_recorded_rays();
-    EXPECT_EQ(replay.rays, 6u);
-    EXPECT_EQ(replay.differing, 0u);
-    // A replay reproduces the queries, not just their number: through the floor alone, the ray
-    // to the sphere's equator misses; the others reach the floor or miss as before.
-    Properties floor_only;
-    Properties rect;
-    rect.set_transform("to_world", Transform::scale(Vector3f(2, 2, 1)));
-    floor_only.set_object("floor", create(ObjectType::Shape, "rectangle", rect));
-    Scene floor_scene(floor_only);
-    replay = floor_scene.replay_recorded_rays();
-    EXPECT_EQ(replay.rays, 6u);
-    EXPECT_EQ(replay.differing, 1u);
-
-    // The budget bounds what is kept, over every thread together; a new recording starts
-    // empty, and discarding frees it.
-    Scene::start_ray_recording(4);
-    trace(scene);
-    Scene::stop_ray_recording();
-    EXPECT_EQ(scene.replay_recorded_rays().rays, 4u);
-    Scene::discard_recorded_rays();
-    EXPECT_EQ(scene.replay_recorded_rays().rays, 0u);
 }
 
 namespace {

@@ -24,6 +24,9 @@ public:
 };
 
 struct SceneDescription;
+namespace detail {
+class SceneQueries;
+}
 
 /// The scene: shapes in one Embree scene, emitters, sensors and the integrator.
 /// Immutable while it renders; every query is thread-safe. Only traverse() (facet/params.h)
@@ -45,26 +48,6 @@ public:
     static void escaped(const Ray &ray, SurfaceInteraction &si);
     /// Any hit in [ray.mint, ray.maxt] (rtcOccluded1).
     bool ray_test(const Ray &ray) const;
-    /// Number of ray_intersect() and ray_test() calls so far, all threads and scenes together
-    /// (`facet bench` takes the difference around a render).
-    static uint64_t ray_count();
-
-    /// Recording of the queries sent to Embree, for `facet bench` to time Embree on its own:
-    /// from start_ray_recording() to stop_ray_recording(), every thread keeps the rays it passes
-    /// to Embree (ray_intersect() and ray_test()) with Embree's answers, the first `max_rays` in
-    /// all. Starting discards an earlier recording. None of these may run during a render.
-    static void start_ray_recording(size_t max_rays);
-    static void stop_ray_recording();
-    static void discard_recorded_rays();
-    struct RayReplay {
-        uint64_t rays = 0;      ///< queries sent again
-        uint64_t differing = 0; ///< answers (hit or not) that differ from the recorded ones
-    };
-    /// Sends the recorded queries again to this scene's Embree scene, the calls of ray_intersect()
-    /// and ray_test() with nothing else around them, each thread's in its order, all on the
-    /// calling thread. For the scene that traced them.
-    RayReplay replay_recorded_rays() const;
-
     /// Picks an emitter uniformly and samples a direction to it from ref. The weight includes the
     /// selection probability; with `test_visibility` an occluded sample gets weight zero.
     std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
@@ -120,6 +103,8 @@ public:
     bool rebuild(const Properties &props);
 
 private:
+    friend class detail::SceneQueries; ///< `facet bench`'s replay of Embree queries (private)
+
     Scene() = default;
     /// The constructor's body; with `previous`, takes over its Embree scene when the shapes
     /// are the same.
