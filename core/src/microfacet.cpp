@@ -10,13 +10,6 @@ const char *microfacet_type_name(MicrofacetType type) {
     return type == MicrofacetType::Beckmann ? "beckmann" : "ggx";
 }
 
-MicrofacetDistribution::MicrofacetDistribution(const Properties &props, float default_alpha)
-    : MicrofacetDistribution(MicrofacetType::Beckmann, default_alpha) {
-    MicrofacetParameters params = read_microfacet(props, default_alpha, false);
-    *this = MicrofacetDistribution(params.type(), params.alpha_u()->mean().mean(),
-                                   params.alpha_v()->mean().mean(), params.sample_visible());
-}
-
 std::pair<Vector3f, float> MicrofacetDistribution::sample(const Vector3f &wi,
                                                           const Point2f &u) const {
     return m_sample_visible ? sample_visible_normals(wi, u) : sample_all(u);

@@ -243,11 +243,6 @@ TEST(MicrofacetParameters, ReadsMitsubaParameters) {
     EXPECT_FALSE(
         read_microfacet(microfacet_props({{"alpha_u", 0.3}, {"alpha_v", 0.3}})).is_anisotropic());
 
-    // The plain-number constructor.
-    MicrofacetDistribution direct(microfacet_props({{"alpha", 0.25}}));
-    EXPECT_FLOAT_EQ(direct.alpha(), 0.25f);
-    EXPECT_TRUE(direct.sample_visible());
-
     // Tiny roughness is clamped to 1e-4.
     Properties zero = microfacet_props({{"alpha", 0.0}});
     EXPECT_FLOAT_EQ(read_microfacet(zero).at(si).alpha(), MicrofacetDistribution::MinAlpha);

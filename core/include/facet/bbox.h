@@ -27,7 +27,6 @@ struct BoundingBox3f {
         max = facet::max(max, b.max);
     }
     Point3f center() const { return (min + max) * 0.5f; }
-    Vector3f extents() const { return max - min; }
     /// Radius of the bounding sphere around center().
     float bounding_sphere_radius() const { return valid() ? norm(max - min) * 0.5f : 0.f; }
 };

@@ -83,44 +83,4 @@ private:
     double m_sum = 0.0;
 };
 
-/// Piecewise-constant density on [0,1]² over a width × height grid of cells, sampled by the
-/// marginal in y and then the conditional in x.
-class Distribution2D {
-public:
-    Distribution2D() = default;
-    Distribution2D(const std::vector<float> &weights, int width, int height)
-        : m_width(width), m_height(height) {
-        m_conditional.resize(size_t(height));
-        std::vector<float> row_sums(static_cast<size_t>(height));
-        for (int y = 0; y < height; ++y) {
-            m_conditional[size_t(y)].build(weights.data() + size_t(y) * width, size_t(width));
-            row_sums[size_t(y)] = float(m_conditional[size_t(y)].sum());
-        }
-        m_marginal.build(row_sums.data(), row_sums.size());
-    }
-
-    bool valid() const { return m_marginal.sum() > 0.0; }
-
-    /// Point in [0,1]² and its density with respect to area on the unit square.
-    Point2f sample(const Point2f &u, float &pdf) const {
-        float uy = u.y, ux = u.x;
-        size_t y = m_marginal.sample_reuse(uy);
-        size_t x = m_conditional[y].sample_reuse(ux);
-        pdf = m_marginal.pmf(y) * m_conditional[y].pmf(x) * float(m_width) * float(m_height);
-        return {(float(x) + ux) / float(m_width), (float(y) + uy) / float(m_height)};
-    }
-
-    float pdf(const Point2f &p) const {
-        int x = std::clamp(int(p.x * float(m_width)), 0, m_width - 1);
-        int y = std::clamp(int(p.y * float(m_height)), 0, m_height - 1);
-        return m_marginal.pmf(size_t(y)) * m_conditional[size_t(y)].pmf(size_t(x)) *
-               float(m_width) * float(m_height);
-    }
-
-private:
-    int m_width = 0, m_height = 0;
-    std::vector<DiscreteDistribution> m_conditional;
-    DiscreteDistribution m_marginal;
-};
-
 } // namespace facet

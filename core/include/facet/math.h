@@ -27,7 +27,6 @@ template <typename T> constexpr T lerp(float t, T a, T b) { return a * (1.f - t)
 inline float safe_sqrt(float x) { return std::sqrt(std::max(x, 0.f)); }
 inline double safe_sqrt(double x) { return std::sqrt(std::max(x, 0.0)); }
 inline float safe_acos(float x) { return std::acos(clamp(x, -1.f, 1.f)); }
-inline float safe_asin(float x) { return std::asin(clamp(x, -1.f, 1.f)); }
 inline float deg_to_rad(float d) { return d * (Pi / 180.f); }
 inline float rad_to_deg(float r) { return r * (180.f / Pi); }
 inline float mulsign(float x, float s) { return std::signbit(s) ? -x : x; }

@@ -33,9 +33,6 @@ public:
                            bool sample_visible = true)
         : m_type(type), m_alpha_u(std::max(alpha_u, MinAlpha)),
           m_alpha_v(std::max(alpha_v, MinAlpha)), m_sample_visible(sample_visible) {}
-    /// From a scene's `distribution`, `alpha` / `alpha_u` + `alpha_v` (plain numbers only) and
-    /// `sample_visible`; see read_microfacet().
-    explicit MicrofacetDistribution(const Properties &props, float default_alpha = 0.1f);
 
     MicrofacetType type() const { return m_type; }
     float alpha() const { return m_alpha_u; }
@@ -65,7 +62,6 @@ public:
         // Also removes m in the lower hemisphere and the underflow near grazing normals.
         return result * cos_m > 1e-20f ? result : 0.f;
     }
-    float D(const Vector3f &m) const { return eval(m); }
 
     /// Smith's masking function G1(v, m) (Walter et al. 2007). For Beckmann this is Walter's
     /// rational approximation of (1 + erf(a) + exp(−a²)/(a√π))⁻¹·2, relative error < 0.35 %.
@@ -83,7 +79,6 @@ public:
         }
         return 2.f / (1.f + std::sqrt(1.f + tan_theta_alpha_2));
     }
-    float G1(const Vector3f &v, const Vector3f &m) const { return smith_g1(v, m); }
 
     /// Uncorrelated shadowing-masking G(wi, wo, m) = G1(wi, m)·G1(wo, m).
     float G(const Vector3f &wi, const Vector3f &wo, const Vector3f &m) const {

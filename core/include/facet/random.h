@@ -38,10 +38,6 @@ public:
         x.u = (next_uint32() >> 9) | 0x3f800000u;
         return x.f - 1.f;
     }
-    double next_double() {
-        uint64_t hi = next_uint32(), lo = next_uint32();
-        return double(((hi << 32) | lo) >> 11) * (1.0 / 9007199254740992.0);
-    }
     uint32_t next_uint32(uint32_t bound) {
         uint32_t threshold = (~bound + 1u) % bound;
         for (;;) {

@@ -70,7 +70,6 @@ public:
     const BoundingBox3f &bbox() const { return m_bbox; }
     /// Seconds the acceleration structure (the Embree scene) took to build.
     double accel_build_seconds() const { return m_accel_seconds; }
-    RTCScene embree_scene() const { return m_rtc_scene; }
     RTCDevice embree_device() const { return m_device; }
     /// The scene option `embree_use_robust_intersections` (default false, as in Mitsuba 3):
     /// Embree's robust (watertight) triangle test instead of its fast one.
