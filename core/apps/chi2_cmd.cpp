@@ -178,6 +178,224 @@ std::string join_args(int argc, char **argv) {
     return s;
 }
 
+// -- facet chi2 bsdf ------------------------------------------------------------------------------
+
+struct BsdfCommand {
+    CommonOptions common;
+    std::string name, xml, wi_text, mode = "radiance";
+    std::vector<std::string> params;
+    float theta = 30.f, phi = 0.f;
+    int component = -1;
+    CLI::Option *theta_opt = nullptr;
+};
+
+CLI::App *add_bsdf_command(CLI::App &app, BsdfCommand &c) {
+    CLI::App *bsdf =
+        app.add_subcommand("bsdf", "Test a BSDF: facet chi2 bsdf <name> [key=value ...]");
+    bsdf->add_option("name", c.name, "BSDF plugin name");
+    bsdf->add_option("params", c.params,
+                     "Parameters key=value (type inferred: number -> float, true/false -> boolean, "
+                     "r,g,b -> rgb, else string) or type:key=value (e.g. integer:n=3)");
+    bsdf->add_option("--xml", c.xml, "The BSDF as XML text or an .xml file (instead of a name)");
+    bsdf->add_option("--wi", c.wi_text, "Incident direction x,y,z in the local frame (normalised)");
+    c.theta_opt =
+        bsdf->add_option("--theta", c.theta, "Incident polar angle in degrees (default 30)");
+    bsdf->add_option("--phi", c.phi, "Incident azimuth in degrees (default 0)");
+    bsdf->add_option("--component", c.component, "Test only this component (lobe) index");
+    bsdf->add_option("--mode", c.mode, "Transport mode: radiance (default) or importance");
+    add_common(*bsdf, c.common);
+    return bsdf;
+}
+
+int run_bsdf(BsdfCommand &c, const std::string &everything) {
+    add_plugin_dirs(c.common.plugin_dirs);
+    if (!c.wi_text.empty() && c.theta_opt->count() > 0)
+        FACET_THROW("give the incident direction either with --wi or with --theta/--phi");
+    Vector3f wi;
+    if (!c.wi_text.empty()) {
+        auto v = parse_floats(c.wi_text, 3, "--wi");
+        wi = Vector3f(v[0], v[1], v[2]);
+    } else {
+        wi = direction_from_angles(c.theta, c.phi);
+    }
+    BSDFContext ctx;
+    if (c.mode == "importance")
+        ctx.mode = TransportMode::Importance;
+    else if (c.mode != "radiance")
+        FACET_THROW("--mode \"{}\": expected radiance or importance", c.mode);
+    if (c.component >= 0) ctx.component = uint32_t(c.component);
+
+    std::string text;
+    if (!c.xml.empty() || (!c.name.empty() && c.name[0] == '<')) {
+        if (!c.params.empty()) FACET_THROW("key=value parameters cannot be added to --xml");
+        text = read_xml_argument(c.xml.empty() ? c.name : c.xml);
+        if (c.name.empty() || c.name[0] == '<') c.name = "xml";
+    } else {
+        if (c.name.empty()) FACET_THROW("name the BSDF plugin to test (or give --xml)");
+        text = chi2_object_xml(ObjectType::BSDF, c.name, c.params);
+    }
+    BSDFAdapter adapter(text, wi, ctx);
+    return run(adapter, c.common, slug("bsdf", c.name, everything));
+}
+
+// -- facet chi2 emitter ---------------------------------------------------------------------------
+
+struct EmitterCommand {
+    CommonOptions common;
+    std::string name, xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
+    std::vector<std::string> params;
+    bool emission = false;
+};
+
+CLI::App *add_emitter_command(CLI::App &app, EmitterCommand &c) {
+    CLI::App *emitter = app.add_subcommand(
+        "emitter",
+        "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
+    emitter->add_option("name", c.name, "Emitter plugin name");
+    emitter->add_option("params", c.params, "Parameters, as for bsdf");
+    emitter->add_option("--xml", c.xml,
+                        "The emitter as XML text or an .xml file, an <emitter> or a whole <scene> "
+                        "(its first emitter is tested), instead of a name");
+    emitter->add_flag("--emission", c.emission,
+                      "Test the directions of emitted rays (sample_ray against "
+                      "pdf_ray_direction; emitters with one origin, e.g. spot) instead of "
+                      "direction sampling from --ref");
+    emitter->add_option("--ref", c.ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
+    emitter->add_option(
+        "--shape", c.shape,
+        "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
+    add_common(*emitter, c.common);
+    return emitter;
+}
+
+int run_emitter(EmitterCommand &c, const std::string &everything) {
+    add_plugin_dirs(c.common.plugin_dirs);
+    auto r = parse_floats(c.ref_text, 3, "--ref");
+    std::string scene;
+    if (!c.xml.empty()) {
+        if (!c.name.empty() || !c.params.empty())
+            FACET_THROW("give the emitter either by name and key=value parameters or --xml");
+        scene = read_xml_argument(c.xml);
+        if (scene.find("<scene") == std::string::npos)
+            scene = "<scene version=\"3.0.0\">" + scene + "</scene>";
+        c.name = "xml";
+    } else {
+        if (c.name.empty()) FACET_THROW("name the emitter plugin to test (or give --xml)");
+        scene = EmitterAdapter::scene_xml(c.name, c.params, c.shape);
+    }
+    if (c.emission) {
+        EmissionAdapter adapter(scene);
+        return run(adapter, c.common, slug("emission", c.name, everything));
+    }
+    EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]));
+    return run(adapter, c.common, slug("emitter", c.name, everything));
+}
+
+// -- facet chi2 sensor ----------------------------------------------------------------------------
+
+struct SensorCommand {
+    CommonOptions common;
+    std::string name, xml, ref, ref_local, aperture_text = "0.5,0.5", film_text;
+    std::vector<std::string> params;
+};
+
+CLI::App *add_sensor_command(CLI::App &app, SensorCommand &c) {
+    CLI::App *sensor = app.add_subcommand(
+        "sensor", "Test a sensor's importance (light tracing): facet chi2 sensor <name> "
+                  "[key=value ...]; its camera rays, or its aperture seen from --ref");
+    sensor->add_option("name", c.name, "Sensor plugin name");
+    sensor->add_option("params", c.params, "Parameters, as for bsdf");
+    sensor->add_option("--xml", c.xml,
+                       "The sensor as XML text or an .xml file, a <sensor> or a whole <scene> "
+                       "(its first sensor is tested), instead of a name");
+    sensor->add_option("--film", c.film_text,
+                       "Film size width,height in pixels for a sensor given by name (default: "
+                       "the plugin's default film)");
+    sensor->add_option("--aperture", c.aperture_text,
+                       "Aperture sample u,v in [0,1) of the camera rays (default 0.5,0.5: the "
+                       "lens centre)");
+    sensor->add_option("--ref", c.ref,
+                       "Test the aperture sampling of sample_direction() from this world point "
+                       "x,y,z against pdf_direction() (thin lens), instead of the camera rays");
+    sensor->add_option("--ref-local", c.ref_local,
+                       "As --ref, with the point in the camera's frame (before to_world)");
+    add_common(*sensor, c.common);
+    return sensor;
+}
+
+/// The sensor's XML (a <scene> around it), from --xml or from its name and parameters.
+std::string sensor_text(SensorCommand &c) {
+    if (!c.xml.empty()) {
+        if (!c.name.empty() || !c.params.empty() || !c.film_text.empty())
+            FACET_THROW("give the sensor either by name and key=value parameters (and "
+                        "--film) or --xml");
+        std::string text = read_xml_argument(c.xml);
+        if (text.find("<scene") == std::string::npos && text.find("version=") == std::string::npos)
+            text = "<scene version=\"3.0.0\">" + text + "</scene>";
+        c.name = "xml";
+        return text;
+    }
+    if (c.name.empty()) FACET_THROW("name the sensor plugin to test (or give --xml)");
+    Point2i film(0, 0);
+    if (!c.film_text.empty()) {
+        auto f = parse_floats(c.film_text, 2, "--film");
+        if (!(f[0] >= 1.f && f[1] >= 1.f) || f[0] != std::floor(f[0]) || f[1] != std::floor(f[1]))
+            FACET_THROW("--film \"{}\": expected two positive whole numbers", c.film_text);
+        film = Point2i(int(f[0]), int(f[1]));
+    }
+    return SensorAdapter::sensor_xml(c.name, c.params, film);
+}
+
+int run_sensor(SensorCommand &c, const std::string &everything) {
+    add_plugin_dirs(c.common.plugin_dirs);
+    std::shared_ptr<Sensor> camera = SensorAdapter::load(sensor_text(c));
+    if (!c.ref.empty() && !c.ref_local.empty())
+        FACET_THROW("give the reference point either with --ref or with --ref-local");
+    if (!c.ref.empty() || !c.ref_local.empty()) {
+        auto r = parse_floats(c.ref.empty() ? c.ref_local : c.ref, 3,
+                              c.ref.empty() ? "--ref-local" : "--ref");
+        Point3f ref(r[0], r[1], r[2]);
+        if (!c.ref_local.empty()) ref = camera->to_world().apply_point(ref);
+        SensorAdapter adapter(camera, ref);
+        return run(adapter, c.common, slug("sensor", c.name, everything));
+    }
+    auto a = parse_floats(c.aperture_text, 2, "--aperture");
+    SensorAdapter adapter(camera, Point2f(a[0], a[1]));
+    return run(adapter, c.common, slug("sensor", c.name, everything));
+}
+
+// -- facet chi2 microfacet ------------------------------------------------------------------------
+
+struct MicrofacetCommand {
+    CommonOptions common;
+    std::string distribution, visible_text = "true";
+    float alpha = 0.1f, alpha_v = -1.f, theta = 30.f, phi = 0.f;
+};
+
+CLI::App *add_microfacet_command(CLI::App &app, MicrofacetCommand &c) {
+    CLI::App *micro = app.add_subcommand(
+        "microfacet",
+        "Test microfacet normal sampling: facet chi2 microfacet beckmann|ggx --alpha a");
+    micro->add_option("type", c.distribution, "beckmann or ggx")->required();
+    micro->add_option("--alpha", c.alpha,
+                      "Roughness (alpha_u when --alpha-v is given; default 0.1)");
+    micro->add_option("--alpha-v", c.alpha_v, "Roughness along v (default: --alpha)");
+    micro->add_option("--visible", c.visible_text,
+                      "Sample visible normals: true (default) or false");
+    micro->add_option("--theta", c.theta, "Incident polar angle in degrees (default 30)");
+    micro->add_option("--phi", c.phi, "Incident azimuth in degrees (default 0)");
+    add_common(*micro, c.common);
+    return micro;
+}
+
+int run_microfacet(const MicrofacetCommand &c, const std::string &everything) {
+    add_plugin_dirs(c.common.plugin_dirs);
+    MicrofacetAdapter adapter(c.distribution, c.alpha, c.alpha_v > 0.f ? c.alpha_v : c.alpha,
+                              parse_bool(c.visible_text, "--visible"),
+                              direction_from_angles(c.theta, c.phi));
+    return run(adapter, c.common, slug("microfacet", c.distribution, everything));
+}
+
 } // namespace
 
 int chi2_main(int argc, char **argv) {
@@ -185,191 +403,19 @@ int chi2_main(int argc, char **argv) {
                  "Prints the statistic, dof, p-value and verdict; exits with 1 on rejection.",
                  "facet chi2");
     app.require_subcommand(1);
-
-    // bsdf
-    CommonOptions bo;
-    std::string bsdf_name, xml, wi_text, mode = "radiance";
-    std::vector<std::string> bsdf_params;
-    float theta = 30.f, phi = 0.f;
-    int component = -1;
-    CLI::App *bsdf =
-        app.add_subcommand("bsdf", "Test a BSDF: facet chi2 bsdf <name> [key=value ...]");
-    bsdf->add_option("name", bsdf_name, "BSDF plugin name");
-    bsdf->add_option("params", bsdf_params,
-                     "Parameters key=value (type inferred: number -> float, true/false -> boolean, "
-                     "r,g,b -> rgb, else string) or type:key=value (e.g. integer:n=3)");
-    bsdf->add_option("--xml", xml, "The BSDF as XML text or an .xml file (instead of a name)");
-    bsdf->add_option("--wi", wi_text, "Incident direction x,y,z in the local frame (normalised)");
-    auto theta_opt =
-        bsdf->add_option("--theta", theta, "Incident polar angle in degrees (default 30)");
-    bsdf->add_option("--phi", phi, "Incident azimuth in degrees (default 0)");
-    bsdf->add_option("--component", component, "Test only this component (lobe) index");
-    bsdf->add_option("--mode", mode, "Transport mode: radiance (default) or importance");
-    add_common(*bsdf, bo);
-
-    // emitter
-    CommonOptions eo;
-    std::string emitter_name, emitter_xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
-    std::vector<std::string> emitter_params;
-    bool emission = false;
-    CLI::App *emitter = app.add_subcommand(
-        "emitter",
-        "Test an emitter's direction sampling: facet chi2 emitter <name> [key=value ...]");
-    emitter->add_option("name", emitter_name, "Emitter plugin name");
-    emitter->add_option("params", emitter_params, "Parameters, as for bsdf");
-    emitter->add_option("--xml", emitter_xml,
-                        "The emitter as XML text or an .xml file, an <emitter> or a whole <scene> "
-                        "(its first emitter is tested), instead of a name");
-    emitter->add_flag("--emission", emission,
-                      "Test the directions of emitted rays (sample_ray against "
-                      "pdf_ray_direction; emitters with one origin, e.g. spot) instead of "
-                      "direction sampling from --ref");
-    emitter->add_option("--ref", ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
-    emitter->add_option(
-        "--shape", shape,
-        "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
-    add_common(*emitter, eo);
-
-    // sensor
-    CommonOptions so;
-    std::string sensor_name, sensor_xml, sensor_ref, sensor_ref_local, aperture_text = "0.5,0.5",
-                                                                       film_text;
-    std::vector<std::string> sensor_params;
-    CLI::App *sensor = app.add_subcommand(
-        "sensor", "Test a sensor's importance (light tracing): facet chi2 sensor <name> "
-                  "[key=value ...]; its camera rays, or its aperture seen from --ref");
-    sensor->add_option("name", sensor_name, "Sensor plugin name");
-    sensor->add_option("params", sensor_params, "Parameters, as for bsdf");
-    sensor->add_option("--xml", sensor_xml,
-                       "The sensor as XML text or an .xml file, a <sensor> or a whole <scene> "
-                       "(its first sensor is tested), instead of a name");
-    sensor->add_option("--film", film_text,
-                       "Film size width,height in pixels for a sensor given by name (default: "
-                       "the plugin's default film)");
-    sensor->add_option("--aperture", aperture_text,
-                       "Aperture sample u,v in [0,1) of the camera rays (default 0.5,0.5: the "
-                       "lens centre)");
-    sensor->add_option("--ref", sensor_ref,
-                       "Test the aperture sampling of sample_direction() from this world point "
-                       "x,y,z against pdf_direction() (thin lens), instead of the camera rays");
-    sensor->add_option("--ref-local", sensor_ref_local,
-                       "As --ref, with the point in the camera's frame (before to_world)");
-    add_common(*sensor, so);
-
-    // microfacet
-    CommonOptions mo;
-    std::string distr_name, visible_text = "true";
-    float alpha = 0.1f, alpha_v = -1.f, m_theta = 30.f, m_phi = 0.f;
-    CLI::App *micro = app.add_subcommand(
-        "microfacet",
-        "Test microfacet normal sampling: facet chi2 microfacet beckmann|ggx --alpha a");
-    micro->add_option("type", distr_name, "beckmann or ggx")->required();
-    micro->add_option("--alpha", alpha, "Roughness (alpha_u when --alpha-v is given; default 0.1)");
-    micro->add_option("--alpha-v", alpha_v, "Roughness along v (default: --alpha)");
-    micro->add_option("--visible", visible_text, "Sample visible normals: true (default) or false");
-    micro->add_option("--theta", m_theta, "Incident polar angle in degrees (default 30)");
-    micro->add_option("--phi", m_phi, "Incident azimuth in degrees (default 0)");
-    add_common(*micro, mo);
-
+    BsdfCommand bsdf;
+    EmitterCommand emitter;
+    SensorCommand sensor;
+    MicrofacetCommand microfacet;
+    const CLI::App *bsdf_app = add_bsdf_command(app, bsdf);
+    const CLI::App *emitter_app = add_emitter_command(app, emitter);
+    const CLI::App *sensor_app = add_sensor_command(app, sensor);
+    add_microfacet_command(app, microfacet);
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
-    std::string everything = join_args(argc, argv);
 
-    if (bsdf->parsed()) {
-        add_plugin_dirs(bo.plugin_dirs);
-        if (!wi_text.empty() && theta_opt->count() > 0)
-            FACET_THROW("give the incident direction either with --wi or with --theta/--phi");
-        Vector3f wi;
-        if (!wi_text.empty()) {
-            auto v = parse_floats(wi_text, 3, "--wi");
-            wi = Vector3f(v[0], v[1], v[2]);
-        } else {
-            wi = direction_from_angles(theta, phi);
-        }
-        BSDFContext ctx;
-        if (mode == "importance")
-            ctx.mode = TransportMode::Importance;
-        else if (mode != "radiance")
-            FACET_THROW("--mode \"{}\": expected radiance or importance", mode);
-        if (component >= 0) ctx.component = uint32_t(component);
-
-        std::string text;
-        if (!xml.empty() || (!bsdf_name.empty() && bsdf_name[0] == '<')) {
-            if (!bsdf_params.empty()) FACET_THROW("key=value parameters cannot be added to --xml");
-            text = read_xml_argument(xml.empty() ? bsdf_name : xml);
-            if (bsdf_name.empty() || bsdf_name[0] == '<') bsdf_name = "xml";
-        } else {
-            if (bsdf_name.empty()) FACET_THROW("name the BSDF plugin to test (or give --xml)");
-            text = chi2_object_xml(ObjectType::BSDF, bsdf_name, bsdf_params);
-        }
-        BSDFAdapter adapter(text, wi, ctx);
-        return run(adapter, bo, slug("bsdf", bsdf_name, everything));
-    }
-    if (emitter->parsed()) {
-        add_plugin_dirs(eo.plugin_dirs);
-        auto r = parse_floats(ref_text, 3, "--ref");
-        std::string scene;
-        if (!emitter_xml.empty()) {
-            if (!emitter_name.empty() || !emitter_params.empty())
-                FACET_THROW("give the emitter either by name and key=value parameters or --xml");
-            scene = read_xml_argument(emitter_xml);
-            if (scene.find("<scene") == std::string::npos)
-                scene = "<scene version=\"3.0.0\">" + scene + "</scene>";
-            emitter_name = "xml";
-        } else {
-            if (emitter_name.empty())
-                FACET_THROW("name the emitter plugin to test (or give --xml)");
-            scene = EmitterAdapter::scene_xml(emitter_name, emitter_params, shape);
-        }
-        if (emission) {
-            EmissionAdapter adapter(scene);
-            return run(adapter, eo, slug("emission", emitter_name, everything));
-        }
-        EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]));
-        return run(adapter, eo, slug("emitter", emitter_name, everything));
-    }
-    if (sensor->parsed()) {
-        add_plugin_dirs(so.plugin_dirs);
-        std::string text;
-        if (!sensor_xml.empty()) {
-            if (!sensor_name.empty() || !sensor_params.empty() || !film_text.empty())
-                FACET_THROW("give the sensor either by name and key=value parameters (and "
-                            "--film) or --xml");
-            text = read_xml_argument(sensor_xml);
-            if (text.find("<scene") == std::string::npos &&
-                text.find("version=") == std::string::npos)
-                text = "<scene version=\"3.0.0\">" + text + "</scene>";
-            sensor_name = "xml";
-        } else {
-            if (sensor_name.empty()) FACET_THROW("name the sensor plugin to test (or give --xml)");
-            Point2i film(0, 0);
-            if (!film_text.empty()) {
-                auto f = parse_floats(film_text, 2, "--film");
-                if (!(f[0] >= 1.f && f[1] >= 1.f) || f[0] != std::floor(f[0]) ||
-                    f[1] != std::floor(f[1]))
-                    FACET_THROW("--film \"{}\": expected two positive whole numbers", film_text);
-                film = Point2i(int(f[0]), int(f[1]));
-            }
-            text = SensorAdapter::sensor_xml(sensor_name, sensor_params, film);
-        }
-        std::shared_ptr<Sensor> camera = SensorAdapter::load(text);
-        if (!sensor_ref.empty() && !sensor_ref_local.empty())
-            FACET_THROW("give the reference point either with --ref or with --ref-local");
-        if (!sensor_ref.empty() || !sensor_ref_local.empty()) {
-            auto r = parse_floats(sensor_ref.empty() ? sensor_ref_local : sensor_ref, 3,
-                                  sensor_ref.empty() ? "--ref-local" : "--ref");
-            Point3f ref(r[0], r[1], r[2]);
-            if (!sensor_ref_local.empty()) ref = camera->to_world().apply_point(ref);
-            SensorAdapter adapter(camera, ref);
-            return run(adapter, so, slug("sensor", sensor_name, everything));
-        }
-        auto a = parse_floats(aperture_text, 2, "--aperture");
-        SensorAdapter adapter(camera, Point2f(a[0], a[1]));
-        return run(adapter, so, slug("sensor", sensor_name, everything));
-    }
-    // microfacet
-    add_plugin_dirs(mo.plugin_dirs);
-    MicrofacetAdapter adapter(distr_name, alpha, alpha_v > 0.f ? alpha_v : alpha,
-                              parse_bool(visible_text, "--visible"),
-                              direction_from_angles(m_theta, m_phi));
-    return run(adapter, mo, slug("microfacet", distr_name, everything));
+    const std::string everything = join_args(argc, argv);
+    if (bsdf_app->parsed()) return run_bsdf(bsdf, everything);
+    if (emitter_app->parsed()) return run_emitter(emitter, everything);
+    if (sensor_app->parsed()) return run_sensor(sensor, everything);
+    return run_microfacet(microfacet, everything);
 }

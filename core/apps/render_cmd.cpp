@@ -206,63 +206,63 @@ std::string format_seconds(double s) {
     return fmt::format("{} h {} min {:.0f} s", minutes / 60, minutes % 60, s - minutes * 60.0);
 }
 
-} // namespace
-
-int render_main(int argc, char **argv) {
-    cli::SceneOptions opts;
+/// The options of `facet render` beyond the scene's.
+struct RenderCommand {
+    cli::SceneOptions scene;
+    std::vector<std::string> more_scenes;
     std::string output, ocio_config, display, view, looks;
     uint64_t seed = 0;
     int spp = 0;
     std::vector<int> crop;
     int pass_index = -1, pass_count = 0;
+    bool pass_given = false; ///< --pass was on the command line
+};
 
-    CLI::App app("Render a Mitsuba 3 scene", "facet render");
-    cli::add_scene_options(app, opts);
-    std::vector<std::string> more_scenes;
-    app.add_option("more_scenes", more_scenes,
+void add_render_options(CLI::App &app, RenderCommand &c) {
+    cli::add_scene_options(app, c.scene);
+    app.add_option("more_scenes", c.more_scenes,
                    "Further scene files, rendered one after the other with the same options");
-    app.add_option("-o,--output", output,
+    app.add_option("-o,--output", c.output,
                    "Output image (default: the scene's name with .exr); .png/.jpg are tone mapped "
                    "through OpenColorIO");
-    app.add_option("--seed", seed, "Added to the sampler's seed (default 0)");
-    app.add_option("--spp", spp,
+    app.add_option("--seed", c.seed, "Added to the sampler's seed (default 0)");
+    app.add_option("--spp", c.spp,
                    "Samples per pixel (default: the sampler's sample_count; samplers may round "
                    "it, e.g. stratified to a square: the summary and the EXR say what was taken)");
-    app.add_option("--crop", crop,
+    app.add_option("--crop", c.crop,
                    "Render only film pixels [X0, X1) x [Y0, Y1) (the EXR's data window inside "
                    "the full display window); pixels equal those of a full render")
         ->expected(4)
         ->type_name("X0 Y0 X1 Y1");
-    app.add_option("--pass", pass_index,
+    app.add_option("--pass", c.pass_index,
                    "Render part I (0-based) of the --passes N independent parts of one render "
                    "of N x spp samples per pixel (for merging later)")
         ->type_name("I");
-    app.add_option("--passes", pass_count,
+    app.add_option("--passes", c.pass_count,
                    "Number of parts for --pass (default 1); without --pass, every part one after "
                    "the other, combined as `facet merge` combines them")
         ->type_name("N");
-    app.add_option("--ocio-config", ocio_config,
+    app.add_option("--ocio-config", c.ocio_config,
                    "OpenColorIO config for 8-bit outputs (default: $OCIO, else facet's own)");
-    app.add_option("--display", display,
+    app.add_option("--display", c.display,
                    "OpenColorIO display for 8-bit outputs (default: the config's default; "
                    "`facet colors` lists them)");
-    app.add_option("--view", view,
+    app.add_option("--view", c.view,
                    "OpenColorIO view of that display (default: the display's default)");
-    app.add_option("--look", looks, "OpenColorIO looks to apply (\"a, +b, -c\")");
-    if (int code = cli::parse(app, argc, argv); code >= 0) return code;
-    if (app.count("--spp") > 0 && spp < 1)
-        FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", spp);
+    app.add_option("--look", c.looks, "OpenColorIO looks to apply (\"a, +b, -c\")");
+}
 
-    // Several scenes, one after the other (Mitsuba's `mitsuba a.xml b.xml`): each writes its own
-    // image, so -o can only be a folder; the first error or signal ends the sequence.
-    std::vector<std::string> scenes{opts.scene};
-    scenes.insert(scenes.end(), more_scenes.begin(), more_scenes.end());
-    if (scenes.size() > 1 && !output.empty() && output.back() != '/') {
+/// The scene files to render, checked before the first renders: several scenes (Mitsuba's
+/// `mitsuba a.xml b.xml`) each write their own image, so -o can only be a folder.
+std::vector<std::string> scenes_to_render(const RenderCommand &c) {
+    std::vector<std::string> scenes{c.scene.scene};
+    scenes.insert(scenes.end(), c.more_scenes.begin(), c.more_scenes.end());
+    if (scenes.size() > 1 && !c.output.empty() && c.output.back() != '/') {
         std::error_code ec;
-        if (!fs::is_directory(output, ec))
+        if (!fs::is_directory(c.output, ec))
             FACET_THROW("-o {}: {} scenes are rendered, each to its own image: -o must name a "
                         "folder (an existing one, or ending in '/'), or be left out",
-                        output, scenes.size());
+                        c.output, scenes.size());
     }
     // A mistyped name is refused before the first scene renders, not after it.
     for (size_t i = 1; i < scenes.size(); ++i) {
@@ -271,206 +271,254 @@ int render_main(int argc, char **argv) {
             FACET_THROW("scene file \"{}\" {} (nothing was rendered)", scenes[i],
                         exists_error ? exists_error.message() : std::string("does not exist"));
     }
+    return scenes;
+}
 
-    const auto render_one = [&]() -> int {
-        const auto load_start = std::chrono::steady_clock::now();
-        std::shared_ptr<Scene> scene = cli::load_scene(opts);
-        const double load_seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-        const auto &sensors = scene->sensors();
-        if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
-            FACET_THROW("-s {}: the scene has {} sensor{} (valid indices 0..{})", opts.sensor,
-                        sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
-        const Sensor &sensor = *sensors[size_t(opts.sensor)];
-        Film &film = sensor.film();
+/// The render options of the command line: threads, seed, spp, the crop window (checked against
+/// the film) and the part of a split render.
+RenderOptions render_options(const RenderCommand &c, const Film &film) {
+    RenderOptions ropts;
+    ropts.threads = c.scene.threads;
+    ropts.seed = c.seed;
+    ropts.spp = c.spp;
+    ropts.progress = !c.scene.quiet;
+    const std::vector<int> &crop = c.crop;
+    if (!crop.empty()) {
+        const Point2i size = film.size();
+        if (crop[0] < 0 || crop[1] < 0 || crop[2] > size.x || crop[3] > size.y ||
+            crop[2] <= crop[0] || crop[3] <= crop[1])
+            FACET_THROW("--crop {} {} {} {}: expected X0 Y0 X1 Y1 with 0 <= X0 < X1 <= {} and "
+                        "0 <= Y0 < Y1 <= {} (the film is {}x{}; X1 and Y1 are exclusive)",
+                        crop[0], crop[1], crop[2], crop[3], size.x, size.y, size.x, size.y);
+        ropts.crop = {{crop[0], crop[1], crop[2], crop[3]}};
+    }
+    if (c.pass_count != 0 || c.pass_index >= 0) {
+        // --passes N alone: all N parts in this process (pass index -1).
+        const int pass_index = c.pass_count >= 1 && !c.pass_given ? -1 : c.pass_index;
+        if (c.pass_count < 1 || pass_index < -1 || pass_index >= c.pass_count ||
+            (pass_index == -1 && c.pass_given))
+            FACET_THROW("--pass I --passes N: expected N >= 1 and 0 <= I < N (or --passes N "
+                        "alone for all the parts), got --pass {} --passes {}",
+                        pass_index < 0 ? std::string("(none)") : std::to_string(pass_index),
+                        c.pass_count == 0 ? std::string("(none)") : std::to_string(c.pass_count));
+        ropts.pass_index = pass_index;
+        ropts.pass_count = c.pass_count;
+    }
+    return ropts;
+}
 
-        std::string out = output_path(opts.scene, output, film);
-        ImageWriteOptions wopts;
-        wopts.ocio_config = ocio_config;
-        wopts.display = display;
-        wopts.view = view;
-        wopts.looks = looks;
-        const bool part = pass_count > 1 && app.count("--pass") > 0; // raw sums follow
-        check_output(out, wopts, *scene, sensor, opts.scene, part);
+/// render_sample_range(), its error naming the options the sample count came from.
+SampleRange sample_range(const RenderCommand &c, const Sensor &sensor, const RenderOptions &ropts) {
+    try {
+        return render_sample_range(sensor, ropts);
+    } catch (const Error &e) {
+        if (e.location().valid()) throw; // a sampler's error, at its place in the scene
+        const std::string count = c.spp > 0 ? fmt::format("--spp {}", c.spp)
+                                            : fmt::format("the sampler's sample_count {}",
+                                                          sensor.sampler().sample_count());
+        const std::string parts =
+            c.pass_count > 0 ? fmt::format(", --passes {}", c.pass_count) : "";
+        FACET_THROW("{}{}: {}", count, parts, e.message());
+    }
+}
 
-        RenderOptions ropts;
-        ropts.threads = opts.threads;
-        ropts.seed = seed;
-        ropts.spp = spp;
-        ropts.progress = !opts.quiet;
-        if (!crop.empty()) {
-            const Point2i size = film.size();
-            if (crop[0] < 0 || crop[1] < 0 || crop[2] > size.x || crop[3] > size.y ||
-                crop[2] <= crop[0] || crop[3] <= crop[1])
-                FACET_THROW("--crop {} {} {} {}: expected X0 Y0 X1 Y1 with 0 <= X0 < X1 <= {} and "
-                            "0 <= Y0 < Y1 <= {} (the film is {}x{}; X1 and Y1 are exclusive)",
-                            crop[0], crop[1], crop[2], crop[3], size.x, size.y, size.x, size.y);
-            ropts.crop = {{crop[0], crop[1], crop[2], crop[3]}};
-        }
-        if (pass_count != 0 || pass_index >= 0) {
-            // --passes N alone: all N parts in this process (pass index -1).
-            if (pass_count >= 1 && app.count("--pass") == 0) pass_index = -1;
-            if (pass_count < 1 || pass_index < -1 || pass_index >= pass_count ||
-                (pass_index == -1 && app.count("--pass") > 0))
-                FACET_THROW("--pass I --passes N: expected N >= 1 and 0 <= I < N (or --passes N "
-                            "alone for all the parts), got --pass {} --passes {}",
-                            pass_index < 0 ? std::string("(none)") : std::to_string(pass_index),
-                            pass_count == 0 ? std::string("(none)") : std::to_string(pass_count));
-            ropts.pass_index = pass_index;
-            ropts.pass_count = pass_count;
-        }
-        std::atomic<bool> cancel{false};
-        ropts.cancel = &cancel;
-        SampleRange range;
-        try {
-            range = render_sample_range(sensor, ropts);
-        } catch (const Error &e) {
-            if (e.location().valid()) throw; // a sampler's error, at its place in the scene
-            // Else the sample count and the parts come from these options: name them.
-            const std::string count = spp > 0 ? fmt::format("--spp {}", spp)
-                                              : fmt::format("the sampler's sample_count {}",
-                                                            sensor.sampler().sample_count());
-            const std::string parts =
-                pass_count > 0 ? fmt::format(", --passes {}", pass_count) : "";
-            FACET_THROW("{}{}: {}", count, parts, e.message());
-        }
-        const uint64_t asked = uint64_t(spp > 0 ? uint32_t(spp) : sensor.sampler().sample_count()) *
-                               uint64_t(ropts.pass_count);
-        // The sampler's rounding, said where the spp is printed.
-        const std::string rounding =
-            range.total != asked
-                ? fmt::format(" (the sampler rounds {} up to {})", asked, range.total)
-                : "";
-        int threads = cli::effective_threads(opts.threads);
+/// What ties the parts of one render together (checked by a merge): scene_identity() of the
+/// scene file, the -D values and the film size.
+std::string scene_hash(const cli::SceneOptions &opts, const Film &film) {
+    std::map<std::string, std::string> params;
+    for (const std::string &define : opts.defines) {
+        size_t eq = define.find('=');
+        params[define.substr(0, eq)] = define.substr(eq + 1);
+    }
+    std::ifstream scene_file(opts.scene, std::ios::binary);
+    std::string scene_text((std::istreambuf_iterator<char>(scene_file)),
+                           std::istreambuf_iterator<char>());
+    return scene_identity(scene_text, params, film.size().x, film.size().y);
+}
 
-        // What ties the parts of one render together (checked by a merge).
-        std::map<std::string, std::string> params;
-        for (const std::string &define : opts.defines) {
-            size_t eq = define.find('=');
-            params[define.substr(0, eq)] = define.substr(eq + 1);
-        }
-        std::ifstream scene_file(opts.scene, std::ios::binary);
-        std::string scene_text((std::istreambuf_iterator<char>(scene_file)),
-                               std::istreambuf_iterator<char>());
-        const std::string scene_hash =
-            scene_identity(scene_text, params, film.size().x, film.size().y);
+/// "Rendering scene.xml: 64x64 pixels, 16 spp, 8 threads" (and the crop and part rendered).
+void print_start(const RenderCommand &c, const Sensor &sensor, const SampleRange &range,
+                 const RenderOptions &ropts) {
+    const Film &film = sensor.film();
+    const std::vector<int> &crop = c.crop;
+    const uint64_t asked = uint64_t(c.spp > 0 ? uint32_t(c.spp) : sensor.sampler().sample_count()) *
+                           uint64_t(ropts.pass_count);
+    // The sampler's rounding, said where the spp is printed.
+    const std::string rounding =
+        range.total != asked ? fmt::format(" (the sampler rounds {} up to {})", asked, range.total)
+                             : "";
+    const int threads = cli::effective_threads(c.scene.threads);
+    const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
+    const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
+    fmt::print("Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", c.scene.scene, w, h,
+               crop.empty() ? ""
+                            : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1], crop[2],
+                                          crop[3], film.size().x, film.size().y),
+               range.count, rounding,
+               ropts.pass_count > 1 && ropts.pass_index < 0
+                   ? fmt::format(" (in {} parts, combined as a merge of them)", ropts.pass_count)
+               : ropts.pass_count > 1 ? fmt::format(" (part {} of {}: samples {}..{} of {})",
+                                                    ropts.pass_index, ropts.pass_count, range.first,
+                                                    range.first + range.count - 1, range.total)
+                                      : "",
+               threads, threads == 1 ? "" : "s");
+    std::fflush(stdout);
+}
 
-        // From here on Ctrl-C, SIGTERM and SIGHUP stop the render and the partial image is written;
-        // from the end of the render to the rename of the output, no signal is fatal (the write
-        // finishes, or removes its temporary file), and facet exits 128 + the signal after it.
-        install_interrupt_handler(&cancel);
-        struct HandlerGuard {
-            ~HandlerGuard() { uninstall_interrupt_handler(); }
-        } handler_guard;
-        if (!opts.quiet) {
-            const int w = crop.empty() ? film.crop_size().x : crop[2] - crop[0];
-            const int h = crop.empty() ? film.crop_size().y : crop[3] - crop[1];
-            fmt::print(
-                "Rendering {}: {}x{} pixels{}, {} spp{}{}, {} thread{}\n", opts.scene, w, h,
-                crop.empty() ? ""
-                             : fmt::format(" (crop {} {} {} {} of {}x{})", crop[0], crop[1],
-                                           crop[2], crop[3], film.size().x, film.size().y),
-                range.count, rounding,
-                ropts.pass_count > 1 && ropts.pass_index < 0
-                    ? fmt::format(" (in {} parts, combined as a merge of them)", ropts.pass_count)
-                : ropts.pass_count > 1
-                    ? fmt::format(" (part {} of {}: samples {}..{} of {})", ropts.pass_index,
-                                  ropts.pass_count, range.first, range.first + range.count - 1,
-                                  range.total)
-                    : "",
-                threads, threads == 1 ? "" : "s");
-            std::fflush(stdout);
-        }
-        cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
-                                      film.crop_size().x, film.crop_size().y, range.count));
-        RenderResult result;
-        // The module that writes the output loads while the render runs, from its first pixels on.
-        ropts.on_first_block = [out] { preload_image_writer(out); };
-        result = render(*scene, sensor, ropts);
-        defer_interrupts();
-        const bool signal_in_render = interrupt_signal() != 0;
-        result.load_seconds = load_seconds;
+/// The summary of where the time went (-v: every phase).
+void print_times(const RenderResult &result, double write_seconds, bool verbose) {
+    fmt::print("Times: load {} (acceleration structure {}), render {}\n",
+               format_seconds(result.load_seconds), format_seconds(result.accel_seconds),
+               format_seconds(result.seconds));
+    if (verbose) {
+        fmt::print("  scene file and plugins  {}\n",
+                   format_seconds(std::max(0.0, result.load_seconds - result.accel_seconds)));
+        fmt::print("  acceleration structure  {}\n", format_seconds(result.accel_seconds));
+        const double rate =
+            result.sampling_seconds > 0.0 ? double(result.samples) / result.sampling_seconds : 0.0;
+        fmt::print("  sampling                {} ({} of {} work units, {:.3g} samples/s)\n",
+                   format_seconds(result.sampling_seconds), result.blocks_done, result.blocks_total,
+                   rate);
+        if (result.first_block_cpu_seconds > 0.0)
+            fmt::print("  first pixels            {:.3f} s CPU from the start of the process "
+                       "(every thread)\n",
+                       result.first_block_cpu_seconds);
+        fmt::print("  developing the film     {}\n", format_seconds(result.develop_seconds));
+        fmt::print("  writing the image       {}\n", format_seconds(write_seconds));
+    }
+    std::fflush(stdout);
+}
 
-        add_metadata(wopts, render_file_metadata(render_file_info(
-                                result, sensor, scene_hash,
-                                fs::absolute(opts.scene).lexically_normal().string(), seed)));
-        cli::set_activity(fmt::format("writing \"{}\"", out));
-        const auto write_start = std::chrono::steady_clock::now();
-        std::string write_error;
-        try {
-            film.write(result.image, out, wopts);
-        } catch (const std::exception &e) {
-            if (interrupt_signal() == 0) throw;
-            write_error = e.what(); // said with the signal, below
-        }
-        const double write_seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
-        if (!opts.quiet) {
-            // The summary of where the time went (-v: every phase).
-            fmt::print("Times: load {} (acceleration structure {}), render {}\n",
-                       format_seconds(result.load_seconds), format_seconds(result.accel_seconds),
-                       format_seconds(result.seconds));
-            if (opts.verbose > 0) {
-                fmt::print(
-                    "  scene file and plugins  {}\n",
-                    format_seconds(std::max(0.0, result.load_seconds - result.accel_seconds)));
-                fmt::print("  acceleration structure  {}\n", format_seconds(result.accel_seconds));
-                const double rate = result.sampling_seconds > 0.0
-                                        ? double(result.samples) / result.sampling_seconds
-                                        : 0.0;
-                fmt::print("  sampling                {} ({} of {} work units, {:.3g} samples/s)\n",
-                           format_seconds(result.sampling_seconds), result.blocks_done,
-                           result.blocks_total, rate);
-                if (result.first_block_cpu_seconds > 0.0)
-                    fmt::print(
-                        "  first pixels            {:.3f} s CPU from the start of the process "
-                        "(every thread)\n",
-                        result.first_block_cpu_seconds);
-                fmt::print("  developing the film     {}\n",
-                           format_seconds(result.develop_seconds));
-                fmt::print("  writing the image       {}\n", format_seconds(write_seconds));
-            }
-            std::fflush(stdout);
-        }
-
-        const std::string reached =
-            fmt::format("{} of {} spp{}", result.spp, result.spp_target,
-                        result.spp == 0 ? ", no pass finished: the image is black" : "");
-        if (const int sig = interrupt_signal(); sig != 0) {
-            // One line: the signal, when it came, and what is in the output file.
-            const std::string what = result.cancelled && !result.timed_out
-                                         ? fmt::format("the partial image ({})", reached)
-                                     : result.timed_out
-                                         ? fmt::format("the image of the timeout ({})", reached)
-                                         : fmt::format("the complete image ({})", reached);
-            const std::string when =
-                signal_in_render ? "after " + format_seconds(result.seconds) : "while writing";
-            const char *verb = sig == SIGTERM  ? "terminated"
-                               : sig == SIGHUP ? "hung up"
-                                               : "interrupted";
-            if (write_error.empty())
-                std::fprintf(stderr, "facet: %s (%s) %s: wrote %s to %s\n", verb,
-                             interrupt_signal_name(sig), when.c_str(), what.c_str(), out.c_str());
-            else
-                std::fprintf(stderr, "facet: %s (%s) %s: %s was not written: %s\n", verb,
-                             interrupt_signal_name(sig), when.c_str(), what.c_str(),
-                             write_error.c_str());
-            return 128 + sig;
-        }
-        if (result.timed_out) {
-            // The integrator's `timeout` is a request, not an interruption: success.
-            if (!opts.quiet)
-                fmt::print("Timeout reached after {} ({}), wrote {}\n",
-                           format_seconds(result.seconds), reached, out);
-            return 0;
-        }
-        if (!opts.quiet)
-            fmt::print("Rendered in {}, wrote {}\n", format_seconds(result.seconds), out);
+/// The last word of a render: after a signal one line on stderr (the signal, when it came, what
+/// is in the output file) and 128 + the signal; else a line on stdout (unless quiet) and 0.
+int report_end(const RenderResult &result, const std::string &out, bool signal_in_render,
+               const std::string &write_error, bool quiet) {
+    const std::string reached =
+        fmt::format("{} of {} spp{}", result.spp, result.spp_target,
+                    result.spp == 0 ? ", no pass finished: the image is black" : "");
+    if (const int sig = interrupt_signal(); sig != 0) {
+        const std::string what =
+            result.cancelled && !result.timed_out ? fmt::format("the partial image ({})", reached)
+            : result.timed_out ? fmt::format("the image of the timeout ({})", reached)
+                               : fmt::format("the complete image ({})", reached);
+        const std::string when =
+            signal_in_render ? "after " + format_seconds(result.seconds) : "while writing";
+        const char *verb = sig == SIGTERM  ? "terminated"
+                           : sig == SIGHUP ? "hung up"
+                                           : "interrupted";
+        if (write_error.empty())
+            std::fprintf(stderr, "facet: %s (%s) %s: wrote %s to %s\n", verb,
+                         interrupt_signal_name(sig), when.c_str(), what.c_str(), out.c_str());
+        else
+            std::fprintf(stderr, "facet: %s (%s) %s: %s was not written: %s\n", verb,
+                         interrupt_signal_name(sig), when.c_str(), what.c_str(),
+                         write_error.c_str());
+        return 128 + sig;
+    }
+    if (result.timed_out) {
+        // The integrator's `timeout` is a request, not an interruption: success.
+        if (!quiet)
+            fmt::print("Timeout reached after {} ({}), wrote {}\n", format_seconds(result.seconds),
+                       reached, out);
         return 0;
-    };
-    for (const std::string &scene_path : scenes) {
-        opts.scene = scene_path;
-        if (const int code = render_one(); code != 0) return code;
+    }
+    if (!quiet) fmt::print("Rendered in {}, wrote {}\n", format_seconds(result.seconds), out);
+    return 0;
+}
+
+/// How the write of the output went: its time, and the error of a write that a signal
+/// interrupted (said with the signal; any other error is thrown).
+struct Written {
+    double seconds = 0.0;
+    std::string error;
+};
+
+/// Writes the render's image to `out` with the file attributes of the render.
+Written write_image(const RenderCommand &c, const Sensor &sensor, const RenderResult &result,
+                    const std::string &hash, const std::string &out, ImageWriteOptions wopts) {
+    add_metadata(wopts, render_file_metadata(render_file_info(
+                            result, sensor, hash,
+                            fs::absolute(c.scene.scene).lexically_normal().string(), c.seed)));
+    cli::set_activity(fmt::format("writing \"{}\"", out));
+    const auto write_start = std::chrono::steady_clock::now();
+    Written written;
+    try {
+        sensor.film().write(result.image, out, wopts);
+    } catch (const std::exception &e) {
+        if (interrupt_signal() == 0) throw;
+        written.error = e.what(); // said with the signal, by report_end()
+    }
+    written.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+    return written;
+}
+
+/// Loads the scene `c.scene.scene`, renders it and writes its image; returns the exit code.
+int render_scene(RenderCommand &c) {
+    cli::SceneOptions &opts = c.scene;
+    const auto load_start = std::chrono::steady_clock::now();
+    std::shared_ptr<Scene> scene = cli::load_scene(opts);
+    const double load_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+    const auto &sensors = scene->sensors();
+    if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
+        FACET_THROW("-s {}: the scene has {} sensor{} (valid indices 0..{})", opts.sensor,
+                    sensors.size(), sensors.size() == 1 ? "" : "s", int(sensors.size()) - 1);
+    const Sensor &sensor = *sensors[size_t(opts.sensor)];
+    const Film &film = sensor.film();
+
+    std::string out = output_path(opts.scene, c.output, film);
+    ImageWriteOptions wopts;
+    wopts.ocio_config = c.ocio_config;
+    wopts.display = c.display;
+    wopts.view = c.view;
+    wopts.looks = c.looks;
+    const bool part = c.pass_count > 1 && c.pass_given; // raw sums follow
+    check_output(out, wopts, *scene, sensor, opts.scene, part);
+
+    RenderOptions ropts = render_options(c, film);
+    std::atomic<bool> cancel{false};
+    ropts.cancel = &cancel;
+    const SampleRange range = sample_range(c, sensor, ropts);
+    const std::string hash = scene_hash(opts, film);
+
+    // From here on Ctrl-C, SIGTERM and SIGHUP stop the render and the partial image is written;
+    // from the end of the render to the rename of the output, no signal is fatal (the write
+    // finishes, or removes its temporary file), and facet exits 128 + the signal after it.
+    install_interrupt_handler(&cancel);
+    struct HandlerGuard {
+        ~HandlerGuard() { uninstall_interrupt_handler(); }
+    } handler_guard;
+    if (!opts.quiet) print_start(c, sensor, range, ropts);
+    cli::set_activity(fmt::format("rendering \"{}\" ({}x{} pixels, {} spp)", opts.scene,
+                                  film.crop_size().x, film.crop_size().y, range.count));
+    // The module that writes the output loads while the render runs, from its first pixels on.
+    ropts.on_first_block = [out] { preload_image_writer(out); };
+    RenderResult result = render(*scene, sensor, ropts);
+    defer_interrupts();
+    const bool signal_in_render = interrupt_signal() != 0;
+    result.load_seconds = load_seconds;
+
+    const Written written = write_image(c, sensor, result, hash, out, wopts);
+    if (!opts.quiet) print_times(result, written.seconds, opts.verbose > 0);
+    return report_end(result, out, signal_in_render, written.error, opts.quiet);
+}
+
+} // namespace
+
+int render_main(int argc, char **argv) {
+    RenderCommand c;
+    CLI::App app("Render a Mitsuba 3 scene", "facet render");
+    add_render_options(app, c);
+    if (int code = cli::parse(app, argc, argv); code >= 0) return code;
+    c.pass_given = app.count("--pass") > 0;
+    if (app.count("--spp") > 0 && c.spp < 1)
+        FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", c.spp);
+
+    // Several scenes render one after the other; the first error or signal ends the sequence.
+    for (const std::string &scene_path : scenes_to_render(c)) {
+        c.scene.scene = scene_path;
+        if (const int code = render_scene(c); code != 0) return code;
     }
     return 0;
 }
