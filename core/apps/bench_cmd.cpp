@@ -38,6 +38,7 @@
 #include <ctime>
 #include <dirent.h>
 #include <unistd.h>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -153,78 +154,59 @@ double thread_cpu_seconds() {
 
 std::string mega(double v) { return fmt::format("{:.3f} M", v * 1e-6); }
 
-} // namespace
-
-int bench_main(int argc, char **argv) {
-    cli::SceneOptions opts;
+/// The options of `facet bench` beyond the scene's.
+struct BenchCommand {
+    cli::SceneOptions scene;
     int spp = 16;
     uint64_t seed = 0;
     std::string reference;
     int rounds = 6;
     double target_rmse = 0.0;
-    CLI::App app("Measure samples and rays per CPU second of the scene's integrator and the share "
-                 "of its CPU time that is Embree's own work; with --reference, the error against "
-                 "a reference image as a function of CPU time",
-                 "facet bench");
-    cli::add_scene_options(app, opts);
-    app.add_option("--spp", spp,
+};
+
+void add_bench_options(CLI::App &app, BenchCommand &c) {
+    cli::add_scene_options(app, c.scene);
+    app.add_option("--spp", c.spp,
                    "Samples per pixel (default 16); with --reference, of the first round")
         ->check(CLI::PositiveNumber);
-    app.add_option("--seed", seed, "Added to the sampler's seed (default 0)");
-    app.add_option("--reference", reference,
+    app.add_option("--seed", c.seed, "Added to the sampler's seed (default 0)");
+    app.add_option("--reference", c.reference,
                    "Equal-error mode: RMSE against this image (e.g. a high-spp EXR of the same "
                    "scene) for renders at doubling sample counts");
-    app.add_option("--rounds", rounds, "Equal-error mode: number of renders (default 6)")
+    app.add_option("--rounds", c.rounds, "Equal-error mode: number of renders (default 6)")
         ->check(CLI::Range(1, 20));
-    app.add_option("--target-rmse", target_rmse,
+    app.add_option("--target-rmse", c.target_rmse,
                    "Equal-error mode: also report the CPU time to reach this RMSE (interpolated "
                    "on the log-log curve, or extrapolated with RMSE ~ 1/sqrt(time))")
         ->check(CLI::PositiveNumber);
-    if (int code = cli::parse(app, argc, argv); code >= 0) return code;
+}
 
-    std::shared_ptr<Scene> scene = cli::load_scene(opts);
-    const auto &sensors = scene->sensors();
-    if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
-        FACET_THROW("-s {}: the scene has {} sensor(s)", opts.sensor, sensors.size());
-    const Sensor &sensor = *sensors[size_t(opts.sensor)];
-    int threads = cli::effective_threads(opts.threads);
+/// The --reference image, checked against the size of the sensor's film.
+Image read_reference(const std::string &reference, const Sensor &sensor) {
+    Image ref_image = read_image(reference);
+    Point2i size = sensor.film().crop_size();
+    if (ref_image.width != size.x || ref_image.height != size.y || ref_image.channels < 3)
+        FACET_THROW("--reference {}: {}x{} pixels with {} channels, expected {}x{} with at "
+                    "least 3 (R, G, B)",
+                    reference, ref_image.width, ref_image.height, ref_image.channels, size.x,
+                    size.y);
+    return ref_image;
+}
 
-    Image ref_image;
-    if (!reference.empty()) {
-        ref_image = read_image(reference);
-        Point2i size = sensor.film().crop_size();
-        if (ref_image.width != size.x || ref_image.height != size.y || ref_image.channels < 3)
-            FACET_THROW("--reference {}: {}x{} pixels with {} channels, expected {}x{} with at "
-                        "least 3 (R, G, B)",
-                        reference, ref_image.width, ref_image.height, ref_image.channels, size.x,
-                        size.y);
-    }
-
-    RenderOptions ropts;
-    ropts.threads = opts.threads;
-    ropts.spp = spp;
-    ropts.seed = seed;
-    ropts.progress = false;
-    std::atomic<bool> cancel{false};
-    ropts.cancel = &cancel;
-
-    fmt::print("bench {}: {}x{} pixels, {} spp, {} thread{}\n", opts.scene,
-               sensor.film().crop_size().x, sensor.film().crop_size().y, spp, threads,
-               threads == 1 ? "" : "s");
-    std::fflush(stdout);
-
-    InstructionCounter counter;
-    install_interrupt_handler(&cancel);
-    Measured m = measure_render(*scene, sensor, ropts, &counter);
-    if (m.result.cancelled) {
+/// Throws "interrupted" when a signal stopped the render (giving the signals back first).
+void throw_if_interrupted(const RenderResult &result) {
+    if (result.cancelled) {
         uninstall_interrupt_handler();
         FACET_THROW("interrupted");
     }
+}
 
+/// What the render cost: samples, rays and instructions per CPU second.
+void print_render_cost(const Measured &m, int threads, const InstructionCounter &counter) {
     const RenderResult &result = m.result;
     const uint64_t rays = m.rays.total();
     const double samples = std::max<double>(1.0, double(result.samples));
-    double cpu = std::max(m.cpu_seconds, 1e-9);
+    const double cpu = std::max(m.cpu_seconds, 1e-9);
     fmt::print("render      : {}samples in {:.3f} CPU-s ({:.3f} CPU-s per thread; wall {:.3f} s) "
                "= {}samples per CPU-s, {:.1f} CPU-ns per sample\n",
                mega(double(result.samples)), m.cpu_seconds, m.cpu_seconds / threads, result.seconds,
@@ -240,94 +222,118 @@ int bench_main(int argc, char **argv) {
                    double(m.instructions) / std::max<double>(1.0, double(rays)));
     else
         fmt::print("instructions: not counted ({})\n", counter.error());
+}
 
-    if (!reference.empty()) {
-        // Equal error: renders at spp, 2 spp, 4 spp, ... each with its own CPU time and error.
-        fmt::print("equal error : RMSE against {} (R, G, B)\n", reference);
-        fmt::print("              {:>8} {:>12} {:>12} {:>14}\n", "spp", "CPU-s", "RMSE",
-                   "1/(RMSE² s)");
-        std::vector<std::pair<double, double>> curve; // (CPU-s, RMSE)
-        for (int k = 0; k < rounds; ++k) {
-            RenderOptions r = ropts;
-            r.spp = spp << k;
-            Measured round = k == 0 ? std::move(m) : measure_render(*scene, sensor, r, nullptr);
-            if (round.result.cancelled) {
-                uninstall_interrupt_handler();
-                FACET_THROW("interrupted");
-            }
-            double e = rmse(round.result.image, ref_image);
-            double t = std::max(round.cpu_seconds, 1e-9);
-            curve.emplace_back(t, e);
-            fmt::print("              {:>8} {:>12.3f} {:>12.6g} {:>14.6g}\n", r.spp, t, e,
-                       1.0 / (e * e * t));
-            std::fflush(stdout);
-        }
-        if (target_rmse > 0.0) {
-            // log(RMSE) against log(time): between the two rounds that bracket the target, else
-            // from the nearest round with the Monte Carlo rate RMSE ~ time^(-1/2).
-            double time = 0.0;
-            for (size_t k = 1; k < curve.size() && time == 0.0; ++k) {
-                auto [t0, e0] = curve[k - 1];
-                auto [t1, e1] = curve[k];
-                if ((e0 - target_rmse) * (e1 - target_rmse) <= 0.0 && e0 != e1) {
-                    double a =
-                        (std::log(target_rmse) - std::log(e0)) / (std::log(e1) - std::log(e0));
-                    time = std::exp(std::log(t0) + a * (std::log(t1) - std::log(t0)));
-                }
-            }
-            bool extrapolated = time == 0.0;
-            if (extrapolated) {
-                auto [t, e] = target_rmse < curve.back().second ? curve.back() : curve.front();
-                time = t * (e / target_rmse) * (e / target_rmse);
-            }
-            fmt::print("              RMSE {:.6g} reached after {:.3f} CPU-s ({})\n", target_rmse,
-                       time,
-                       extrapolated ? "extrapolated with RMSE ~ 1/sqrt(time)" : "interpolated");
+/// The CPU time at which the RMSE curve (CPU-s, RMSE) reaches `target`: log(RMSE) against
+/// log(time) between the two rounds that bracket the target, else from the nearest round with the
+/// Monte Carlo rate RMSE ~ time^(-1/2).
+void print_time_to_rmse(const std::vector<std::pair<double, double>> &curve, double target) {
+    double time = 0.0;
+    for (size_t k = 1; k < curve.size() && time == 0.0; ++k) {
+        auto [t0, e0] = curve[k - 1];
+        auto [t1, e1] = curve[k];
+        if ((e0 - target) * (e1 - target) <= 0.0 && e0 != e1) {
+            double a = (std::log(target) - std::log(e0)) / (std::log(e1) - std::log(e0));
+            time = std::exp(std::log(t0) + a * (std::log(t1) - std::log(t0)));
         }
     }
+    bool extrapolated = time == 0.0;
+    if (extrapolated) {
+        auto [t, e] = target < curve.back().second ? curve.back() : curve.front();
+        time = t * (e / target) * (e / target);
+    }
+    fmt::print("              RMSE {:.6g} reached after {:.3f} CPU-s ({})\n", target, time,
+               extrapolated ? "extrapolated with RMSE ~ 1/sqrt(time)" : "interpolated");
+}
+
+/// Equal error: renders at spp, 2 spp, 4 spp, ... each with its own CPU time and error against
+/// the reference; the first round is the render already measured, `first`.
+void print_equal_error(const BenchCommand &c, const Scene &scene, const Sensor &sensor,
+                       const RenderOptions &ropts, const Measured &first, const Image &ref_image) {
+    fmt::print("equal error : RMSE against {} (R, G, B)\n", c.reference);
+    fmt::print("              {:>8} {:>12} {:>12} {:>14}\n", "spp", "CPU-s", "RMSE", "1/(RMSE² s)");
+    std::vector<std::pair<double, double>> curve; // (CPU-s, RMSE)
+    Measured later;
+    for (int k = 0; k < c.rounds; ++k) {
+        RenderOptions r = ropts;
+        r.spp = c.spp << k;
+        const Measured &round =
+            k == 0 ? first : (later = measure_render(scene, sensor, r, nullptr));
+        throw_if_interrupted(round.result);
+        double e = rmse(round.result.image, ref_image);
+        double t = std::max(round.cpu_seconds, 1e-9);
+        curve.emplace_back(t, e);
+        fmt::print("              {:>8} {:>12.3f} {:>12.6g} {:>14.6g}\n", r.spp, t, e,
+                   1.0 / (e * e * t));
+        std::fflush(stdout);
+    }
+    if (c.target_rmse > 0.0) print_time_to_rmse(curve, c.target_rmse);
+}
+
+/// The recorded queries sent again to Embree: the first pass, and the timed passes after it.
+struct Replayed {
+    RayRecording::Replay first, timed; ///< timed.differing counts the first pass's too
+    uint64_t passes = 0;               ///< timed passes
+    double cpu_seconds = 0.0;          ///< of the timed passes
+};
+
+/// Sends the recorded queries again to Embree on the calling thread. A first pass counts the
+/// rays (and warms the caches, as the render had them); the timed passes send as many rays as
+/// the render traced, `rays` (at most 64 passes), for a CPU time long enough to measure.
+Replayed replay_timed(const RayRecording &recording, const Scene &scene, uint64_t rays) {
+    Replayed r;
+    r.first = recording.replay(scene);
+    r.passes = r.first.rays == 0
+                   ? 0
+                   : std::clamp<uint64_t>((rays + r.first.rays - 1) / r.first.rays, 1, 64);
+    const double replay_before = thread_cpu_seconds();
+    for (uint64_t i = 0; i < r.passes; ++i) {
+        const RayRecording::Replay pass = recording.replay(scene);
+        r.timed.rays += pass.rays;
+        r.timed.differing += pass.differing;
+    }
+    r.cpu_seconds = thread_cpu_seconds() - replay_before;
+    r.timed.differing += r.first.differing;
+    return r;
+}
+
+/// Embree alone: the queries of a render at fewer samples, at most RecordBudget of them (36
+/// bytes each), sent to Embree again; their CPU time per ray, times the rays of the measured
+/// render `m`, is Embree's share of it. Gives the signals back (uninstall_interrupt_handler).
+void print_embree_share(const Scene &scene, const Sensor &sensor, const RenderOptions &ropts,
+                        const Measured &m) {
+    const uint64_t rays = m.rays.total();
     if (rays == 0) {
         uninstall_interrupt_handler();
         fmt::print("embree alone: skipped (the render sent no ray to Embree)\n");
-        return 0;
+        return;
     }
-    // Embree alone: the queries of a render at fewer samples, at most RecordBudget of them (36
-    // bytes each), sent to Embree again.
     constexpr size_t RecordBudget = size_t(1) << 20;
     RenderOptions record = ropts;
-    record.spp =
-        int(std::clamp(double(spp) * double(RecordBudget) / double(rays), 1.0, double(spp)));
+    record.spp = int(std::clamp(double(ropts.spp) * double(RecordBudget) / double(rays), 1.0,
+                                double(ropts.spp)));
     RayRecording recording(RecordBudget);
-    RenderResult recorded = render(*scene, sensor, record);
+    RenderResult recorded = render(scene, sensor, record);
     recording.stop();
     uninstall_interrupt_handler();
     if (recorded.cancelled) FACET_THROW("interrupted");
-    // A first pass counts the rays (and warms the caches, as the render had them); the timed
-    // passes send as many rays as the render traced (at most 64 passes), for a CPU time long
-    // enough to measure.
-    const RayRecording::Replay first = recording.replay(*scene);
-    const uint64_t passes =
-        first.rays == 0 ? 0 : std::clamp<uint64_t>((rays + first.rays - 1) / first.rays, 1, 64);
-    RayRecording::Replay replay;
-    const double replay_before = thread_cpu_seconds();
-    for (uint64_t i = 0; i < passes; ++i) {
-        const RayRecording::Replay pass = recording.replay(*scene);
-        replay.rays += pass.rays;
-        replay.differing += pass.differing;
-    }
-    const double replay_cpu = thread_cpu_seconds() - replay_before;
-    replay.differing += first.differing;
+    const Replayed replayed = replay_timed(recording, scene, rays);
+    const RayRecording::Replay &replay = replayed.timed;
     if (replay.rays == 0) {
         fmt::print("embree alone: skipped (no ray recorded)\n");
-        return 0;
+        return;
     }
-    const double per_ray = replay_cpu / double(replay.rays);
+    const double samples = std::max<double>(1.0, double(m.result.samples));
+    const double cpu = std::max(m.cpu_seconds, 1e-9);
+    const double per_ray = replayed.cpu_seconds / double(replay.rays);
     const double embree_cpu = per_ray * double(rays);
     fmt::print("embree alone: {}rays from a {}-spp render sent again to Embree {}, on one "
                "thread with nothing around them: {}rays in {:.3f} CPU-s = {:.1f} CPU-ns per ray "
                "({})\n",
-               mega(double(first.rays)), record.spp,
-               passes == 1 ? std::string("once") : fmt::format("{} times", passes),
-               mega(double(replay.rays)), replay_cpu, 1e9 * per_ray,
+               mega(double(replayed.first.rays)), record.spp,
+               replayed.passes == 1 ? std::string("once")
+                                    : fmt::format("{} times", replayed.passes),
+               mega(double(replay.rays)), replayed.cpu_seconds, 1e9 * per_ray,
                replay.differing == 0
                    ? std::string("every answer as in the render")
                    : fmt::format("{} answers differ from the render's", replay.differing));
@@ -335,5 +341,47 @@ int bench_main(int argc, char **argv) {
                "{:.1f} CPU-ns); the rest, {:.1f} CPU-ns per sample, is facet's\n",
                100.0 * embree_cpu / cpu, mega(double(rays)), 1e9 * per_ray,
                1e9 * std::max(cpu - embree_cpu, 0.0) / samples);
+}
+
+} // namespace
+
+int bench_main(int argc, char **argv) {
+    BenchCommand c;
+    CLI::App app("Measure samples and rays per CPU second of the scene's integrator and the share "
+                 "of its CPU time that is Embree's own work; with --reference, the error against "
+                 "a reference image as a function of CPU time",
+                 "facet bench");
+    add_bench_options(app, c);
+    if (int code = cli::parse(app, argc, argv); code >= 0) return code;
+
+    cli::SceneOptions &opts = c.scene;
+    std::shared_ptr<Scene> scene = cli::load_scene(opts);
+    const auto &sensors = scene->sensors();
+    if (opts.sensor < 0 || size_t(opts.sensor) >= sensors.size())
+        FACET_THROW("-s {}: the scene has {} sensor(s)", opts.sensor, sensors.size());
+    const Sensor &sensor = *sensors[size_t(opts.sensor)];
+    const int threads = cli::effective_threads(opts.threads);
+    const Image ref_image = c.reference.empty() ? Image() : read_reference(c.reference, sensor);
+
+    RenderOptions ropts;
+    ropts.threads = opts.threads;
+    ropts.spp = c.spp;
+    ropts.seed = c.seed;
+    ropts.progress = false;
+    std::atomic<bool> cancel{false};
+    ropts.cancel = &cancel;
+
+    fmt::print("bench {}: {}x{} pixels, {} spp, {} thread{}\n", opts.scene,
+               sensor.film().crop_size().x, sensor.film().crop_size().y, c.spp, threads,
+               threads == 1 ? "" : "s");
+    std::fflush(stdout);
+
+    InstructionCounter counter;
+    install_interrupt_handler(&cancel);
+    const Measured m = measure_render(*scene, sensor, ropts, &counter);
+    throw_if_interrupted(m.result);
+    print_render_cost(m, threads, counter);
+    if (!c.reference.empty()) print_equal_error(c, *scene, sensor, ropts, m, ref_image);
+    print_embree_share(*scene, sensor, ropts, m);
     return 0;
 }
