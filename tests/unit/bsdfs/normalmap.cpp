@@ -3,7 +3,7 @@
 // directions that change sides, sample weight == eval/pdf, energy, chi-square, errors and the
 // null pass-through.
 
-#include "../../plugins/bsdfs/perturbed_bsdf.h"
+#include "../../../plugins/bsdfs/perturbed_bsdf.h"
 #include "bsdf_checks.h"
 
 #include <facet/texture.h>
