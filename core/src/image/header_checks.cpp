@@ -15,7 +15,7 @@
 //   (OpenEXR's C core) refused the two attribute entries at once in the same trial: once it
 //   is OpenImageIO's default, the attribute part of check_exr_headers() may go.
 // Each check below names the fuzz regression (tests/data/fuzz/image/regressions/) and the test
-// (tests/unit/hostile_files.cpp) that need it.
+// (tests/unit/core/hostile_files.cpp) that need it.
 #include "image_module.h"
 
 #include <facet/checked.h>
