@@ -410,7 +410,8 @@ their mean is the estimate. Rays that hit nothing give 0. The value goes to all 
 )DOC";
 
 // Conventions (facet/integrator.h): a SamplingIntegrator estimates the radiance along one camera
-// ray in sample(); facet renders the image in blocks and passes on all threads around it. The
+// ray in sample(); facet's render loop takes the image in blocks and passes on all threads around
+// it (an integrator implements no loop of its own). The
 // estimate may use only the sampler for randomness (so the image is the same for any number of
 // threads), and sample() runs on many threads at once: it must not modify the integrator.
 // The base class reads timeout, samples_per_pass and block_size (rows of the table above).
@@ -562,6 +563,8 @@ and `seed`.
 // must depend only on (the pixel's seed, i, sample_count, the base seed), never on the samples
 // taken before: renders split into passes, crops and threads then give the same image. The base
 // class reads sample_count and seed; clone() must copy everything a sample's values depend on.
+// A sampler whose pattern needs a particular count (a square, a power of two) overrides
+// set_sample_count() to round it and returns the count it takes; the render reports it.
 
 #include <facet/plugin.h>
 #include <facet/random.h>
@@ -645,11 +648,11 @@ facet's base film and scales the colour by 2^`exposure` (photographic stops) bef
 )DOC";
 
 // Conventions (facet/film.h): the base class reads the size, the crop window and the nested
-// rfilter, owns the pixel sums and develops them (develop(): linear RGB, alpha, then the AOVs of
-// the render). A film changes what develop() returns or how write() stores it. A render of
-// several passes in one process or a merge develops the pass sums with the base class's
-// develop_sums(), without this develop(): keep changes of the image to what a merge may skip, or
-// render such films in one pass.
+// rfilter, and develops a render's pixel sums (a FilmBuffer the render owns: the film is only
+// read, by any number of renders at once) into linear RGB, alpha, then the AOVs of the render. A
+// film changes what develop() returns or how write() stores it. A render of several passes in
+// one process or a merge develops the pass sums with the base class's Film::develop(), not this
+// override: keep changes of the image to what a merge may skip, or render such films in one pass.
 
 #include <facet/film.h>
 #include <facet/image.h>
@@ -675,8 +678,8 @@ public:
         m_gain = float(std::exp2(exposure));
     }
 
-    Image develop() const override {
-        Image image = Film::develop();
+    Image develop(const FilmBuffer &buffer) const override {
+        Image image = Film::develop(buffer);
         // The colour channels (R, G, B) come first; alpha and the AOVs keep their values.
         const int colour = std::min(image.channels, 3);
         for (size_t i = 0; i < image.data.size(); i += size_t(image.channels))

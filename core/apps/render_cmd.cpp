@@ -120,26 +120,25 @@ std::string output_path(const std::string &scene, const std::string &out, const 
 
 /// A one-pixel image with the channels of the image `facet render` writes: the film's own
 /// colour channels (a one-pixel develop of the sensor's film: a film plugin names them), the
-/// integrator's AOVs, and the raw sums of a part of a split render. The film's crop window is
-/// the scene file's afterwards (the render sets its own).
+/// integrator's AOVs, and the raw sums of a part of a split render.
 struct ChannelsProbe {
     Image image;
     size_t colour = 0, aovs = 0; ///< the first `colour` channels, then `aovs`, then raw sums
 };
 
 ChannelsProbe output_channels_probe(const Scene &scene, const Sensor &sensor, bool part) {
-    Film &film = sensor.film();
+    const Film &film = sensor.film();
     std::vector<std::string> aovs;
     if (auto sampling = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator()))
         aovs = sampling->aov_names();
-    film.set_crop_window(Point2i(0, 0), Point2i(1, 1));
-    film.prepare(aovs);
+    const bool splats = bool(std::dynamic_pointer_cast<LightTracer>(scene.integrator()));
+    const FilmBuffer buffer(Point2i(0, 0), Point2i(1, 1), aovs, splats);
     ChannelsProbe probe;
-    probe.image = film.develop();
+    probe.image = film.develop(buffer);
     probe.aovs = aovs.size();
     probe.colour = size_t(probe.image.channels) - aovs.size();
     if (part) {
-        const std::vector<std::string> raw = film.raw_channel_names();
+        const std::vector<std::string> raw = buffer.raw_channel_names();
         Image with_raw(1, 1, probe.image.channels + int(raw.size()));
         with_raw.x = probe.image.x;
         with_raw.y = probe.image.y;
@@ -149,7 +148,6 @@ ChannelsProbe output_channels_probe(const Scene &scene, const Sensor &sensor, bo
         with_raw.channel_names.insert(with_raw.channel_names.end(), raw.begin(), raw.end());
         probe.image = std::move(with_raw);
     }
-    film.reset_crop_window();
     return probe;
 }
 

@@ -193,8 +193,6 @@ Film::Film(const Properties &props) {
             "{}x{} film",
             ox, oy, cw, ch, m_size.x, m_size.y);
     m_crop_size = {int(cw), int(ch)};
-    m_file_crop_offset = m_crop_offset;
-    m_file_crop_size = m_crop_size;
 
     for (const auto &[name, obj] : props.objects()) {
         if (!obj || obj->type() != ObjectType::ReconstructionFilter) continue;
@@ -208,90 +206,114 @@ Film::Film(const Properties &props) {
             ObjectType::ReconstructionFilter, Properties("gaussian"));
 }
 
-void Film::set_crop_window(const Point2i &offset, const Point2i &size) {
+void Film::check_crop_window(const Point2i &offset, const Point2i &size) const {
     if (offset.x < 0 || offset.y < 0 || size.x <= 0 || size.y <= 0 ||
         int64_t(offset.x) + size.x > m_size.x || int64_t(offset.y) + size.y > m_size.y)
         FACET_THROW("the crop window [{}, {}) x [{}, {}) must be non-empty and lie inside the "
                     "{}x{} film (pixels 0..{} x 0..{})",
                     offset.x, int64_t(offset.x) + size.x, offset.y, int64_t(offset.y) + size.y,
                     m_size.x, m_size.y, m_size.x - 1, m_size.y - 1);
-    m_crop_offset = offset;
-    m_crop_size = size;
-    m_storage.clear();
-    m_splats.clear();
 }
 
-void Film::reset_crop_window() {
-    if (m_crop_offset == m_file_crop_offset && m_crop_size == m_file_crop_size) return;
-    m_crop_offset = m_file_crop_offset;
-    m_crop_size = m_file_crop_size;
-    m_storage.clear();
-    m_splats.clear();
-}
+// ---------------------------------------------------------------------------------------------
+// FilmBuffer
 
-void Film::prepare(const std::vector<std::string> &aov_names) {
-    // The accumulation buffer (doubles) and the developed image (floats) of every channel:
-    // refused beyond a budget instead of failing in the allocator (or the kernel's OOM killer).
+FilmBuffer::FilmBuffer(const Point2i &offset, const Point2i &size,
+                       std::vector<std::string> aov_names, bool splats)
+    : m_offset(offset), m_size(size), m_aov_names(std::move(aov_names)) {
+    // The accumulation buffer (doubles) and the developed image (floats) of every channel.
     constexpr uint64_t BudgetBytes = uint64_t(8) << 30;
-    const uint64_t pixels = uint64_t(m_crop_size.x) * uint64_t(m_crop_size.y);
+    const uint64_t pixels = uint64_t(std::max(size.x, 0)) * uint64_t(std::max(size.y, 0));
+    const uint64_t channels = 4 + uint64_t(m_aov_names.size()) + (splats ? 3 : 0);
     uint64_t bytes = 0;
-    if (__builtin_mul_overflow(pixels, (4 + uint64_t(aov_names.size())) * 12, &bytes) ||
-        bytes > BudgetBytes)
+    if (__builtin_mul_overflow(pixels, channels * 12, &bytes) || bytes > BudgetBytes)
         FACET_THROW("a {}x{} film with {} AOV channels needs {:.1f} GiB for its buffers, more "
                     "than the {} GiB budget: lower the resolution, crop it or use fewer AOVs",
-                    m_crop_size.x, m_crop_size.y, aov_names.size(),
-                    double(pixels) * double(4 + aov_names.size()) * 12.0 / double(1 << 30),
-                    BudgetBytes >> 30);
-    m_aov_names = aov_names;
-    size_t channels = 4 + aov_names.size();
-    m_storage.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * channels, 0.0);
-    m_splats.clear();
-    m_splat_scale = 1.0;
+                    size.x, size.y, m_aov_names.size(),
+                    double(pixels) * double(channels) * 12.0 / double(1 << 30), BudgetBytes >> 30);
+    m_sums.assign(size_t(pixels) * channel_count(), 0.0);
+    if (splats) m_splats.assign(size_t(pixels) * 3, 0.0);
 }
 
-void Film::put_splats(const ImageBlock &block) {
-    if (m_splats.empty()) m_splats.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * 3, 0.0);
+void FilmBuffer::put_splats(const ImageBlock &block) {
+    if (m_splats.empty()) FACET_THROW("FilmBuffer::put_splats: the buffer has no splat buffer");
     const int nc = block.channel_count();
     const Point2i s = block.storage_size();
     const float *data = block.data().data();
-    const int bx = block.offset().x - block.border() - m_crop_offset.x;
-    const int by = block.offset().y - block.border() - m_crop_offset.y;
+    const int bx = block.offset().x - block.border() - m_offset.x;
+    const int by = block.offset().y - block.border() - m_offset.y;
     for (int y = 0; y < s.y; ++y) {
         int cy = by + y;
-        if (cy < 0 || cy >= m_crop_size.y) continue;
+        if (cy < 0 || cy >= m_size.y) continue;
         for (int x = 0; x < s.x; ++x) {
             int cx = bx + x;
-            if (cx < 0 || cx >= m_crop_size.x) continue;
+            if (cx < 0 || cx >= m_size.x) continue;
             const float *src = data + (size_t(y) * s.x + x) * nc;
-            double *dst = m_splats.data() + (size_t(cy) * m_crop_size.x + cx) * 3;
+            double *dst = m_splats.data() + (size_t(cy) * m_size.x + cx) * 3;
             for (int c = 0; c < 3; ++c) dst[c] += double(src[c]);
         }
     }
 }
 
-void Film::put_block(const ImageBlock &block) {
+void FilmBuffer::put_block(const ImageBlock &block) {
     const int nc = block.channel_count();
-    if (size_t(nc) != 4 + m_aov_names.size())
-        FACET_THROW("Film::put_block: the block has {} AOV channels, the film expects {}",
+    if (size_t(nc) != channel_count())
+        FACET_THROW("FilmBuffer::put_block: the block has {} AOV channels, the buffer expects {}",
                     block.aov_count(), m_aov_names.size());
-    if (m_storage.empty()) prepare(m_aov_names);
     const Point2i s = block.storage_size();
     const float *data = block.data().data();
-    // Block storage pixel (0, 0) is film pixel offset - border; map it to the crop window.
-    const int bx = block.offset().x - block.border() - m_crop_offset.x;
-    const int by = block.offset().y - block.border() - m_crop_offset.y;
+    // Block storage pixel (0, 0) is film pixel offset - border; map it to the window.
+    const int bx = block.offset().x - block.border() - m_offset.x;
+    const int by = block.offset().y - block.border() - m_offset.y;
     for (int y = 0; y < s.y; ++y) {
         int cy = by + y;
-        if (cy < 0 || cy >= m_crop_size.y) continue;
+        if (cy < 0 || cy >= m_size.y) continue;
         for (int x = 0; x < s.x; ++x) {
             int cx = bx + x;
-            if (cx < 0 || cx >= m_crop_size.x) continue;
+            if (cx < 0 || cx >= m_size.x) continue;
             const float *src = data + (size_t(y) * s.x + x) * nc;
-            double *dst = m_storage.data() + (size_t(cy) * m_crop_size.x + cx) * nc;
+            double *dst = m_sums.data() + (size_t(cy) * m_size.x + cx) * nc;
             for (int c = 0; c < nc; ++c) dst[c] += double(src[c]);
         }
     }
 }
+
+std::vector<std::string> FilmBuffer::raw_channel_names() const {
+    std::vector<std::string> names;
+    const std::string p = RawChannelPrefix;
+    for (const char *c : {"R", "G", "B"}) names.push_back(p + "sum." + c);
+    for (const auto &n : m_aov_names) names.push_back(p + "sum." + n);
+    names.push_back(p + "weight");
+    if (!m_splats.empty())
+        for (const char *c : {"R", "G", "B"}) names.push_back(p + "splat." + c);
+    return names;
+}
+
+std::vector<float> FilmBuffer::raw_sums() const {
+    const size_t pixels = size_t(m_size.x) * size_t(m_size.y);
+    const size_t nc = channel_count(), ns = m_splats.empty() ? 0 : 3, n = nc + ns;
+    std::vector<float> out(pixels * n);
+    for (size_t i = 0; i < pixels; ++i) {
+        for (size_t c = 0; c < nc; ++c) out[i * n + c] = float(m_sums[i * nc + c]);
+        for (size_t c = 0; c < ns; ++c) out[i * n + nc + c] = float(m_splats[i * 3 + c]);
+    }
+    return out;
+}
+
+void FilmBuffer::set_raw_sums(const std::vector<double> &raw) {
+    const size_t pixels = size_t(m_size.x) * size_t(m_size.y);
+    const size_t nc = channel_count(), ns = m_splats.empty() ? 0 : 3, n = nc + ns;
+    if (raw.size() != pixels * n)
+        FACET_THROW("FilmBuffer::set_raw_sums: {} values for {} pixels of {} raw channels",
+                    raw.size(), pixels, n);
+    for (size_t i = 0; i < pixels; ++i) {
+        for (size_t c = 0; c < nc; ++c) m_sums[i * nc + c] = raw[i * n + c];
+        for (size_t c = 0; c < ns; ++c) m_splats[i * 3 + c] = raw[i * n + nc + c];
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Development
 
 void develop_pixel(const double *storage, int aov_count, const double *splat, double splat_scale,
                    bool alpha, float *dst) {
@@ -332,60 +354,15 @@ Image developed_image(const Point2i &crop_offset, const Point2i &crop_size, cons
 
 } // namespace
 
-Image Film::develop() const {
-    const int naov = int(m_aov_names.size());
-    const int nc = 4 + naov;
-    Image img = developed_image(m_crop_offset, m_crop_size, m_size, m_alpha, m_aov_names);
-    if (m_storage.empty() && m_splats.empty()) return img;
-    for (size_t i = 0, n = size_t(m_crop_size.x) * m_crop_size.y; i < n; ++i)
-        develop_pixel(m_storage.empty() ? nullptr : m_storage.data() + i * nc, naov,
-                      m_splats.empty() ? nullptr : m_splats.data() + i * 3, m_splat_scale, m_alpha,
-                      img.data.data() + i * size_t(img.channels));
-    return img;
-}
-
-void Film::prepare_splats() {
-    m_splats.assign(size_t(m_crop_size.x) * size_t(m_crop_size.y) * 3, 0.0);
-}
-
-std::vector<std::string> Film::raw_channel_names() const {
-    std::vector<std::string> names;
-    const std::string p = RawChannelPrefix;
-    if (!m_storage.empty()) {
-        for (const char *c : {"R", "G", "B"}) names.push_back(p + "sum." + c);
-        for (const auto &n : m_aov_names) names.push_back(p + "sum." + n);
-        names.push_back(p + "weight");
-    }
-    if (!m_splats.empty())
-        for (const char *c : {"R", "G", "B"}) names.push_back(p + "splat." + c);
-    return names;
-}
-
-std::vector<float> Film::raw_sums() const {
-    const size_t pixels = size_t(m_crop_size.x) * size_t(m_crop_size.y);
-    const size_t nc = m_storage.empty() ? 0 : 4 + m_aov_names.size();
-    const size_t ns = m_splats.empty() ? 0 : 3, n = nc + ns;
-    std::vector<float> out(pixels * n);
-    for (size_t i = 0; i < pixels; ++i) {
-        for (size_t c = 0; c < nc; ++c) out[i * n + c] = float(m_storage[i * nc + c]);
-        for (size_t c = 0; c < ns; ++c) out[i * n + nc + c] = float(m_splats[i * 3 + c]);
-    }
-    return out;
-}
-
-Image Film::develop_sums(const std::vector<double> &sums, double splat_scale) const {
-    const size_t pixels = size_t(m_crop_size.x) * size_t(m_crop_size.y);
-    const int naov = int(m_aov_names.size());
-    const size_t nc = m_storage.empty() ? 0 : size_t(4 + naov);
-    const size_t ns = m_splats.empty() ? 0 : 3, n = nc + ns;
-    if (sums.size() != pixels * n)
-        FACET_THROW("develop_sums: {} values for {} pixels of {} raw channels", sums.size(), pixels,
-                    n);
-    Image img = developed_image(m_crop_offset, m_crop_size, m_size, m_alpha, m_aov_names);
-    for (size_t i = 0; i < pixels; ++i)
-        develop_pixel(nc ? sums.data() + i * n : nullptr, naov,
-                      ns ? sums.data() + i * n + nc : nullptr, splat_scale, m_alpha,
-                      img.data.data() + i * size_t(img.channels));
+Image Film::develop(const FilmBuffer &buffer) const {
+    const int naov = int(buffer.aov_names().size());
+    const size_t nc = buffer.channel_count();
+    Image img =
+        developed_image(buffer.offset(), buffer.size(), m_size, m_alpha, buffer.aov_names());
+    const std::vector<double> &sums = buffer.sums(), &splats = buffer.splats();
+    for (size_t i = 0, n = size_t(buffer.size().x) * size_t(buffer.size().y); i < n; ++i)
+        develop_pixel(sums.data() + i * nc, naov, splats.empty() ? nullptr : splats.data() + i * 3,
+                      buffer.splat_scale(), m_alpha, img.data.data() + i * size_t(img.channels));
     return img;
 }
 

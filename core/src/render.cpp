@@ -1,361 +1,29 @@
+// Core's render loop: render() builds a RenderJob per part, which runs the integrator's
+// per-sample (or per-light-path) work in passes of blocks on the render threads (render_loop.h).
+#include "render_loop.h"
 #include "scene_description.h"
 
 #include <facet/film.h>
 #include <facet/integrator.h>
 #include <facet/logger.h>
 #include <facet/properties.h>
-#include <facet/random.h>
 #include <facet/render.h>
 #include <facet/sampler.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
 
-#include <sys/ioctl.h>
-#include <sys/resource.h>
-#include <tbb/global_control.h>
-#include <tbb/info.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <algorithm>
-#include <cerrno>
-#include <chrono>
-#include <condition_variable>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
+#include <cmath>
 #include <limits>
 #include <map>
-#include <mutex>
-#include <pmmintrin.h>
-#include <signal.h>
-#include <thread>
-#include <unistd.h>
-#include <xmmintrin.h>
+#include <utility>
 
 namespace facet {
 
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-/// Sets flush-to-zero / denormals-are-zero for the lifetime of the object (Embree wants both).
-class ScopedFlushToZero {
-public:
-    ScopedFlushToZero() : m_csr(_mm_getcsr()) {
-        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-    }
-    ~ScopedFlushToZero() { _mm_setcsr(m_csr); }
-
-private:
-    unsigned int m_csr;
-};
-
-/// One line on a terminal: "Rendering [=====     ] 42% (1.2s, ETA 1.6s)".
-class ProgressLine {
-public:
-    explicit ProgressLine(bool enabled) : m_enabled(enabled && ::isatty(2)) {}
-    bool enabled() const { return m_enabled; }
-
-    /// Redraws at most every 500 ms unless `force`.
-    void update(size_t done, size_t total, double elapsed, bool force = false) {
-        if (!m_enabled || total == 0) return;
-        if (!force && elapsed - m_last < 0.5) return;
-        m_last = elapsed;
-        const double frac = double(done) / double(total);
-        std::string eta = done > 0 && done < total
-                              ? fmt::format(", ETA {:.1f}s", elapsed * (1.0 - frac) / frac)
-                              : "";
-        const std::string tail =
-            fmt::format(" {:3d}% ({:.1f}s{})", int(frac * 100.0), elapsed, eta);
-        // The line fits the terminal (one column spare: a full line would wrap on some
-        // terminals): the bar shrinks, then goes, then the line is cut.
-        const size_t columns = terminal_columns() - 1;
-        const size_t room = columns > tail.size() + 12 ? columns - tail.size() - 12 : 0;
-        const size_t width = std::min<size_t>(40, room);
-        std::string line = "Rendering";
-        if (width >= 5) {
-            const size_t filled = std::min(width, size_t(frac * double(width) + 0.5));
-            line += " [" + std::string(filled, '=') + std::string(width - filled, ' ') + "]";
-        }
-        line += tail;
-        if (line.size() > columns) line.resize(columns);
-        // Pad to clear what a longer earlier line left behind (within the terminal).
-        const size_t drawn = line.size();
-        if (drawn < m_width) line.append(m_width - drawn, ' ');
-        m_width = drawn;
-        line.insert(0, "\r");
-        std::fputs(line.c_str(), stderr);
-        std::fflush(stderr);
-        m_drawn = true;
-    }
-    void finish() {
-        if (m_enabled && m_drawn) std::fputs("\n", stderr);
-    }
-    bool drawn() const { return m_drawn; }
-
-private:
-    /// Columns of the terminal on stderr ($COLUMNS, else 80, when it does not say).
-    static size_t terminal_columns() {
-        struct winsize ws {};
-        if (::ioctl(2, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0)
-            return std::max<size_t>(ws.ws_col, 2);
-        if (const char *c = std::getenv("COLUMNS"))
-            if (int n = std::atoi(c); n > 1) return size_t(n);
-        return 80;
-    }
-
-    bool m_enabled;
-    bool m_drawn = false;
-    double m_last = -1.0;
-    size_t m_width = 0;
-};
-
-} // namespace
-
-uint64_t sample_stream_seed(uint64_t seed, uint64_t index) {
-    uint64_t h = tea_hash(uint32_t(index), uint32_t(seed) ^ uint32_t(index >> 32));
-    return h ^ (uint64_t(uint32_t(seed >> 32)) << 32);
-}
+// ---------------------------------------------------------------------------------------------
+// Integrator parameters
 
 namespace {
-
-/// sample_stream_seed() of indices first .. first + 3, bit for bit, for the instructions of one
-/// (the four hashes run in the lanes of one register).
-void sample_stream_seeds4(uint64_t seed, uint64_t first, uint64_t (&out)[4]) {
-    uint32_t v0[4], v1[4];
-    for (int k = 0; k < 4; ++k) {
-        const uint64_t index = first + uint64_t(k);
-        v0[k] = uint32_t(index);
-        v1[k] = uint32_t(seed) ^ uint32_t(index >> 32);
-    }
-    tea_hash4(v0, v1, out);
-    for (uint64_t &h : out) h ^= uint64_t(uint32_t(seed >> 32)) << 32;
-}
-
-} // namespace
-
-// ---------------------------------------------------------------------------------------------
-// BlockMerger
-
-BlockMerger::BlockMerger(Film &film, bool splat, size_t group)
-    : m_film(film), m_splat(splat), m_group(std::max<size_t>(group, 1)) {}
-BlockMerger::~BlockMerger() = default;
-
-std::unique_ptr<ImageBlock> BlockMerger::acquire() {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_free.empty()) return std::make_unique<ImageBlock>();
-    auto b = std::move(m_free.back());
-    m_free.pop_back();
-    return b;
-}
-
-void BlockMerger::merge(const ImageBlock &block) {
-    if (m_splat)
-        m_film.put_splats(block);
-    else
-        m_film.put_block(block);
-}
-
-size_t BlockMerger::submit(size_t index, std::unique_ptr<ImageBlock> block) {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    m_pending.emplace(index, std::move(block));
-    ++m_finished;
-    // Merge every whole group that is next in order: the keys are distinct and sorted, so the
-    // group is complete when its first and last blocks are the first m_group pending ones.
-    while (m_pending.size() >= m_group && m_pending.begin()->first == m_next &&
-           std::next(m_pending.begin(), std::ptrdiff_t(m_group - 1))->first ==
-               m_next + m_group - 1) {
-        for (size_t k = 0; k < m_group; ++k) {
-            auto it = m_pending.begin();
-            merge(*it->second);
-            m_free.push_back(std::move(it->second));
-            m_pending.erase(it);
-        }
-        m_next += m_group;
-    }
-    return m_finished;
-}
-
-void BlockMerger::release(std::unique_ptr<ImageBlock> block) {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    m_free.push_back(std::move(block));
-}
-
-void BlockMerger::flush() {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_group == 1) {
-        for (auto &[index, block] : m_pending) merge(*block);
-        m_next += m_pending.size();
-    }
-    m_pending.clear();
-}
-
-size_t BlockMerger::merged() {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    return m_next;
-}
-
-size_t BlockMerger::finished() {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    return m_finished;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Work units on the render threads
-
-double process_cpu_seconds() {
-    rusage ru{};
-    getrusage(RUSAGE_SELF, &ru);
-    return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
-           1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-}
-
-int hardware_threads() { return std::max(1, tbb::info::default_concurrency()); }
-
-int capped_thread_count(int threads) {
-    if (threads < 0)
-        FACET_THROW("the thread count must be positive (or 0 for all cores), got {}", threads);
-    const int hardware = hardware_threads();
-    return threads > 0 ? std::min(threads, hardware) : hardware;
-}
-
-int render_thread_count(const RenderOptions &opts) { return capped_thread_count(opts.threads); }
-
-bool StopCondition::timed_out() const { return timeout > 0.0 && seconds_since(start) >= timeout; }
-
-namespace {
-
-/// The stop condition of the render whose work unit the thread runs (render_should_stop()).
-thread_local const StopCondition *t_render_stop = nullptr;
-
-} // namespace
-
-bool render_should_stop() {
-    const StopCondition *stop = t_render_stop;
-    return stop && (*stop)();
-}
-
-std::vector<uint32_t> progressive_schedule(uint32_t spp, uint32_t samples_per_pass, uint32_t cap) {
-    cap = std::max(cap, 1u);
-    std::vector<uint32_t> pass_start; // pass p takes samples [pass_start[p], pass_start[p + 1])
-    uint32_t next = 0, size = 1;
-    while (next < spp) {
-        pass_start.push_back(next);
-        const uint32_t take =
-            samples_per_pass > 0 ? std::min(samples_per_pass, spp) : std::min(size, cap);
-        next += std::min(take, spp - next);
-        if (next > 1) size = std::min(cap, size * 2);
-    }
-    pass_start.push_back(spp);
-    return pass_start;
-}
-
-WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondition &stop,
-                       const std::atomic<uint64_t> &work_done, uint64_t work_total,
-                       const std::function<std::function<void(size_t)>()> &make_worker) {
-    const int threads = capped_thread_count(opts.threads);
-    const auto start = Clock::now();
-    std::unique_ptr<tbb::global_control> allow;
-    if (opts.threads > 0)
-        allow = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      size_t(threads));
-    tbb::task_arena arena(threads);
-    const int workers = arena.max_concurrency();
-
-    ProgressLine progress(opts.progress);
-    std::atomic<size_t> next_unit{0};
-    std::atomic<bool> cancelled{false}, timed_out{false};
-    std::atomic<bool> first_done{false};
-    double first_unit_cpu = 0.0; // written once, by the thread that finished the first unit
-
-    std::mutex monitor_mutex;
-    std::condition_variable monitor_cv;
-    bool finished = false, announced = false;
-    auto announce_stop = [&] {
-        // Under monitor_mutex. The line ends the progress line; the render stops within
-        // moments, keeping the passes finished so far.
-        if (announced) return;
-        announced = true;
-        std::fputs(progress.drawn() ? "\nfacet: stopping...\n" : "facet: stopping...\n", stderr);
-        std::fflush(stderr);
-    };
-    std::thread monitor([&] {
-        std::unique_lock<std::mutex> lock(monitor_mutex);
-        while (
-            !monitor_cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return finished; })) {
-            if (stop.cancelled()) announce_stop();
-            if (!announced) progress.update(work_done.load(), work_total, seconds_since(start));
-            if (opts.on_progress && work_total > 0)
-                opts.on_progress(double(work_done.load()) / double(work_total));
-        }
-    });
-
-    auto worker = [&](int) {
-        ScopedFlushToZero ftz;
-        // render_should_stop() on this thread asks `stop` (the previous one again afterwards).
-        struct ScopedStop {
-            const StopCondition *saved = t_render_stop;
-            explicit ScopedStop(const StopCondition *s) { t_render_stop = s; }
-            ~ScopedStop() { t_render_stop = saved; }
-        } scoped_stop(&stop);
-        std::function<void(size_t)> run = make_worker();
-        for (;;) {
-            if (stop.cancelled()) {
-                cancelled = true;
-                return;
-            }
-            if (stop.timed_out()) {
-                timed_out = true;
-                return;
-            }
-            const size_t index = next_unit.fetch_add(1);
-            if (index >= count) return;
-            run(index);
-            if (!first_done.load(std::memory_order_relaxed) && !first_done.exchange(true)) {
-                first_unit_cpu = process_cpu_seconds();
-                if (opts.on_first_block) opts.on_first_block();
-            }
-        }
-    };
-    try {
-        arena.execute([&] { tbb::parallel_for(0, workers, worker, tbb::simple_partitioner()); });
-    } catch (...) {
-        {
-            std::lock_guard<std::mutex> lock(monitor_mutex);
-            finished = true;
-        }
-        monitor_cv.notify_all();
-        monitor.join();
-        throw;
-    }
-
-    WorkUnitsRun run;
-    run.seconds = seconds_since(start);
-    run.first_unit_cpu_seconds = first_unit_cpu; // the threads were joined: no race
-    run.cancelled = cancelled || stop.cancelled();
-    run.timed_out = !run.cancelled && (timed_out || stop.timed_out());
-    {
-        std::lock_guard<std::mutex> lock(monitor_mutex);
-        finished = true;
-        if (run.cancelled) announce_stop();
-        if (!announced) progress.update(work_done.load(), work_total, run.seconds, true);
-        if (opts.on_progress && work_total > 0)
-            opts.on_progress(double(work_done.load()) / double(work_total));
-    }
-    monitor_cv.notify_all();
-    monitor.join();
-    if (!announced) progress.finish();
-    return run;
-}
-
-// ---------------------------------------------------------------------------------------------
-// The sampling integrators' render loop
 
 double read_timeout(const Properties &props) {
     const double timeout = props.get_float("timeout", -1.0);
@@ -364,6 +32,20 @@ double read_timeout(const Properties &props) {
                        "timeout must be a number of seconds (<= 0 for none), got {}", timeout);
     return timeout;
 }
+
+uint32_t read_samples_per_pass(const Properties &props) {
+    if (!props.has("samples_per_pass")) {
+        props.get_int("samples_per_pass", 0); // recorded as requested (parameter tables)
+        return 0;
+    }
+    int64_t v = props.get_int("samples_per_pass");
+    if (v <= 0 || v > int64_t(UINT32_MAX))
+        FACET_THROW_AT(props.location("samples_per_pass"),
+                       "samples_per_pass must be a positive number of samples, got {}", v);
+    return uint32_t(v);
+}
+
+} // namespace
 
 // Depths are path lengths counted in 32 bits (4294967295: as good as unbounded); a larger value
 // is a mistake, not a wish for longer paths.
@@ -386,21 +68,10 @@ uint32_t read_rr_depth(const Properties &props, const char *plugin) {
     return uint32_t(rr_depth);
 }
 
-uint32_t read_samples_per_pass(const Properties &props) {
-    if (!props.has("samples_per_pass")) {
-        props.get_int("samples_per_pass", 0); // recorded as requested (parameter tables)
-        return 0;
-    }
-    int64_t v = props.get_int("samples_per_pass");
-    if (v <= 0 || v > int64_t(UINT32_MAX))
-        FACET_THROW_AT(props.location("samples_per_pass"),
-                       "samples_per_pass must be a positive number of samples, got {}", v);
-    return uint32_t(v);
-}
+Integrator::Integrator(const Properties &props)
+    : m_timeout(read_timeout(props)), m_samples_per_pass(read_samples_per_pass(props)) {}
 
-SamplingIntegrator::SamplingIntegrator(const Properties &props) {
-    m_timeout = read_timeout(props);
-    m_samples_per_pass = read_samples_per_pass(props);
+SamplingIntegrator::SamplingIntegrator(const Properties &props) : Integrator(props) {
     int64_t bs = props.get_int("block_size", 0);
     if (bs < 0 || bs > 4096)
         FACET_THROW_AT(props.location("block_size"),
@@ -408,6 +79,9 @@ SamplingIntegrator::SamplingIntegrator(const Properties &props) {
                        bs);
     m_block_size = int(bs);
 }
+
+// ---------------------------------------------------------------------------------------------
+// The render job
 
 SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts) {
     if (opts.spp < 0) FACET_THROW("the sample count must be positive, got {}", opts.spp);
@@ -417,18 +91,14 @@ SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts)
         FACET_THROW("the pass index must lie in 0..{} (pass_count {}), or be -1 for all of them, "
                     "got {}",
                     opts.pass_count - 1, opts.pass_count, opts.pass_index);
-    // Samplers may round the count (stratified ones to a square); seeding once lets them do so
-    // before the count is read back.
-    std::unique_ptr<Sampler> sampler = sensor.sampler().clone();
     const uint64_t per_part = opts.spp > 0 ? uint64_t(opts.spp) : sensor.sampler().sample_count();
     const uint64_t whole = per_part * uint64_t(opts.pass_count);
     if (whole > UINT32_MAX / 2)
         FACET_THROW("{} passes of {} samples per pixel are too many (at most {} in all)",
                     opts.pass_count, per_part, UINT32_MAX / 2);
-    sampler->set_sample_count(uint32_t(whole));
-    sampler->seed(0);
+    // Samplers may round the count (stratified ones to a square).
     SampleRange range;
-    range.total = std::max(sampler->sample_count(), 1u);
+    range.total = std::max(sensor.sampler().clone()->set_sample_count(uint32_t(whole)), 1u);
     if (opts.pass_index < 0) { // all the passes
         range.count = range.total;
         return range;
@@ -439,237 +109,412 @@ SampleRange render_sample_range(const Sensor &sensor, const RenderOptions &opts)
     return range;
 }
 
-RenderResult SamplingIntegrator::render(const Scene &scene, const Sensor &sensor,
-                                        const RenderOptions &opts) const {
-    const auto start = Clock::now();
-    if (opts.block_size < 0)
-        FACET_THROW("the block size must be positive, got {}", opts.block_size);
-    const int bs = opts.block_size > 0 ? opts.block_size : m_block_size > 0 ? m_block_size : 32;
-
-    Film &film = sensor.film();
-    const Sampler &proto_sampler = sensor.sampler();
-    const SampleRange range = render_sample_range(sensor, opts);
-    const uint64_t asked =
-        uint64_t(opts.spp > 0 ? uint32_t(opts.spp) : proto_sampler.sample_count()) *
-        uint64_t(opts.pass_count);
-    if (range.total != asked)
-        FACET_LOG(Info, "The sampler takes {} samples per pixel instead of {}", range.total, asked);
-    if (range.count == 0)
-        FACET_THROW("pass {} of {} has no samples: the {} samples per pixel of the whole render "
-                    "cannot be split into {} parts",
-                    opts.pass_index, opts.pass_count, range.total, opts.pass_count);
-    // The per-thread samplers are clones of this one, set to the whole render's sample count.
-    std::unique_ptr<Sampler> base_sampler = proto_sampler.clone();
-    base_sampler->set_sample_count(range.total);
-    base_sampler->seed(0);
-    const uint32_t spp = range.count;
-    if (m_samples_per_pass > 0 && spp % std::min(m_samples_per_pass, spp) != 0)
-        FACET_THROW("the sample count ({}) must be a multiple of samples_per_pass ({})", spp,
-                    m_samples_per_pass);
-    const uint64_t seed = opts.seed + proto_sampler.base_seed();
-    const std::vector<std::string> aov_names = this->aov_names();
-    const int aov_count = int(aov_names.size());
-    film.prepare(aov_names);
-
-    const Point2i film_size = film.size(), crop_offset = film.crop_offset(),
-                  crop_size = film.crop_size();
-    const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
-
-    // Progressive rendering: the samples are taken in passes over the whole image, and the film
-    // only ever holds whole passes, so a render stopped at any moment has every pixel at the
-    // same spp. Without samples_per_pass the passes take 1, 1, 2, 4, ... samples, at most
-    // about 2^18 samples over the film each (a power of two): early stops keep a useful image
-    // and a stop throws away at most one pass. The schedule depends only on the film size and
-    // the part's samples, never on the crop or the thread count.
-    uint32_t cap = 1;
-    while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
-    const std::vector<uint32_t> pass_start = progressive_schedule(spp, m_samples_per_pass, cap);
-    const size_t passes = pass_start.size() - 1;
-
-    const int border = ImageBlock::border_for(film.rfilter());
-    // The pixels whose samples reach the crop window through the filter are sampled, in blocks
-    // of the grid of the whole film: a crop's pixels receive the same samples, in the same
-    // order, as in a render of the whole film.
-    const int rx0 = std::max(0, crop_offset.x - border), ry0 = std::max(0, crop_offset.y - border);
-    const int rx1 = std::min(film_size.x, crop_offset.x + crop_size.x + border);
-    const int ry1 = std::min(film_size.y, crop_offset.y + crop_size.y + border);
-    const int gx0 = rx0 / bs, gy0 = ry0 / bs;
-    const int blocks_x = (rx1 + bs - 1) / bs - gx0, blocks_y = (ry1 + bs - 1) / bs - gy0;
-    const size_t blocks = size_t(blocks_x) * size_t(blocks_y);
-    const size_t total = blocks * passes;
-    const uint64_t sampled_pixels = uint64_t(rx1 - rx0) * uint64_t(ry1 - ry0);
-    const ReconstructionFilter &filter = film.rfilter();
-    const bool needs_aperture = sensor.needs_aperture_sample();
-    const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
-
-    FACET_LOG(Info, "Starting render job ({}x{}, {} samples in {} pass{}{}, {} threads)",
-              crop_size.x, crop_size.y, spp, passes, passes == 1 ? "" : "es",
-              opts.pass_count > 1 ? fmt::format(", part {} of {}", opts.pass_index, opts.pass_count)
-                                  : "",
-              render_thread_count(opts));
-    if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
-
-    StopCondition stop{opts.cancel, m_timeout, start};
-    BlockMerger merger(film, /*splat=*/false, blocks);
-    std::atomic<uint64_t> samples_done{0}, invalid_samples{0};
-    std::atomic<uint64_t> first_invalid_pixel{UINT64_MAX};
-
-    // Unit `index` is block index % blocks of pass index / blocks; blocks are in scanline order.
-    auto make_worker = [&]() -> std::function<void(size_t)> {
-        auto sampler = std::shared_ptr<Sampler>(base_sampler->clone());
-        auto aovs = std::make_shared<std::vector<float>>(size_t(aov_count) + 1, 0.f);
-        return [&, sampler, aovs](size_t index) {
-            const size_t pass = index / blocks;
-            const size_t block_index = index % blocks;
-            const int bx = gx0 + int(block_index % size_t(blocks_x)),
-                      by = gy0 + int(block_index / size_t(blocks_x));
-            const Point2i offset(bx * bs, by * bs);
-            const Point2i size(std::min(bs, film_size.x - offset.x),
-                               std::min(bs, film_size.y - offset.y));
-            std::unique_ptr<ImageBlock> block = merger.acquire();
-            block->reset(offset, size, border, aov_count);
-            const int x0 = std::max(offset.x, rx0), x1 = std::min(offset.x + size.x, rx1);
-            const int y0 = std::max(offset.y, ry0), y1 = std::min(offset.y + size.y, ry1);
-            const uint32_t first = range.first + pass_start[pass],
-                           last = range.first + pass_start[pass + 1];
-
-            uint64_t invalid = 0;
-            uint32_t until_check = 1;
-            uint64_t pixel_seeds[4]; // of the row's pixels x0 + 4i .. x0 + 4i + 3
-            for (int y = y0; y < y1; ++y) {
-                for (int x = x0; x < x1; ++x) {
-                    const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
-                    if ((x - x0) % 4 == 0) sample_stream_seeds4(seed, pixel_index, pixel_seeds);
-                    sampler->seed(pixel_seeds[(x - x0) % 4]);
-                    for (uint32_t s = first; s < last; ++s) {
-                        // A stop abandons the unit (its pass is incomplete and is dropped).
-                        if (--until_check == 0) {
-                            until_check = 16;
-                            if (stop()) {
-                                merger.release(std::move(block));
-                                return;
-                            }
-                        }
-                        sampler->set_sample_index(s);
-                        const Point2f u = sampler->draw_2d();
-                        const Point2f pos(float(x) + u.x, float(y) + u.y);
-                        const Point2f aperture =
-                            needs_aperture ? sampler->draw_2d() : Point2f(0.5f, 0.5f);
-                        auto [ray, weight] = sensor.sample_ray(0.f, pos * inv_film_size, aperture);
-                        // Integrators need not write every AOV for every sample (e.g. on a miss).
-                        // (The buffer's extra float only keeps data() valid: nothing reads it.)
-                        if (aov_count > 0) std::fill_n(aovs->data(), aov_count, 0.f);
-                        Color3f L = sample(scene, *sampler, ray, aovs->data()) * weight;
-                        bool valid = L.is_finite();
-                        for (int k = 0; k < aov_count; ++k)
-                            valid = valid && std::isfinite((*aovs)[size_t(k)]);
-                        if (!valid) {
-                            // One bad sample must not turn the whole pixel into NaN: drop it.
-                            if (invalid++ == 0) {
-                                uint64_t cur = first_invalid_pixel.load();
-                                while (
-                                    pixel_index < cur &&
-                                    !first_invalid_pixel.compare_exchange_weak(cur, pixel_index)) {}
-                            }
-                            continue;
-                        }
-                        block->put(pos, L, aovs->data(), filter);
-                    }
-                }
-                samples_done.fetch_add(uint64_t(x1 - x0) * (last - first),
-                                       std::memory_order_relaxed);
-            }
-            // An integrator may have cut its last samples short (render_should_stop()); a stop
-            // stays true once it is, so this sees it.
-            if (stop()) {
-                merger.release(std::move(block));
-                return;
-            }
-            invalid_samples += invalid;
-            merger.submit(index, std::move(block));
-        };
-    };
-    WorkUnitsRun run =
-        run_units(total, opts, stop, samples_done, sampled_pixels * spp, make_worker);
-    merger.flush();
-
-    RenderResult result;
-    const size_t passes_done = merger.merged() / std::max<size_t>(blocks, 1);
-    result.blocks_total = total;
-    result.blocks_done = merger.merged();
-    result.first_block_cpu_seconds = run.first_unit_cpu_seconds;
-    result.cancelled = passes_done < passes;
-    result.timed_out = result.cancelled && run.timed_out;
-    result.spp_target = spp;
-    result.spp = pass_start[passes_done];
-    result.samples = sampled_pixels * result.spp;
-    result.sample_offset = range.first;
-    result.spp_total = range.total;
-    if (result.cancelled) {
-        const std::string what = fmt::format(
-            "after {} of {} passes: the image has {} of {} samples per pixel{}", passes_done,
-            passes, result.spp, spp, result.spp == 0 ? " (no pass was finished: it is black)" : "");
-        if (result.timed_out)
-            FACET_LOG(Warn, "Timeout of {:.2f}s reached {}", m_timeout, what);
-        else
-            FACET_LOG(Warn, "Rendering stopped {}", what);
-    }
-    if (invalid_samples > 0) {
-        uint64_t p = first_invalid_pixel.load();
-        FACET_LOG(Warn,
-                  "{} samples had NaN or infinite radiance and were dropped (the first at pixel "
-                  "({}, {}))",
-                  invalid_samples.load(), p % uint64_t(film_size.x), p / uint64_t(film_size.x));
-    }
-    result.sampling_seconds = run.seconds;
-    const auto develop_start = Clock::now();
-    result.image = film.develop();
-    result.develop_seconds = seconds_since(develop_start);
-    result.seconds = seconds_since(start);
-    return result;
+void SplatTarget::splat(const Point2f &film_pos, const Color3f &value) {
+    m_block.splat(film_pos, value, m_filter);
 }
 
 namespace {
 
-/// A part's raw channels (Film::raw_channel_names) after its developed ones.
-void append_raw_channels(Image &image, const Film &film) {
-    const std::vector<std::string> names = film.raw_channel_names();
-    const std::vector<float> raw = film.raw_sums();
-    const size_t pixels = size_t(image.width) * size_t(image.height), nr = names.size();
-    const size_t nd = size_t(image.channels), n = nd + nr;
-    if (raw.size() != pixels * nr)
-        FACET_THROW("the film's raw sums ({} values) do not match its {}x{} image", raw.size(),
-                    image.width, image.height);
-    std::vector<float> data(pixels * n);
-    for (size_t i = 0; i < pixels; ++i) {
-        std::copy_n(image.data.data() + i * nd, nd, data.data() + i * n);
-        std::copy_n(raw.data() + i * nr, nr, data.data() + i * n + nd);
-    }
-    image.data = std::move(data);
-    image.channels = int(n);
-    image.channel_names.insert(image.channel_names.end(), names.begin(), names.end());
+/// The film pixels a render develops: `offset` + [0, size).
+struct Window {
+    Point2i offset, size;
+};
+
+/// RenderOptions::crop (validated against the film), else the film's crop window.
+Window render_window(const Film &film, const RenderOptions &opts) {
+    const auto &c = opts.crop;
+    if (c[0] == 0 && c[1] == 0 && c[2] == 0 && c[3] == 0)
+        return {film.crop_offset(), film.crop_size()};
+    if (c[2] <= c[0] || c[3] <= c[1])
+        FACET_THROW("the crop window x0 y0 x1 y1 = {} {} {} {} is empty (x1 and y1 are "
+                    "exclusive: they must be greater than x0 and y0)",
+                    c[0], c[1], c[2], c[3]);
+    const Window w{Point2i(c[0], c[1]), Point2i(c[2] - c[0], c[3] - c[1])};
+    film.check_crop_window(w.offset, w.size);
+    return w;
 }
 
-} // namespace
+/// The blocks of a sampling render: the pixels whose samples reach the window through the
+/// filter, in square blocks of the grid of the whole film, so a crop's pixels receive the same
+/// samples, in the same order, as in a render of the whole film.
+struct BlockGrid {
+    BlockGrid(const Film &film, const Window &window, int block_size) : bs(block_size) {
+        const Point2i film_size = film.size();
+        border = ImageBlock::border_for(film.rfilter());
+        x0 = std::max(0, window.offset.x - border);
+        y0 = std::max(0, window.offset.y - border);
+        x1 = std::min(film_size.x, window.offset.x + window.size.x + border);
+        y1 = std::min(film_size.y, window.offset.y + window.size.y + border);
+        gx0 = x0 / bs;
+        gy0 = y0 / bs;
+        blocks_x = (x1 + bs - 1) / bs - gx0;
+        blocks_y = (y1 + bs - 1) / bs - gy0;
+    }
+    size_t blocks() const { return size_t(blocks_x) * size_t(blocks_y); }
+    uint64_t sampled_pixels() const { return uint64_t(x1 - x0) * uint64_t(y1 - y0); }
+    /// Film pixel of the top left corner of block `index` (scanline order).
+    Point2i block_offset(size_t index) const {
+        return {(gx0 + int(index % size_t(blocks_x))) * bs,
+                (gy0 + int(index / size_t(blocks_x))) * bs};
+    }
 
-/// Where the scene file declares `object` (its tag); none for objects not loaded from a file.
-static Location declared_at(const Scene &scene, const Object *object) {
-    if (const std::shared_ptr<SceneDescription> &d = scene.description())
-        for (const SceneDescription::Node &node : d->nodes)
-            if (node.instance.get() == object) return node.location;
-    return {};
+    int bs, border;
+    int x0, y0, x1, y1; ///< the sampled pixels [x0, x1) x [y0, y1)
+    int gx0, gy0, blocks_x, blocks_y;
+};
+
+/// The first sample that had a NaN or infinite value, and how many did (dropped).
+struct InvalidSamples {
+    std::atomic<uint64_t> count{0};
+    std::atomic<uint64_t> first_pixel{UINT64_MAX};
+    void add(uint64_t n, uint64_t pixel) {
+        if (n == 0) return;
+        count += n;
+        uint64_t cur = first_pixel.load();
+        while (pixel < cur && !first_pixel.compare_exchange_weak(cur, pixel)) {}
+    }
+};
+
+/// One render of one part (RenderOptions::pass_index) of a sensor: everything that belongs to
+/// it, and core's loop render -> pass -> block -> sample around the integrator's per-sample
+/// work. The scene, sensor and film are only read.
+class RenderJob {
+public:
+    RenderJob(const Scene &scene, const Sensor &sensor, const RenderOptions &opts,
+              const Window &window)
+        : m_scene(scene), m_sensor(sensor), m_film(sensor.film()), m_opts(opts), m_window(window),
+          m_range(render_sample_range(sensor, opts)) {}
+
+    RenderResult run(const Integrator &integrator);
+    /// The accumulation buffer of the finished render (its raw sums for a part's file).
+    std::unique_ptr<FilmBuffer> take_buffer() { return std::move(m_buffer); }
+
+private:
+    /// The sample range, the sampler set to the whole render's sample count, the seed and the
+    /// pass schedule; `what` names a sample in messages ("samples", "light paths").
+    void plan(const Integrator &integrator, uint32_t cap, const char *what);
+    RenderResult run_sampling(const SamplingIntegrator &integrator);
+    RenderResult run_light_tracing(const LightTracer &tracer);
+    /// Samples [first, last) of every pixel of block `index` of the grid into `block`; false
+    /// when a stop cut it short.
+    bool render_block(const SamplingIntegrator &integrator, const BlockGrid &grid, size_t index,
+                      uint32_t first, uint32_t last, Sampler &sampler, std::vector<float> &aovs,
+                      ImageBlock &block, InvalidSamples &invalid) const;
+    /// Light paths [begin, end) of the render into `block`; false when a stop cut it short.
+    bool trace_paths(const LightTracer &tracer, uint64_t begin, uint64_t end, Sampler &sampler,
+                     ImageBlock &block) const;
+    /// The result of `passes_done` whole passes of `units` work units each, developed.
+    RenderResult finish(const WorkUnitsRun &run, size_t units_per_pass, size_t passes_done,
+                        uint64_t pixels, const char *what);
+
+    const Scene &m_scene;
+    const Sensor &m_sensor;
+    const Film &m_film;
+    const RenderOptions &m_opts;
+    const Window m_window;
+    const Clock::time_point m_start = Clock::now();
+    const SampleRange m_range;
+    std::unique_ptr<Sampler> m_sampler; ///< the threads' samplers are clones of it
+    uint64_t m_seed = 0;
+    double m_timeout = -1.0;
+    std::vector<uint32_t> m_pass_start; ///< pass p takes samples [m_pass_start[p], [p + 1])
+    StopCondition m_stop;
+    std::unique_ptr<FilmBuffer> m_buffer;
+    std::unique_ptr<BlockMerger> m_merger;
+};
+
+RenderResult RenderJob::run(const Integrator &integrator) {
+    if (const auto *sampling = dynamic_cast<const SamplingIntegrator *>(&integrator))
+        return run_sampling(*sampling);
+    if (const auto *tracer = dynamic_cast<const LightTracer *>(&integrator))
+        return run_light_tracing(*tracer);
+    FACET_THROW("the integrator {} cannot render images", integrator.to_string());
+}
+
+void RenderJob::plan(const Integrator &integrator, uint32_t cap, const char *what) {
+    const Sampler &proto = m_sensor.sampler();
+    const uint64_t asked = uint64_t(m_opts.spp > 0 ? uint32_t(m_opts.spp) : proto.sample_count()) *
+                           uint64_t(m_opts.pass_count);
+    if (m_range.total != asked)
+        FACET_LOG(Info, "The sampler takes {} samples per pixel instead of {}", m_range.total,
+                  asked);
+    if (m_range.count == 0)
+        FACET_THROW("pass {} of {} has no samples: the {} {} per pixel of the whole render "
+                    "cannot be split into {} parts",
+                    m_opts.pass_index, m_opts.pass_count, m_range.total, what, m_opts.pass_count);
+    m_sampler = proto.clone();
+    m_sampler->set_sample_count(m_range.total);
+    const uint32_t spp = m_range.count, per_pass = integrator.samples_per_pass();
+    if (per_pass > 0 && spp % std::min(per_pass, spp) != 0)
+        FACET_THROW("the sample count ({}) must be a multiple of samples_per_pass ({})", spp,
+                    per_pass);
+    m_seed = m_opts.seed + proto.base_seed();
+    m_timeout = integrator.timeout();
+    m_pass_start = progressive_schedule(spp, per_pass, cap);
+    m_stop = StopCondition{m_opts.cancel, m_timeout, m_start};
+}
+
+RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
+    if (m_opts.block_size < 0)
+        FACET_THROW("the block size must be positive, got {}", m_opts.block_size);
+    const int bs = m_opts.block_size > 0         ? m_opts.block_size
+                   : integrator.block_size() > 0 ? integrator.block_size()
+                                                 : 32;
+    // Progressive rendering: the samples are taken in passes over the whole image, and the
+    // buffer only ever holds whole passes, so a render stopped at any moment has every pixel at
+    // the same spp. Without samples_per_pass the passes take 1, 1, 2, 4, ... samples, at most
+    // about 2^18 samples over the film each (a power of two): early stops keep a useful image
+    // and a stop throws away at most one pass. The schedule depends only on the film size and
+    // the part's samples, never on the crop or the thread count.
+    const Point2i film_size = m_film.size();
+    const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
+    uint32_t cap = 1;
+    while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
+    plan(integrator, cap, "samples");
+    const std::vector<std::string> aov_names = integrator.aov_names();
+    m_buffer = std::make_unique<FilmBuffer>(m_window.offset, m_window.size, aov_names);
+
+    const BlockGrid grid(m_film, m_window, bs);
+    const size_t blocks = grid.blocks(), passes = m_pass_start.size() - 1;
+    const uint32_t spp = m_range.count;
+    FACET_LOG(Info, "Starting render job ({}x{}, {} samples in {} pass{}{}, {} threads)",
+              m_window.size.x, m_window.size.y, spp, passes, passes == 1 ? "" : "es",
+              m_opts.pass_count > 1
+                  ? fmt::format(", part {} of {}", m_opts.pass_index, m_opts.pass_count)
+                  : "",
+              render_thread_count(m_opts));
+    if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
+
+    m_merger = std::make_unique<BlockMerger>(*m_buffer, /*splat=*/false, blocks);
+    std::atomic<uint64_t> samples_done{0};
+    InvalidSamples invalid;
+    // Unit `index` is block index % blocks of pass index / blocks.
+    auto make_worker = [&]() -> std::function<void(size_t)> {
+        auto sampler = std::shared_ptr<Sampler>(m_sampler->clone());
+        auto aovs = std::make_shared<std::vector<float>>(aov_names.size() + 1, 0.f);
+        return [&, sampler, aovs](size_t index) {
+            const size_t pass = index / blocks;
+            const uint32_t first = m_range.first + m_pass_start[pass],
+                           last = m_range.first + m_pass_start[pass + 1];
+            std::unique_ptr<ImageBlock> block = m_merger->acquire();
+            if (!render_block(integrator, grid, index % blocks, first, last, *sampler, *aovs,
+                              *block, invalid)) {
+                m_merger->release(std::move(block));
+                return;
+            }
+            const Point2i o = block->offset(), s = block->size();
+            const uint64_t pixels =
+                uint64_t(std::max(0, std::min(o.x + s.x, grid.x1) - std::max(o.x, grid.x0))) *
+                uint64_t(std::max(0, std::min(o.y + s.y, grid.y1) - std::max(o.y, grid.y0)));
+            samples_done.fetch_add(pixels * (last - first), std::memory_order_relaxed);
+            m_merger->submit(index, std::move(block));
+        };
+    };
+    const WorkUnitsRun run = run_units(blocks * passes, m_opts, m_stop, samples_done,
+                                       grid.sampled_pixels() * spp, make_worker);
+    m_merger->flush();
+    if (const uint64_t n = invalid.count.load(); n > 0) {
+        const uint64_t p = invalid.first_pixel.load();
+        FACET_LOG(Warn,
+                  "{} samples had NaN or infinite radiance and were dropped (the first at pixel "
+                  "({}, {}))",
+                  n, p % uint64_t(film_size.x), p / uint64_t(film_size.x));
+    }
+    return finish(run, blocks, m_merger->merged() / std::max<size_t>(blocks, 1),
+                  grid.sampled_pixels(), "samples");
+}
+
+bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGrid &grid,
+                             size_t index, uint32_t first, uint32_t last, Sampler &sampler,
+                             std::vector<float> &aovs, ImageBlock &block,
+                             InvalidSamples &invalid) const {
+    const Point2i film_size = m_film.size(), offset = grid.block_offset(index);
+    const Point2i size(std::min(grid.bs, film_size.x - offset.x),
+                       std::min(grid.bs, film_size.y - offset.y));
+    const int aov_count = int(aovs.size()) - 1; // (the extra float keeps data() valid)
+    block.reset(offset, size, grid.border, aov_count);
+    const int x0 = std::max(offset.x, grid.x0), x1 = std::min(offset.x + size.x, grid.x1);
+    const int y0 = std::max(offset.y, grid.y0), y1 = std::min(offset.y + size.y, grid.y1);
+    const ReconstructionFilter &filter = m_film.rfilter();
+    const bool needs_aperture = m_sensor.needs_aperture_sample();
+    const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
+
+    uint64_t bad = 0, first_bad_pixel = UINT64_MAX;
+    uint32_t until_check = 1;
+    uint64_t pixel_seeds[4]; // of the row's pixels x0 + 4i .. x0 + 4i + 3
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
+            if ((x - x0) % 4 == 0) sample_stream_seeds4(m_seed, pixel_index, pixel_seeds);
+            sampler.seed(pixel_seeds[(x - x0) % 4]);
+            for (uint32_t s = first; s < last; ++s) {
+                // A stop abandons the block (its pass is incomplete and is dropped).
+                if (--until_check == 0) {
+                    until_check = 16;
+                    if (m_stop()) return false;
+                }
+                sampler.set_sample_index(s);
+                const Point2f u = sampler.draw_2d();
+                const Point2f pos(float(x) + u.x, float(y) + u.y);
+                const Point2f aperture = needs_aperture ? sampler.draw_2d() : Point2f(0.5f, 0.5f);
+                auto [ray, weight] = m_sensor.sample_ray(0.f, pos * inv_film_size, aperture);
+                // Integrators need not write every AOV for every sample (e.g. on a miss).
+                if (aov_count > 0) std::fill_n(aovs.data(), aov_count, 0.f);
+                const Color3f L = integrator.sample(m_scene, sampler, ray, aovs.data()) * weight;
+                bool valid = L.is_finite();
+                for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
+                if (!valid) {
+                    // One bad sample must not turn the whole pixel into NaN: drop it.
+                    if (bad++ == 0) first_bad_pixel = pixel_index;
+                    continue;
+                }
+                block.put(pos, L, aovs.data(), filter);
+            }
+        }
+    }
+    // An integrator may have cut its last samples short (render_should_stop()); a stop stays
+    // true once it is, so this sees it.
+    if (m_stop()) return false;
+    invalid.add(bad, first_bad_pixel);
+    return true;
+}
+
+RenderResult RenderJob::run_light_tracing(const LightTracer &tracer) {
+    if (!m_sensor.supports_direction_sampling())
+        FACET_THROW("a light tracer cannot connect to the sensor {} (it does not support "
+                    "sampling a direction towards it)",
+                    m_sensor.to_string());
+    // Sample s of the whole render (of range.total samples per pixel) is the light paths
+    // [s·P, (s + 1)·P) for a P-pixel film; a part takes the samples of its range. The passes
+    // double without a cap: each work unit splats into a block of the whole window, so few
+    // units for any spp.
+    plan(tracer, 1u << 30, "light paths");
+    m_buffer = std::make_unique<FilmBuffer>(m_window.offset, m_window.size,
+                                            std::vector<std::string>{}, /*splats=*/true);
+    const Point2i film_size = m_film.size();
+    const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
+    // A fixed number of work units per pass whatever the thread count (determinism).
+    constexpr uint64_t UnitsPerPass = 64;
+    const uint64_t units = std::min<uint64_t>(UnitsPerPass, film_pixels);
+    const size_t passes = m_pass_start.size() - 1;
+    const uint32_t spp = m_range.count;
+    FACET_LOG(Info,
+              "Starting particle tracing ({}x{}, {} light paths per pixel in {} pass{}{}, {} "
+              "threads)",
+              m_window.size.x, m_window.size.y, spp, passes, passes == 1 ? "" : "es",
+              m_opts.pass_count > 1
+                  ? fmt::format(", part {} of {}", m_opts.pass_index, m_opts.pass_count)
+                  : "",
+              render_thread_count(m_opts));
+    if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
+
+    m_merger = std::make_unique<BlockMerger>(*m_buffer, /*splat=*/true, size_t(units));
+    std::atomic<uint64_t> paths_done{0};
+    auto make_worker = [&]() -> std::function<void(size_t)> {
+        auto sampler = std::shared_ptr<Sampler>(m_sampler->clone());
+        return [&, sampler](size_t index) {
+            const size_t pass = index / units;
+            const uint64_t unit = index % units;
+            // The pass's light paths, numbered over the whole render.
+            const uint64_t first = uint64_t(m_range.first + m_pass_start[pass]) * film_pixels,
+                           count =
+                               uint64_t(m_pass_start[pass + 1] - m_pass_start[pass]) * film_pixels;
+            const uint64_t begin = first + count * unit / units,
+                           end = first + count * (unit + 1) / units;
+            std::unique_ptr<ImageBlock> block = m_merger->acquire();
+            if (!trace_paths(tracer, begin, end, *sampler, *block)) {
+                m_merger->release(std::move(block));
+                return;
+            }
+            paths_done.fetch_add(end - begin, std::memory_order_relaxed);
+            m_merger->submit(index, std::move(block));
+        };
+    };
+    const WorkUnitsRun run = run_units(size_t(units) * passes, m_opts, m_stop, paths_done,
+                                       film_pixels * spp, make_worker);
+    m_merger->flush();
+    return finish(run, size_t(units), m_merger->merged() / size_t(units), film_pixels,
+                  "light paths");
+}
+
+bool RenderJob::trace_paths(const LightTracer &tracer, uint64_t begin, uint64_t end,
+                            Sampler &sampler, ImageBlock &block) const {
+    block.reset(m_window.offset, m_window.size, ImageBlock::border_for(m_film.rfilter()));
+    SplatTarget target(block, m_film.rfilter());
+    for (uint64_t i = begin; i < end; ++i) {
+        // A stop abandons the unit (its pass is incomplete and is dropped).
+        if ((i - begin) % 64 == 63 && m_stop()) return false;
+        sampler.seed(sample_stream_seed(m_seed, i));
+        tracer.trace(m_scene, m_sensor, sampler, target);
+    }
+    // trace() may have cut the last paths short (render_should_stop()); a stop stays true once
+    // it is, so this sees it.
+    return !m_stop();
+}
+
+RenderResult RenderJob::finish(const WorkUnitsRun &run, size_t units_per_pass, size_t passes_done,
+                               uint64_t pixels, const char *what) {
+    const size_t passes = m_pass_start.size() - 1;
+    const uint32_t spp = m_range.count;
+    RenderResult result;
+    result.blocks_total = units_per_pass * passes;
+    result.blocks_done = m_merger->merged();
+    result.first_block_cpu_seconds = run.first_unit_cpu_seconds;
+    result.cancelled = passes_done < passes;
+    result.timed_out = result.cancelled && run.timed_out;
+    result.spp_target = spp;
+    result.spp = m_pass_start[passes_done];
+    result.samples = pixels * result.spp;
+    result.sample_offset = m_range.first;
+    result.spp_total = m_range.total;
+    if (m_buffer->has_splats())
+        // The importance of the sensor integrates to one over the whole film: every pixel
+        // receives spp times its value from width x height x spp paths.
+        m_buffer->set_splat_scale(result.spp > 0 ? 1.0 / double(result.spp) : 1.0);
+    if (result.cancelled) {
+        const std::string done = fmt::format(
+            "after {} of {} passes: the image has {} of {} {} per pixel{}", passes_done, passes,
+            result.spp, spp, what, result.spp == 0 ? " (no pass was finished: it is black)" : "");
+        if (result.timed_out)
+            FACET_LOG(Warn, "Timeout of {:.2f}s reached {}", m_timeout, done);
+        else
+            FACET_LOG(Warn, "Rendering stopped {}", done);
+    }
+    result.sampling_seconds = run.seconds;
+    const auto develop_start = Clock::now();
+    result.image = m_film.develop(*m_buffer);
+    result.develop_seconds = seconds_since(develop_start);
+    result.seconds = seconds_since(m_start);
+    result.crop = {{m_window.offset.x, m_window.offset.y, m_window.offset.x + m_window.size.x,
+                    m_window.offset.y + m_window.size.y}};
+    result.film_width = m_film.size().x;
+    result.film_height = m_film.size().y;
+    result.pass_index = m_opts.pass_index;
+    result.pass_count = m_opts.pass_count;
+    result.accel_seconds = m_scene.accel_build_seconds();
+    return result;
+}
+
+/// One render of a part, and its accumulation buffer.
+std::pair<RenderResult, std::unique_ptr<FilmBuffer>>
+render_job(const Scene &scene, const Sensor &sensor, const RenderOptions &opts,
+           const Window &window, const Integrator &integrator) {
+    RenderJob job(scene, sensor, opts, window);
+    RenderResult result = job.run(integrator);
+    return {std::move(result), job.take_buffer()};
 }
 
 /// Every pass of opts.pass_count, one after the other, combined as a merge of the parts combines
 /// them: the raw sums of each pass rounded to float (what a part's file holds), added in pass
 /// order in double and developed once. The result is bit-identical to the merge of the parts.
-static RenderResult render_all_passes(const Scene &scene, const Sensor &sensor,
-                                      const RenderOptions &opts) {
+RenderResult render_all_passes(const Scene &scene, const Sensor &sensor, const RenderOptions &opts,
+                               const Window &window, const Integrator &integrator) {
     const auto start = Clock::now();
-    Film &film = sensor.film();
+    const Film &film = sensor.film();
     RenderResult all;
     std::vector<double> sums;
     std::vector<std::string> raw_names;
+    std::unique_ptr<FilmBuffer> first;
     for (int i = 0; i < opts.pass_count; ++i) {
         RenderOptions part = opts;
         part.pass_index = i;
@@ -677,20 +522,23 @@ static RenderResult render_all_passes(const Scene &scene, const Sensor &sensor,
             part.on_progress = [&opts, i](double f) {
                 opts.on_progress((double(i) + f) / double(opts.pass_count));
             };
-        RenderResult r = render(scene, sensor, part);
-        const std::vector<std::string> &names = r.image.channel_names;
-        if (names.size() < 3 || names[0] != "R" || names[1] != "G" || names[2] != "B")
+        auto [r, buffer] = render_job(scene, sensor, part, window, integrator);
+        const std::vector<std::string> names = buffer->raw_channel_names();
+        const std::vector<float> raw = buffer->raw_sums();
+        const std::vector<std::string> &channels = r.image.channel_names;
+        if (channels.size() < 3 || channels[0] != "R" || channels[1] != "G" || channels[2] != "B")
             FACET_THROW("a render of {} passes in one process develops R, G, B: the film {} "
                         "develops into {} (use the pixel format rgb or rgba, or render the passes "
                         "apart)",
-                        opts.pass_count, film.to_string(), names.empty() ? "nothing" : names[0]);
-        const std::vector<float> raw = film.raw_sums();
+                        opts.pass_count, film.to_string(),
+                        channels.empty() ? "nothing" : channels[0]);
         if (i == 0) {
-            raw_names = film.raw_channel_names();
+            raw_names = names;
             sums.assign(raw.size(), 0.0);
+            first = std::move(buffer);
             all = r;
         } else {
-            if (film.raw_channel_names() != raw_names || raw.size() != sums.size())
+            if (names != raw_names || raw.size() != sums.size())
                 FACET_THROW("pass {} of {} has other raw channels than pass 0", i, opts.pass_count);
             all.blocks_done += r.blocks_done;
             all.blocks_total += r.blocks_total;
@@ -708,7 +556,10 @@ static RenderResult render_all_passes(const Scene &scene, const Sensor &sensor,
     }
     const SampleRange range = render_sample_range(sensor, opts);
     // As a merge: splats are divided by the light paths per pixel of all the passes.
-    all.image = film.develop_sums(sums, all.spp > 0 ? 1.0 / double(all.spp) : 1.0);
+    first->set_raw_sums(sums);
+    first->set_splat_scale(all.spp > 0 ? 1.0 / double(all.spp) : 1.0);
+    // The base class's development, as a merge of the parts develops them.
+    all.image = film.Film::develop(*first);
     all.spp_target = range.total;
     all.spp_total = range.total;
     all.sample_offset = 0;
@@ -718,9 +569,33 @@ static RenderResult render_all_passes(const Scene &scene, const Sensor &sensor,
     return all;
 }
 
-RenderResult Integrator::render(const Scene &, const Sensor &, const RenderOptions &) const {
-    FACET_THROW("the integrator {} cannot render images", to_string());
+/// A part's raw channels (FilmBuffer::raw_channel_names) after its developed ones.
+void append_raw_channels(Image &image, const std::vector<std::string> &names,
+                         const std::vector<float> &raw) {
+    const size_t pixels = size_t(image.width) * size_t(image.height), nr = names.size();
+    const size_t nd = size_t(image.channels), n = nd + nr;
+    if (raw.size() != pixels * nr)
+        FACET_THROW("the render's raw sums ({} values) do not match its {}x{} image", raw.size(),
+                    image.width, image.height);
+    std::vector<float> data(pixels * n);
+    for (size_t i = 0; i < pixels; ++i) {
+        std::copy_n(image.data.data() + i * nd, nd, data.data() + i * n);
+        std::copy_n(raw.data() + i * nr, nr, data.data() + i * n + nd);
+    }
+    image.data = std::move(data);
+    image.channels = int(n);
+    image.channel_names.insert(image.channel_names.end(), names.begin(), names.end());
 }
+
+/// Where the scene file declares `object` (its tag); none for objects not loaded from a file.
+Location declared_at(const Scene &scene, const Object *object) {
+    if (const std::shared_ptr<SceneDescription> &d = scene.description())
+        for (const SceneDescription::Node &node : d->nodes)
+            if (node.instance.get() == object) return node.location;
+    return {};
+}
+
+} // namespace
 
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts) {
     if (opts.threads > hardware_threads()) {
@@ -733,23 +608,15 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
     const Scene::RenderLock lock(scene); // no update() of the scene while it renders
     if (!scene.integrator()) FACET_THROW("the scene has no integrator");
     const Integrator &integrator = *scene.integrator();
-    Film &film = sensor.film();
-    const auto &c = opts.crop;
-    if (c[0] == 0 && c[1] == 0 && c[2] == 0 && c[3] == 0) {
-        film.reset_crop_window();
-    } else {
-        if (c[2] <= c[0] || c[3] <= c[1])
-            FACET_THROW("the crop window x0 y0 x1 y1 = {} {} {} {} is empty (x1 and y1 are "
-                        "exclusive: they must be greater than x0 and y0)",
-                        c[0], c[1], c[2], c[3]);
-        film.set_crop_window(Point2i(c[0], c[1]), Point2i(c[2] - c[0], c[3] - c[1]));
-    }
-    const SampleRange range = render_sample_range(sensor, opts); // validates the options
-    RenderResult result;
+    const Window window = render_window(sensor.film(), opts);
+    render_sample_range(sensor, opts); // validates the options
     try {
         if (opts.pass_count > 1 && opts.pass_index < 0)
-            return render_all_passes(scene, sensor, opts);
-        result = integrator.render(scene, sensor, opts);
+            return render_all_passes(scene, sensor, opts, window, integrator);
+        auto [result, buffer] = render_job(scene, sensor, opts, window, integrator);
+        if (opts.pass_count > 1)
+            append_raw_channels(result.image, buffer->raw_channel_names(), buffer->raw_sums());
+        return std::move(result);
     } catch (const Error &e) {
         // An integrator's own error (its parameters against the render's sample count, say), at
         // the integrator's place in the scene file.
@@ -757,127 +624,6 @@ RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOption
         if (!at.valid()) throw;
         throw Error(at, e.message());
     }
-    if (result.spp_total == 0) {
-        // An integrator that does not fill these in renders one whole part.
-        if (opts.pass_count != 1)
-            FACET_THROW("the integrator {} renders in one part only (it cannot render part {} of "
-                        "{})",
-                        integrator.to_string(), opts.pass_index, opts.pass_count);
-        result.spp_target = range.count;
-        result.spp = range.count;
-        result.sample_offset = range.first;
-        result.spp_total = range.total;
-    }
-    result.pass_index = opts.pass_index;
-    result.pass_count = opts.pass_count;
-    const Point2i o = film.crop_offset(), sz = film.crop_size();
-    result.crop = {{o.x, o.y, o.x + sz.x, o.y + sz.y}};
-    result.film_width = film.size().x;
-    result.film_height = film.size().y;
-    result.accel_seconds = scene.accel_build_seconds();
-    if (result.sampling_seconds == 0.0) result.sampling_seconds = result.seconds;
-    if (opts.pass_count > 1) append_raw_channels(result.image, film);
-    return result;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Interrupt handling
-
-namespace {
-
-std::atomic<bool> *g_interrupt_flag = nullptr;
-volatile sig_atomic_t g_interrupt_signal = 0; ///< the first signal since the install
-std::atomic<unsigned> g_signals_seen{0};      ///< bit `sig` per signal received
-std::atomic<bool> g_deferring{false};
-struct sigaction g_old_sigint, g_old_sighup, g_old_sigterm;
-bool g_handler_installed = false;
-static_assert(std::atomic<unsigned>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
-              "the signal handler uses only lock-free atomics (async-signal-safe)");
-
-extern "C" void facet_interrupt_handler(int sig) {
-    const int saved_errno = errno;
-    if (g_interrupt_signal == 0) g_interrupt_signal = sig;
-    if (g_interrupt_flag) g_interrupt_flag->store(true);
-    const unsigned bit = 1u << unsigned(sig);
-    const bool repeated = (g_signals_seen.fetch_or(bit) & bit) != 0;
-    if (!g_deferring.load()) {
-        // While rendering, a second signal of the same kind takes the default action, so the
-        // user can force quit: the render may take a while to reach a stop, and nothing but its
-        // unfinished passes is lost (no output file is open yet).
-        struct sigaction dfl;
-        std::memset(&dfl, 0, sizeof(dfl));
-        dfl.sa_handler = SIG_DFL;
-        sigemptyset(&dfl.sa_mask);
-        sigaction(sig, &dfl, nullptr);
-    } else if (repeated) {
-        // While the output is written, even a repeated signal is not fatal: the write is bounded
-        // (encoding one image, writing, fsync, reading it back, renaming), force-quitting would
-        // throw away the render the user waited for and leave the temporary file behind, and a
-        // write stuck in the kernel (a dead network file system) would not run a handler anyway
-        // (SIGKILL remains for that). Say why facet has not exited yet.
-        static const char msg[] = "facet: still writing the image; exiting once it is complete\n";
-        ssize_t ignored = ::write(STDERR_FILENO, msg, sizeof(msg) - 1);
-        (void)ignored;
-    }
-    errno = saved_errno;
-}
-
-/// Points SIGINT, SIGHUP and SIGTERM at facet_interrupt_handler (the previous actions into
-/// `old_*` when given).
-void set_interrupt_actions(struct sigaction *old_int, struct sigaction *old_hup,
-                           struct sigaction *old_term) {
-    struct sigaction sa;
-    std::memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = facet_interrupt_handler;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESTART;
-    sigaction(SIGINT, &sa, old_int);
-    sigaction(SIGHUP, &sa, old_hup);
-    sigaction(SIGTERM, &sa, old_term);
-}
-
-} // namespace
-
-void install_interrupt_handler(std::atomic<bool> *flag) {
-    if (g_handler_installed) uninstall_interrupt_handler();
-    g_interrupt_flag = flag;
-    g_interrupt_signal = 0;
-    g_signals_seen = 0;
-    g_deferring = false;
-    set_interrupt_actions(&g_old_sigint, &g_old_sighup, &g_old_sigterm);
-    g_handler_installed = true;
-}
-
-void defer_interrupts() {
-    if (!g_handler_installed) return;
-    g_deferring = true;
-    // Back from the default action a first signal while rendering left for its kind.
-    set_interrupt_actions(nullptr, nullptr, nullptr);
-}
-
-int interrupt_signal() { return int(g_interrupt_signal); }
-
-const char *interrupt_signal_name(int sig) {
-    switch (sig) {
-    case SIGINT:
-        return "SIGINT";
-    case SIGHUP:
-        return "SIGHUP";
-    case SIGTERM:
-        return "SIGTERM";
-    default:
-        return "a signal";
-    }
-}
-
-void uninstall_interrupt_handler() {
-    if (!g_handler_installed) return;
-    sigaction(SIGINT, &g_old_sigint, nullptr);
-    sigaction(SIGHUP, &g_old_sighup, nullptr);
-    sigaction(SIGTERM, &g_old_sigterm, nullptr);
-    g_interrupt_flag = nullptr;
-    g_deferring = false;
-    g_handler_installed = false;
 }
 
 } // namespace facet

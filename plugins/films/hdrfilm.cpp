@@ -111,8 +111,8 @@ public:
         props.get_bool("attach_log", false);
     }
 
-    Image develop() const override {
-        Image rgb = Film::develop();
+    Image develop(const FilmBuffer &buffer) const override {
+        Image rgb = Film::develop(buffer);
         if (m_pixel_format == PixelFormat::RGB || m_pixel_format == PixelFormat::RGBA) return rgb;
 
         // Colour channels become Y or XYZ; alpha and AOVs follow unchanged.

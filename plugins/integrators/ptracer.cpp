@@ -50,144 +50,16 @@ facing the sampled direction, so an environment lights the scene as it does for 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 
 namespace facet {
 
-class ParticleTracer final : public Integrator {
+class ParticleTracer final : public LightTracer {
 public:
-    explicit ParticleTracer(const Properties &props) {
+    explicit ParticleTracer(const Properties &props) : LightTracer(props) {
         m_max_depth = read_max_depth(props, "ptracer");
         m_rr_depth = read_rr_depth(props, "ptracer");
         m_hide_emitters = props.get_bool("hide_emitters", false);
-        m_samples_per_pass = read_samples_per_pass(props);
-        m_timeout = read_timeout(props);
-    }
-
-    RenderResult render(const Scene &scene, const Sensor &sensor,
-                        const RenderOptions &opts) const override {
-        const auto start = std::chrono::steady_clock::now();
-        if (!sensor.supports_direction_sampling())
-            FACET_THROW("ptracer: the sensor {} cannot be connected to (it does not support "
-                        "sampling a direction towards it)",
-                        sensor.to_string());
-        Film &film = sensor.film();
-        // Sample s of the whole render (of range.total samples per pixel) is the light paths
-        // [s·P, (s + 1)·P) for a P-pixel film; a part takes the samples of its range.
-        const SampleRange range = render_sample_range(sensor, opts);
-        if (range.count == 0)
-            FACET_THROW("pass {} of {} has no samples: the {} light paths per pixel of the whole "
-                        "render cannot be split into {} parts",
-                        opts.pass_index, opts.pass_count, range.total, opts.pass_count);
-        std::unique_ptr<Sampler> base_sampler = sensor.sampler().clone();
-        base_sampler->set_sample_count(range.total);
-        base_sampler->seed(0);
-        const uint32_t spp = range.count;
-        if (m_samples_per_pass > 0 && spp % std::min(m_samples_per_pass, spp) != 0)
-            FACET_THROW("ptracer: the sample count ({}) must be a multiple of samples_per_pass "
-                        "({})",
-                        spp, m_samples_per_pass);
-        const uint64_t seed = opts.seed + sensor.sampler().base_seed();
-        const Point2i film_size = film.size();
-        const uint64_t film_pixels = uint64_t(film_size.x) * uint64_t(film_size.y);
-        film.prepare({});
-        film.prepare_splats();
-
-        // Progressive passes of 1, 1, 2, 4, ... light paths per pixel (or samples_per_pass),
-        // each split into a fixed number of work units whatever the thread count
-        // (determinism); the film only ever holds whole passes, so a stopped render's image is
-        // that of the light paths per pixel it reached. Each unit splats into a block of the
-        // whole crop window, so the passes double without a cap: few units for any spp.
-        const std::vector<uint32_t> pass_start =
-            progressive_schedule(spp, m_samples_per_pass, 1u << 30);
-        const size_t passes = pass_start.size() - 1;
-        const uint64_t units_per_pass = std::min<uint64_t>(UnitsPerPass, film_pixels);
-        const size_t total = size_t(units_per_pass) * passes;
-        const int border = ImageBlock::border_for(film.rfilter());
-        const ReconstructionFilter &filter = film.rfilter();
-        FACET_LOG(Info,
-                  "Starting particle tracing ({}x{}, {} light paths per pixel in {} pass{}{}, {} "
-                  "threads)",
-                  film.crop_size().x, film.crop_size().y, spp, passes, passes == 1 ? "" : "es",
-                  opts.pass_count > 1
-                      ? fmt::format(", part {} of {}", opts.pass_index, opts.pass_count)
-                      : "",
-                  render_thread_count(opts));
-        if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
-
-        StopCondition stop{opts.cancel, m_timeout, start};
-        BlockMerger merger(film, /*splat=*/true, size_t(units_per_pass));
-        std::atomic<uint64_t> paths_done{0};
-        const bool have_emitters = !scene.emitters().empty();
-        auto make_worker = [&]() -> std::function<void(size_t)> {
-            auto sampler = std::shared_ptr<Sampler>(base_sampler->clone());
-            return [&, sampler](size_t index) {
-                const size_t pass = index / units_per_pass;
-                const uint64_t unit = index % units_per_pass;
-                // The pass's light paths, numbered over the whole render.
-                const uint64_t first = uint64_t(range.first + pass_start[pass]) * film_pixels,
-                               count =
-                                   uint64_t(pass_start[pass + 1] - pass_start[pass]) * film_pixels;
-                const uint64_t begin = first + count * unit / units_per_pass,
-                               end = first + count * (unit + 1) / units_per_pass;
-                std::unique_ptr<ImageBlock> block = merger.acquire();
-                block->reset(film.crop_offset(), film.crop_size(), border);
-                if (have_emitters)
-                    for (uint64_t i = begin; i < end; ++i) {
-                        // A stop abandons the unit (its pass is incomplete and is dropped).
-                        if ((i - begin) % 64 == 63 && stop()) {
-                            merger.release(std::move(block));
-                            return;
-                        }
-                        sampler->seed(sample_stream_seed(seed, i));
-                        trace(scene, sensor, *sampler, *block, filter);
-                    }
-                // trace() may have cut the last paths short (render_should_stop()); a stop stays
-                // true once it is, so this sees it.
-                if (stop()) {
-                    merger.release(std::move(block));
-                    return;
-                }
-                paths_done.fetch_add(end - begin, std::memory_order_relaxed);
-                merger.submit(index, std::move(block));
-            };
-        };
-        WorkUnitsRun run = run_units(total, opts, stop, paths_done, film_pixels * spp, make_worker);
-        merger.flush();
-
-        RenderResult result;
-        const size_t passes_done = merger.merged() / size_t(units_per_pass);
-        result.blocks_total = total;
-        result.blocks_done = merger.merged();
-        result.cancelled = passes_done < passes;
-        result.timed_out = result.cancelled && run.timed_out;
-        result.spp_target = spp;
-        result.spp = pass_start[passes_done];
-        result.samples = film_pixels * result.spp;
-        result.sample_offset = range.first;
-        result.spp_total = range.total;
-        // The importance of the sensor integrates to one over the whole film: every pixel
-        // receives spp times its value from width x height x spp paths.
-        film.set_splat_scale(result.spp > 0 ? 1.0 / double(result.spp) : 1.0);
-        if (result.cancelled) {
-            const std::string what =
-                fmt::format("after {} of {} passes: the image has {} of {} light paths per "
-                            "pixel{}",
-                            passes_done, passes, result.spp, spp,
-                            result.spp == 0 ? " (no pass was finished: it is black)" : "");
-            if (result.timed_out)
-                FACET_LOG(Warn, "Timeout of {:.2f}s reached {}", m_timeout, what);
-            else
-                FACET_LOG(Warn, "Rendering stopped {}", what);
-        }
-        result.sampling_seconds = run.seconds;
-        const auto develop_start = std::chrono::steady_clock::now();
-        result.image = film.develop();
-        const auto now = std::chrono::steady_clock::now();
-        result.develop_seconds = std::chrono::duration<double>(now - develop_start).count();
-        result.seconds = std::chrono::duration<double>(now - start).count();
-        return result;
     }
 
     std::string to_string() const override {
@@ -198,21 +70,18 @@ public:
                            m_rr_depth, m_hide_emitters);
     }
 
-private:
-    static constexpr uint64_t UnitsPerPass = 64;
-
     /// One sample: the emitter connection (directly visible emitters) and one light path.
-    void trace(const Scene &scene, const Sensor &sensor, Sampler &sampler, ImageBlock &block,
-               const ReconstructionFilter &filter) const {
+    void trace(const Scene &scene, const Sensor &sensor, Sampler &sampler,
+               SplatTarget &film) const override {
         const auto &emitters = scene.emitters();
+        if (emitters.empty()) return;
         const float n_emitters = float(emitters.size());
         auto pick = [&](float u) {
             size_t i = std::min(size_t(u * n_emitters), emitters.size() - 1);
             return emitters[i].get();
         };
         if (m_max_depth != 0 && !m_hide_emitters)
-            connect_emitter(scene, sensor, *pick(sampler.next_1d()), n_emitters, sampler, block,
-                            filter);
+            connect_emitter(scene, sensor, *pick(sampler.next_1d()), n_emitters, sampler, film);
 
         const Emitter &emitter = *pick(sampler.next_1d());
         const Point2f u_dir = sampler.next_2d(), u_pos = sampler.next_2d();
@@ -236,8 +105,7 @@ private:
                     if (correction > 0.f && !scene.ray_test(si.spawn_ray_to(ds.p))) {
                         Color3f f = bsdf->eval(ctx, si, wo);
                         Color3f value = throughput * f * importance * correction;
-                        if (!value.is_black() && value.is_finite())
-                            block.splat(ds.uv, value, filter);
+                        if (!value.is_black() && value.is_finite()) film.splat(ds.uv, value);
                     }
                 }
             }
@@ -285,13 +153,11 @@ private:
     /// Emitters seen directly: a point on the emitter's shape connected to the sensor, weighted
     /// by the emitted radiance towards the sensor and the emitter's cosine.
     void connect_emitter(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
-                         float n_emitters, Sampler &sampler, ImageBlock &block,
-                         const ReconstructionFilter &filter) const {
+                         float n_emitters, Sampler &sampler, SplatTarget &film) const {
         const Point2f u_pos = sampler.next_2d(), u_sensor = sampler.next_2d();
         if (emitter.is_infinite()) {
             if (!emitter.is_delta())
-                connect_environment(scene, sensor, emitter, n_emitters, u_pos, u_sensor, block,
-                                    filter);
+                connect_environment(scene, sensor, emitter, n_emitters, u_pos, u_sensor, film);
             return;
         }
         // Point and spot lights are invisible to a camera; only emitters on shapes are seen.
@@ -315,7 +181,7 @@ private:
         if (L.is_black()) return;
         if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
         Color3f value = L * (cos_theta * n_emitters / ps.pdf) * importance;
-        if (value.is_finite()) block.splat(ds.uv, value, filter);
+        if (value.is_finite()) film.splat(ds.uv, value);
     }
 
     /// An environment seen directly: a direction sampled by the emitter from the sensor's
@@ -325,7 +191,7 @@ private:
     /// that sphere and no cosine. The radiance is the environment's along the connection.
     void connect_environment(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
                              float n_emitters, const Point2f &u_pos, const Point2f &u_sensor,
-                             ImageBlock &block, const ReconstructionFilter &filter) const {
+                             SplatTarget &film) const {
         Interaction ref;
         ref.p = sensor.to_world().apply_point(Point3f(0.f));
         ref.n = Normal3f(0.f);
@@ -353,14 +219,12 @@ private:
         Scene::escaped(Ray(ds.p, -ds.d), miss);
         const Color3f L = emitter.eval(miss);
         Color3f value = L * (dist2 * n_emitters / eds.pdf) * importance;
-        if (!value.is_black() && value.is_finite()) block.splat(ds.uv, value, filter);
+        if (!value.is_black() && value.is_finite()) film.splat(ds.uv, value);
     }
 
     uint32_t m_max_depth;
     uint32_t m_rr_depth;
     bool m_hide_emitters;
-    uint32_t m_samples_per_pass = 0;
-    double m_timeout = -1.0;
 };
 
 } // namespace facet

@@ -41,8 +41,13 @@ public:
         return std::make_unique<LowDiscrepancySampler>(*this);
     }
 
+    uint32_t set_sample_count(uint32_t spp) override {
+        m_sample_count = spp;
+        round_count();
+        return m_sample_count;
+    }
+
     void seed(uint64_t seed_value) override {
-        round_count(); // the render loop may have changed the sample count
         m_pixel_seed = qmc::hash_combine(qmc::hash64(seed_value), uint32_t(m_base_seed));
         m_sample_index = 0;
         m_dimension = 0;

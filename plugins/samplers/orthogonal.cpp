@@ -64,11 +64,15 @@ public:
         return std::unique_ptr<Sampler>(new OrthogonalSampler(*this));
     }
 
-    void seed(uint64_t seed_value) override {
-        // The render loop may have changed the sample count: round it as the constructor does
-        // (without the warning), so sample_count() is the number of samples of the pattern.
+    /// Rounds as the constructor does (without the warning): to the square of a prime.
+    uint32_t set_sample_count(uint32_t spp) override {
+        m_sample_count = spp;
         update_resolution();
         m_sample_count = m_resolution * m_resolution;
+        return m_sample_count;
+    }
+
+    void seed(uint64_t seed_value) override {
         m_pixel_seed = qmc::hash_combine(qmc::hash64(seed_value), uint32_t(m_base_seed));
         m_sample_index = 0;
         m_dimension = 0;

@@ -44,8 +44,13 @@ public:
         return std::make_unique<StratifiedSampler>(*this);
     }
 
+    uint32_t set_sample_count(uint32_t spp) override {
+        m_sample_count = spp;
+        update_resolution();
+        return m_sample_count;
+    }
+
     void seed(uint64_t seed_value) override {
-        update_resolution(); // the render loop may have changed the sample count
         m_pixel_seed = qmc::hash_combine(qmc::hash64(seed_value), uint32_t(m_base_seed));
         m_sample_index = 0;
         m_dimension = 0;

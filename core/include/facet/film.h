@@ -31,8 +31,8 @@ public:
              const ReconstructionFilter &filter);
     /// Splats L at `pos` for a light tracer: the filter weights over the footprint are normalised
     /// to sum to one and only r, g, b receive them (the weight channel stays untouched), so the
-    /// energy of a splat lands on the film whatever the filter. Film::put_splats() takes the
-    /// result.
+    /// energy of a splat lands on the film whatever the filter. FilmBuffer::put_splats() takes
+    /// the result.
     void splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter);
     const Point2i &offset() const { return m_offset; }
     const Point2i &size() const { return m_size; }
@@ -76,8 +76,64 @@ private:
     std::vector<float> m_wx, m_wy; ///< scratch filter weights, reused
 };
 
-/// Film: image size, crop window, reconstruction filter and output format. The `hdrfilm` plugin
-/// derives from it; the base class owns the pixel storage.
+/// The accumulation buffers of one render: for a window of film pixels, Σ w·L (r, g, b), Σ w·aov
+/// per AOV channel and Σ w per pixel, and for a light tracer a splat buffer of r, g, b. A render
+/// owns its buffer; the Film only describes how to develop and store it, so one Film (and one
+/// Scene) may serve any number of renders at once.
+class FilmBuffer {
+public:
+    /// The window `offset` + [0, size) of the film, with the extra channels `aov_names`, and a
+    /// splat buffer when `splats`. Refuses (FACET_THROW) buffers beyond an 8 GiB budget instead
+    /// of failing in the allocator (or the kernel's OOM killer).
+    FilmBuffer(const Point2i &offset, const Point2i &size, std::vector<std::string> aov_names,
+               bool splats = false);
+
+    const Point2i &offset() const { return m_offset; }
+    const Point2i &size() const { return m_size; }
+    const std::vector<std::string> &aov_names() const { return m_aov_names; }
+    bool has_splats() const { return !m_splats.empty(); }
+    /// Doubles per pixel of sums(): r, g, b, the AOVs, weight.
+    size_t channel_count() const { return 4 + m_aov_names.size(); }
+
+    /// Adds a finished block (the render loop calls this in a fixed order). Pixels outside the
+    /// window (parts of the filter border) are dropped.
+    void put_block(const ImageBlock &block);
+    /// Adds the r, g, b channels of `block` (filled with ImageBlock::splat) to the splat buffer;
+    /// development adds that buffer, times splat_scale(), to the normalised image, so splats are
+    /// not divided by sample weights.
+    void put_splats(const ImageBlock &block);
+    /// Factor applied to the splat buffer when developing (1 / light paths per pixel).
+    void set_splat_scale(double scale) { m_splat_scale = scale; }
+    double splat_scale() const { return m_splat_scale; }
+
+    /// channel_count() sums per window pixel, in scanline order.
+    const std::vector<double> &sums() const { return m_sums; }
+    /// 3 splat sums per window pixel (empty without a splat buffer).
+    const std::vector<double> &splats() const { return m_splats; }
+
+    /// Raw channels: the sums the window is developed from, named "facet.sum.R", "facet.sum.G",
+    /// "facet.sum.B", "facet.sum.<aov>" (Σ w·value over the samples that reach the pixel through
+    /// the filter), "facet.weight" (Σ w), then "facet.splat.R/G/B" with a splat buffer. A part
+    /// of a render split into passes carries them (rounded to float) after its developed
+    /// channels, so that passes merge exactly: their sums are added in pass order and developed
+    /// once (develop_pixel), whatever the filter.
+    std::vector<std::string> raw_channel_names() const;
+    /// The raw channels of every window pixel, rounded to float (raw_channel_names() per pixel).
+    std::vector<float> raw_sums() const;
+    /// Replaces the sums (and splats) by `raw`, raw_channel_names() doubles per pixel: the sums
+    /// of several passes added up, developed once.
+    void set_raw_sums(const std::vector<double> &raw);
+
+private:
+    Point2i m_offset, m_size;
+    std::vector<std::string> m_aov_names;
+    std::vector<double> m_sums;   ///< channel_count() per window pixel
+    std::vector<double> m_splats; ///< 3 per window pixel (empty: none)
+    double m_splat_scale = 1.0;
+};
+
+/// Film: image size, crop window, reconstruction filter and output format: a read-only
+/// description during a render. The `hdrfilm` plugin derives from it.
 class Film : public Object {
 public:
     /// Reads width (768), height (576), crop_offset_x/y, crop_width/height and the nested rfilter
@@ -86,61 +142,19 @@ public:
     ObjectType type() const override { return ObjectType::Film; }
 
     Point2i size() const { return m_size; }
+    /// The crop window of the scene file (crop_offset_x/y, crop_width/height).
     Point2i crop_offset() const { return m_crop_offset; }
     Point2i crop_size() const { return m_crop_size; }
-    /// Renders the window `offset` + [0, size) of the film instead of the crop window of the
-    /// scene file (validated against the film size; a FACET_THROW names what is wrong).
-    void set_crop_window(const Point2i &offset, const Point2i &size);
-    /// Back to the crop window of the scene file (crop_offset_x/y, crop_width/height).
-    void reset_crop_window();
+    /// Throws (naming what is wrong) unless the window `offset` + [0, size) is non-empty and lies
+    /// inside the film: a render's own crop window (RenderOptions::crop).
+    void check_crop_window(const Point2i &offset, const Point2i &size) const;
     const ReconstructionFilter &rfilter() const { return *m_filter; }
 
-    /// Clears the storage for a new render without extra channels.
-    void prepare() { prepare({}); }
-    /// Clears the storage for a new render with extra (AOV) channels named `aov_names`.
-    void prepare(const std::vector<std::string> &aov_names);
-    /// Names of the extra channels of the current render.
-    const std::vector<std::string> &aov_names() const { return m_aov_names; }
-    /// Adds a finished block (the render loop calls this in a fixed order). Pixels outside the
-    /// crop window (parts of the filter border) are dropped.
-    void put_block(const ImageBlock &block);
-
-    /// Splatting path (light tracers). Adds the r, g, b channels of `block` (filled with
-    /// ImageBlock::splat) to a separate splat buffer; develop() adds that buffer, times
-    /// splat_scale, to the normalised image, so splats are not divided by sample weights.
-    ///
-    /// Determinism rule: a light tracer splits its light paths into a fixed number of work units
-    /// that does not depend on the thread count, seeds each path's sample stream from (seed, path
-    /// index), gives every unit its own block covering the crop window (plus the filter border)
-    /// and hands the blocks in strictly in unit order (BlockMerger in render.h): the same seed and
-    /// sample count give the same image for any number of threads.
-    void put_splats(const ImageBlock &block);
-    /// Gives the film a (zero) splat buffer, so a light tracer's image has one even before its
-    /// first splat (its raw channels do not depend on how far it got).
-    void prepare_splats();
-    /// Factor applied to the splat buffer by develop() (1 / light paths per pixel).
-    void set_splat_scale(double scale) { m_splat_scale = scale; }
-    double splat_scale() const { return m_splat_scale; }
-    /// Normalised linear RGB (plus alpha when the pixel format asks) of the crop window, followed
-    /// by the AOV channels. Pixels without any sample weight are 0 (and alpha 0). The image's
-    /// window (Image::x, y, full_width, full_height) is the crop window inside the film, so an
-    /// EXR of a crop has the crop as data window and the whole film as display window.
-    virtual Image develop() const;
-
-    /// Raw channels: the sums the crop window is developed from, named "facet.sum.R",
-    /// "facet.sum.G", "facet.sum.B", "facet.sum.<aov>" (Σ w·value over the samples that reach
-    /// the pixel through the filter), "facet.weight" (Σ w), then "facet.splat.R/G/B" when the
-    /// film has a splat buffer. A part of a render split into passes carries them (rounded to
-    /// float) after its developed channels, so that passes merge exactly: their sums are added
-    /// in pass order and developed once (develop_pixel), whatever the filter.
-    std::vector<std::string> raw_channel_names() const;
-    /// The raw channels of every crop pixel, rounded to float (raw_channel_names() per pixel).
-    std::vector<float> raw_sums() const;
-    /// Develops the crop window from `sums` (raw_channel_names() doubles per pixel) and
-    /// `splat_scale` instead of the film's own: the render of several passes in one process.
-    /// The channels are the base class's (R, G, B, A, AOVs): a film that develops into other
-    /// colour channels (hdrfilm's xyz, luminance) is not converted.
-    Image develop_sums(const std::vector<double> &sums, double splat_scale) const;
+    /// Normalised linear RGB (plus alpha when the pixel format asks) of the buffer's window,
+    /// followed by the AOV channels. Pixels without any sample weight are 0 (and alpha 0). The
+    /// image's window (Image::x, y, full_width, full_height) is the buffer's window inside the
+    /// film, so an EXR of a crop has the crop as data window and the whole film as display window.
+    virtual Image develop(const FilmBuffer &buffer) const;
     /// Extension the film writes by default (".exr").
     virtual std::string default_extension() const { return ".exr"; }
     /// Writes `image` to `path` through image I/O (atomically), float16 or float32 as configured.
@@ -153,12 +167,7 @@ public:
 
 protected:
     Point2i m_size, m_crop_offset, m_crop_size;
-    Point2i m_file_crop_offset, m_file_crop_size; ///< the crop window of the scene file
     std::shared_ptr<ReconstructionFilter> m_filter;
-    std::vector<double> m_storage; ///< Σ w·L (3), Σ w·aov (per AOV) and Σ w per crop pixel
-    std::vector<std::string> m_aov_names;
-    std::vector<double> m_splats; ///< Σ splatted r, g, b per crop pixel (empty: none)
-    double m_splat_scale = 1.0;
     bool m_half = true;   ///< component_format float16
     bool m_alpha = false; ///< pixel_format rgba
 };

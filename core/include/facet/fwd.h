@@ -33,6 +33,8 @@ class Shape;
 class Mesh;
 class Sensor;
 class Film;
+class FilmBuffer;
+class ImageBlock;
 class Sampler;
 class Texture;
 class SpectrumTexture;

@@ -10,13 +10,10 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 namespace facet {
-
-class ImageBlock;
 
 struct RenderOptions {
     int threads = 0;   ///< 0 = all cores
@@ -38,7 +35,7 @@ struct RenderOptions {
     /// pass_count x spp samples per pixel: the part takes the samples
     /// [pass_index·T/pass_count, (pass_index+1)·T/pass_count) of every pixel, T being that total
     /// after the sampler's rounding (T = pass_count·spp for the independent sampler). A part's
-    /// image carries the raw sums of its pixels (Film::raw_channel_names) after its developed
+    /// image carries the raw sums of its pixels (FilmBuffer::raw_channel_names) after its developed
     /// channels: the parts merge exactly (sums added in pass order, developed once), whatever
     /// the filter. pass_index -1: every part, one after the other in this process, combined as
     /// their merge combines them (bit-identical to it; a merge of crops of parts too).
@@ -92,8 +89,12 @@ struct RenderResult {
     double first_block_cpu_seconds = 0.0;
 };
 
-/// Renders `sensor` of `scene` with the scene's integrator (Integrator::render). Deterministic:
-/// the same scene, seed and spp give the same image for any thread count.
+/// Renders `sensor` of `scene` with the scene's integrator: a render job that owns everything of
+/// this one render (its sample range, pass schedule, stop condition, accumulation buffers,
+/// timing and result) and runs the integrator's per-sample work in core's loop. The scene, its
+/// sensors and films are only read: any number of renders of one scene may run at once (from
+/// different threads), each giving the image it gives alone. Deterministic: the same scene, seed
+/// and spp give the same image for any thread count.
 RenderResult render(const Scene &scene, const Sensor &sensor, const RenderOptions &opts);
 
 /// Installs SIGINT/SIGHUP/SIGTERM handlers that set `flag` and record the first signal (restored
@@ -109,84 +110,6 @@ void uninstall_interrupt_handler();
 int interrupt_signal();
 /// "SIGINT", "SIGHUP" or "SIGTERM".
 const char *interrupt_signal_name(int sig);
-
-// ---------------------------------------------------------------------------------------------
-// Building blocks of integrators' render loops
-
-/// Seed of one sample stream (a pixel, a light path) from the render seed and an index.
-uint64_t sample_stream_seed(uint64_t seed, uint64_t index);
-
-/// Image blocks that finished, merged into the film strictly in index order, so the result does
-/// not depend on which thread finished first. Also recycles block memory. `splat` blocks go
-/// through Film::put_splats(), the others through Film::put_block().
-class BlockMerger {
-public:
-    /// With `group` > 1 the blocks are merged only in whole groups [g·group, (g+1)·group) (the
-    /// blocks of one pass over the image), so the film only ever holds whole passes.
-    BlockMerger(Film &film, bool splat = false, size_t group = 1);
-    ~BlockMerger();
-    std::unique_ptr<ImageBlock> acquire();
-    /// Hands in block `index` (each index in [0, n) exactly once, or not at all after a
-    /// cancellation); merges every block that is now next in order. Returns the number of blocks
-    /// handed in so far.
-    size_t submit(size_t index, std::unique_ptr<ImageBlock> block);
-    /// Takes back a block that is not handed in (a unit abandoned by a stop).
-    void release(std::unique_ptr<ImageBlock> block);
-    /// After a cancelled render: merges what is left, still in index order (gaps are skipped);
-    /// with groups, the blocks of incomplete groups are dropped instead.
-    void flush();
-    size_t finished();
-    /// Number of blocks merged into the film (whole groups only, with groups).
-    size_t merged();
-
-private:
-    void merge(const ImageBlock &block);
-    Film &m_film;
-    bool m_splat;
-    std::mutex m_mutex;
-    std::map<size_t, std::unique_ptr<ImageBlock>> m_pending;
-    std::vector<std::unique_ptr<ImageBlock>> m_free;
-    size_t m_group = 1;
-    size_t m_next = 0, m_finished = 0;
-};
-
-/// When a render stops early: the cancel flag is set, or `timeout` seconds (if > 0) have passed
-/// since `start`. Cheap enough to ask every few samples.
-struct StopCondition {
-    const std::atomic<bool> *cancel = nullptr;
-    double timeout = -1.0;
-    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-    bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
-    bool timed_out() const;
-    bool operator()() const { return cancelled() || timed_out(); }
-};
-
-/// The passes of a progressive render of `spp` samples per pixel: pass p takes the samples
-/// [s[p], s[p + 1]) of every pixel (s[0] = 0, the last is spp). With `samples_per_pass` > 0
-/// passes of that many; else 1, 1, 2, 4, ... samples, at most `cap` per pass. The render's film
-/// holds whole passes only (BlockMerger groups), so a stopped render has every pixel at the same
-/// spp, s[passes done].
-std::vector<uint32_t> progressive_schedule(uint32_t spp, uint32_t samples_per_pass, uint32_t cap);
-
-/// What run_units() did.
-struct WorkUnitsRun {
-    bool cancelled = false; ///< stopped by the cancel flag before every unit was taken
-    bool timed_out = false; ///< stopped by the timeout before every unit was taken
-    double seconds = 0.0;
-    /// CPU time of the whole process (all its threads, from its start) when the first unit was
-    /// done; 0 when none was.
-    double first_unit_cpu_seconds = 0.0;
-};
-
-/// The render loop of every integrator: runs work units 0..count-1 on opts.threads threads (a
-/// TBB arena; every thread sets flush-to-zero). `make_worker` is called once per thread and
-/// returns the function that runs one unit; each thread takes the next unit index until none is
-/// left or `stop` says so; a unit may itself return early (without handing in its result) when
-/// `stop` says so. The progress line shows work_done / work_total, redrawn by a monitor thread
-/// (so it moves while long units run), which also says "stopping" at the first cancellation.
-WorkUnitsRun run_units(size_t count, const RenderOptions &opts, const StopCondition &stop,
-                       const std::atomic<uint64_t> &work_done, uint64_t work_total,
-                       const std::function<std::function<void(size_t)>()> &make_worker);
 
 /// Number of threads a render with `opts` uses: capped_thread_count(opts.threads).
 int render_thread_count(const RenderOptions &opts);

@@ -50,10 +50,17 @@ public:
         return {x, y};
     }
 
+    /// Samples per pixel of the sampler's pattern.
     uint32_t sample_count() const { return m_sample_count; }
-    void set_sample_count(uint32_t spp) { m_sample_count = spp; }
+    /// Sets the samples per pixel of the pattern to `spp` or, for a sampler whose pattern needs
+    /// a particular count (a square, a power of two), to the count it rounds `spp` to, and
+    /// returns the count set. The render calls it once, on its own copy, before seeding; a
+    /// sampler that cannot take `spp` samples throws.
+    virtual uint32_t set_sample_count(uint32_t spp) {
+        m_sample_count = spp;
+        return m_sample_count;
+    }
     uint64_t base_seed() const { return m_base_seed; }
-    void set_base_seed(uint64_t seed) { m_base_seed = seed; }
 
 protected:
     Sampler(const Sampler &) = default;

@@ -45,10 +45,10 @@ public:
     /// Whether sample_direction() and pdf_direction() are implemented.
     virtual bool supports_direction_sampling() const { return false; }
 
-    Film &film() const { return *m_film; }
-    Sampler &sampler() const { return *m_sampler; }
-    std::shared_ptr<Film> film_ptr() const { return m_film; }
-    std::shared_ptr<Sampler> sampler_ptr() const { return m_sampler; }
+    /// The film and the sampler: descriptions a render reads (it takes its own copy of the
+    /// sampler and its own accumulation buffers), never changes.
+    const Film &film() const { return *m_film; }
+    const Sampler &sampler() const { return *m_sampler; }
     const Transform &to_world() const { return m_to_world; }
 
 protected:

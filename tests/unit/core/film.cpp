@@ -207,9 +207,9 @@ TEST(ImageBlock, GaussianSpreadsSymmetricallyAndDevelopsToTheSample) {
     fp.set_int("width", 8);
     fp.set_int("height", 8);
     auto film = make_film(fp);
-    film->prepare();
-    film->put_block(block);
-    Image img = film->develop();
+    FilmBuffer buffer(film->crop_offset(), film->crop_size(), {});
+    buffer.put_block(block);
+    Image img = film->develop(buffer);
     ASSERT_EQ(img.channels, 3);
     for (int y = 3; y <= 5; ++y)
         for (int x = 3; x <= 5; ++x) {
@@ -246,9 +246,9 @@ TEST(ImageBlock, AOVChannels) {
     fp.set_int("width", 2);
     fp.set_int("height", 2);
     auto film = make_film(fp);
-    film->prepare({"albedo.R", "depth"});
-    film->put_block(block);
-    Image img = film->develop();
+    FilmBuffer buffer(film->crop_offset(), film->crop_size(), {"albedo.R", "depth"});
+    buffer.put_block(block);
+    Image img = film->develop(buffer);
     ASSERT_EQ(img.channels, 5);
     EXPECT_EQ(img.channel_names, (std::vector<std::string>{"R", "G", "B", "albedo.R", "depth"}));
     EXPECT_FLOAT_EQ(img.at(1, 0, 0), 2.f);
@@ -258,7 +258,7 @@ TEST(ImageBlock, AOVChannels) {
 
     ImageBlock plain;
     plain.reset({0, 0}, {2, 2}, 1);
-    EXPECT_THROW(film->put_block(plain), Error); // channel count mismatch
+    EXPECT_THROW(buffer.put_block(plain), Error); // channel count mismatch
 }
 
 TEST(Film, Defaults) {
@@ -319,7 +319,7 @@ TEST(Film, PutBlockKeepsOnlyTheCropWindow) {
     p.set_int("crop_height", 2);
     auto film = make_film(p);
     auto box = make_filter("box");
-    film->prepare();
+    FilmBuffer buffer(film->crop_offset(), film->crop_size(), {});
     ImageBlock block;
     block.reset({2, 3}, {4, 2}, 1);
     // Inside the crop: pixel (3, 4) -> crop pixel (1, 1).
@@ -327,8 +327,8 @@ TEST(Film, PutBlockKeepsOnlyTheCropWindow) {
     block.put({3.5f, 4.5f}, Color3f(3.f, 2.f, 1.f), *box);
     // In the border, outside the crop window: dropped.
     block.put({1.5f, 4.5f}, Color3f(100.f), *box);
-    film->put_block(block);
-    Image img = film->develop();
+    buffer.put_block(block);
+    Image img = film->develop(buffer);
     ASSERT_EQ(img.width, 4);
     ASSERT_EQ(img.height, 2);
     EXPECT_FLOAT_EQ(img.at(1, 1, 0), 2.f);
@@ -345,14 +345,14 @@ TEST(Film, DevelopKnownSamplesWithAlphaAndLuminance) {
     p.set_string("pixel_format", "rgba");
     auto film = make_film(p);
     auto box = make_filter("box");
-    film->prepare();
+    FilmBuffer buffer(film->crop_offset(), film->crop_size(), {});
     ImageBlock block;
     block.reset({0, 0}, {2, 1}, 1);
     block.put({0.2f, 0.5f}, Color3f(1.f, 0.f, 0.f), *box);
     block.put({0.7f, 0.1f}, Color3f(0.f, 1.f, 0.f), *box);
     block.put({0.9f, 0.9f}, Color3f(0.f, 0.f, 4.f), *box);
-    film->put_block(block);
-    Image img = film->develop();
+    buffer.put_block(block);
+    Image img = film->develop(buffer);
     ASSERT_EQ(img.channels, 4);
     EXPECT_EQ(img.channel_names[3], "A");
     EXPECT_FLOAT_EQ(img.at(0, 0, 0), 1.f / 3.f);
@@ -367,11 +367,11 @@ TEST(Film, DevelopKnownSamplesWithAlphaAndLuminance) {
     p.set_int("height", 1);
     p.set_string("pixel_format", "luminance");
     film = make_film(p);
-    film->prepare();
+    FilmBuffer one(film->crop_offset(), film->crop_size(), {});
     block.reset({0, 0}, {1, 1}, 1);
     block.put({0.5f, 0.5f}, Color3f(1.f, 0.5f, 0.25f), *box);
-    film->put_block(block);
-    img = film->develop();
+    one.put_block(block);
+    img = film->develop(one);
     ASSERT_EQ(img.channels, 1);
     EXPECT_EQ(img.channel_names[0], "Y");
     EXPECT_NEAR(img.at(0, 0, 0), Color3f(1.f, 0.5f, 0.25f).luminance(), 1e-6f);
@@ -405,16 +405,16 @@ TEST(Film, SplatsKeepTheirEnergyAndAreScaledNotNormalised) {
     fp.set_int("width", 8);
     fp.set_int("height", 8);
     auto film = make_film(fp);
-    film->prepare();
+    FilmBuffer buffer(film->crop_offset(), film->crop_size(), {}, /*splats=*/true);
     ImageBlock block;
     block.reset({0, 0}, {8, 8}, ImageBlock::border_for(*g));
     block.splat({4.3f, 3.8f}, Color3f(2.f, 1.f, 0.5f), *g);
     block.splat({1.5f, 1.5f}, Color3f(4.f, 0.f, 0.f), *g);
     for (int y = 0; y < block.storage_size().y; ++y)
         for (int x = 0; x < block.storage_size().x; ++x) EXPECT_EQ(block_weight(block, x, y), 0.f);
-    film->put_splats(block);
-    film->set_splat_scale(0.25);
-    Image img = film->develop();
+    buffer.put_splats(block);
+    buffer.set_splat_scale(0.25);
+    Image img = film->develop(buffer);
     double red = 0.0, green = 0.0;
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
@@ -430,11 +430,51 @@ TEST(Film, SplatsKeepTheirEnergyAndAreScaledNotNormalised) {
     ImageBlock samples;
     samples.reset({0, 0}, {8, 8}, ImageBlock::border_for(*g));
     samples.put({6.5f, 6.5f}, Color3f(1.f), *g);
-    film->put_block(samples);
-    Image both = film->develop();
+    buffer.put_block(samples);
+    Image both = film->develop(buffer);
     EXPECT_NEAR(both.at(6, 6, 0), 1.f + img.at(6, 6, 0), 1e-6f);
     EXPECT_NEAR(both.at(4, 3, 1), img.at(4, 3, 1), 1e-6f);
-    // prepare() clears the splats and the scale.
-    film->prepare();
-    EXPECT_EQ(film->develop().at(4, 3, 1), 0.f);
+    // A buffer without a splat buffer refuses splats; a new buffer starts at zero.
+    FilmBuffer plain(film->crop_offset(), film->crop_size(), {});
+    EXPECT_THROW(plain.put_splats(block), Error);
+    EXPECT_EQ(film->develop(plain).at(4, 3, 1), 0.f);
+}
+
+// The raw channels of a part (its sums, rounded to float) developed again after being added up
+// give what the buffer develops to; a window outside the film and a huge buffer are refused.
+TEST(FilmBuffer, RawSumsRoundTripAndLimits) {
+    auto g = make_filter("gaussian");
+    Properties fp;
+    fp.set_int("width", 8);
+    fp.set_int("height", 6);
+    auto film = make_film(fp);
+    FilmBuffer buffer({2, 1}, {5, 4}, {"depth"}, /*splats=*/true);
+    ImageBlock block;
+    block.reset({0, 0}, {8, 6}, ImageBlock::border_for(*g), 1);
+    const float depth = 3.f;
+    block.put({3.25f, 2.5f}, Color3f(1.f, 2.f, 4.f), &depth, *g);
+    buffer.put_block(block);
+    ImageBlock splats;
+    splats.reset({0, 0}, {8, 6}, ImageBlock::border_for(*g));
+    splats.splat({4.5f, 3.5f}, Color3f(8.f), *g);
+    buffer.put_splats(splats);
+    EXPECT_EQ(buffer.raw_channel_names(),
+              (std::vector<std::string>{"facet.sum.R", "facet.sum.G", "facet.sum.B",
+                                        "facet.sum.depth", "facet.weight", "facet.splat.R",
+                                        "facet.splat.G", "facet.splat.B"}));
+    const std::vector<float> raw = buffer.raw_sums();
+    ASSERT_EQ(raw.size(), size_t(5 * 4 * 8));
+    FilmBuffer again({2, 1}, {5, 4}, {"depth"}, true);
+    again.set_raw_sums(std::vector<double>(raw.begin(), raw.end()));
+    const Image a = film->develop(buffer), b = film->develop(again);
+    ASSERT_EQ(a.data.size(), b.data.size());
+    for (size_t i = 0; i < a.data.size(); ++i) EXPECT_NEAR(a.data[i], b.data[i], 1e-6f) << i;
+    EXPECT_EQ(a.x, 2);
+    EXPECT_EQ(a.y, 1);
+    EXPECT_EQ(a.full_width, 8);
+    EXPECT_THROW(again.set_raw_sums({1.0, 2.0}), Error);
+    EXPECT_THROW(film->check_crop_window({4, 0}, {5, 1}), Error);
+    EXPECT_THROW(film->check_crop_window({0, 0}, {0, 1}), Error);
+    EXPECT_NO_THROW(film->check_crop_window({7, 5}, {1, 1}));
+    EXPECT_THROW(FilmBuffer({0, 0}, {1 << 20, 1 << 20}, {}), Error); // beyond the 8 GiB budget
 }

@@ -244,9 +244,9 @@ TEST(Filters, NegativeLobesAreSummedWithTheirSign) {
     fp.set_int("height", 1);
     fp.set_object("rfilter", f);
     auto film = PluginRegistry::instance().create_as<Film>(ObjectType::Film, fp);
-    film->prepare();
-    film->put_block(block);
-    Image img = film->develop();
+    FilmBuffer buffer(film->crop_offset(), film->crop_size(), {});
+    buffer.put_block(block);
+    Image img = film->develop(buffer);
     for (int x : {2, 3, 4, 5}) {
         EXPECT_NEAR(img.at(x, 0, 0), 2.f, 1e-5f) << x;
         EXPECT_NEAR(img.at(x, 0, 2), 0.5f, 1e-5f) << x;
