@@ -49,8 +49,6 @@ struct PyScene {
     std::map<std::string, std::string> params;
     std::string text;  ///< the XML, for facet:scene_hash (as `facet render` computes it)
     std::string edits; ///< the values traverse() changed, in order (also in facet:scene_hash)
-    /// A render develops into the sensor's film: one render of a scene at a time.
-    std::shared_ptr<std::mutex> render_mutex = std::make_shared<std::mutex>();
 };
 
 std::string file_text(const std::string &path) {
@@ -273,14 +271,9 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     opts.cancel = &cancel;
 
     std::shared_ptr<Scene> keep = s.scene; // alive while the render thread runs
-    std::shared_ptr<std::mutex> mutex = s.render_mutex;
     std::optional<py::error_already_set> interrupt;
     RenderResult result = run_interruptible(
-        cancel, interrupt,
-        [keep, mutex, lock, &sensor, opts]() {
-            std::lock_guard<std::mutex> lock(*mutex);
-            return render(*keep, sensor, opts);
-        },
+        cancel, interrupt, [keep, lock, &sensor, opts]() { return render(*keep, sensor, opts); },
         poll);
     if (callback && reported < 1.0 && !result.cancelled) progress(1.0);
 
