@@ -1,3 +1,5 @@
+#include "mesh_inline.h"
+
 #include <facet/bsdf.h>
 #include <facet/emitter.h>
 #include <facet/logger.h>

@@ -1,3 +1,4 @@
+#include "mesh_inline.h"
 #include "scene_queries.h"
 #include "stats.h"
 

@@ -5,7 +5,6 @@
 #include <facet/warp.h>
 
 #include <algorithm>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -20,21 +19,11 @@ public:
     BoundingBox3f bbox() const override { return m_bbox; }
     float surface_area() const override { return m_area; }
     RTCGeometry embree_geometry(RTCDevice device) const override;
-    /// Final: the scene computes the hits of meshes with has_flat_hit() by flat_hit() directly.
+    /// Final: every mesh, whatever loader filled it, computes its hits the same way.
     void compute_surface_interaction(const Ray &ray, float t, uint32_t prim_index,
                                      const Point2f &uv, SurfaceInteraction &si) const final;
-    /// True for a flat mesh without texture coordinates (the common case), whose hits
-    /// flat_hit() computes.
-    bool has_flat_hit() const { return !m_face_table.empty() && m_uvs.empty(); }
-    /// compute_surface_interaction() of a mesh with has_flat_hit(), inline for
-    /// Scene::ray_intersect() (no virtual call): p, n, sh_frame, uv, dp_du, dp_dv, shape and
-    /// prim_index of the hit at Embree's barycentrics `uv` on face `prim_index`.
-    void flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceInteraction &si) const;
-    PositionSample sample_position(const Point2f &u) const override;
-    /// sample_position() written into `ps` (p, n, uv, pdf and delta), inline for the triangle
-    /// lights of Scene::sample_emitter_direction(). Only for a mesh with area (surface_area() >
-    /// 0): sample_position() checks it.
-    void sample_point(Point2f u, PositionSample &ps) const;
+    /// Final: a point uniform in area, whatever loader filled the mesh.
+    PositionSample sample_position(const Point2f &u) const final;
     bool is_mesh() const override { return true; }
     std::string to_string() const override;
 
@@ -102,6 +91,14 @@ protected:
     void build_face_table();
 
 private:
+    friend class Scene; // reaches the two below without a virtual call (core/src/mesh_inline.h)
+    /// True for a flat mesh without texture coordinates, whose hits flat_hit() computes.
+    bool has_flat_hit() const { return !m_face_table.empty() && m_uvs.empty(); }
+    /// compute_surface_interaction() of a mesh with has_flat_hit().
+    void flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceInteraction &si) const;
+    /// sample_position() written into `ps`; only for a mesh with area.
+    void sample_point(Point2f u, PositionSample &ps) const;
+
     /// Per face when the mesh is flat (else empty): geometric normal, shading normal and the
     /// shading frame's s, 9 floats (the frame's t is cross(ns, s)).
     std::vector<float> m_face_table;
@@ -115,63 +112,5 @@ private:
     float m_area = 0.f;
     BoundingBox3f m_bbox;
 };
-
-inline void Mesh::flat_hit(uint32_t prim_index, const Point2f &uv, SurfaceInteraction &si) const {
-    FACET_ASSERT(has_flat_hit());
-    const uint32_t *face = &m_faces[3 * size_t(prim_index)];
-    const Point3f p0 = vertex_position(face[0]), p1 = vertex_position(face[1]),
-                  p2 = vertex_position(face[2]);
-    // Embree's (u, v) weight vertices 1 and 2; they serve as the texture coordinates too.
-    const float b1 = uv.x, b2 = uv.y, b0 = 1.f - b1 - b2;
-    si.shape = this;
-    si.prim_index = prim_index;
-    // Interpolating the vertices is more accurate than ray(t) far from the ray origin.
-    si.p = p0 * b0 + p1 * b1 + p2 * b2;
-    // Normals and the shading frame of the face were computed at load. They are copied from
-    // the table, not from registers: spilled and copied back as 8-byte words, the floats
-    // would be read before their 4-byte stores had reached the cache (a stall on every hit).
-    const float *f = &m_face_table[9 * size_t(prim_index)];
-    std::memcpy(static_cast<void *>(&si.n), f, sizeof(Normal3f));
-    std::memcpy(static_cast<void *>(&si.sh_frame.n), f + 3, sizeof(Normal3f));
-    std::memcpy(static_cast<void *>(&si.sh_frame.s), f + 6, sizeof(Vector3f));
-    si.sh_frame.t = cross(Normal3f(f[3], f[4], f[5]), Vector3f(f[6], f[7], f[8]));
-    si.uv = Point2f(b1, b2);
-    si.dp_du = p1 - p0;
-    si.dp_dv = p2 - p0;
-}
-
-inline void Mesh::sample_point(Point2f u, PositionSample &ps) const {
-    // Pick a triangle in proportion to its area and reuse the sample within its interval: the
-    // first whose cumulative area exceeds u.x (the last one if none does), by a linear scan for
-    // the few triangles of a typical light. (The rarer cases are out of line, so that this
-    // stays small enough to inline.)
-    const size_t count = m_area_cdf.size();
-    size_t f = 0;
-    if (count <= 8) {
-        while (f + 1 < count && !(u.x < m_area_cdf[f])) ++f;
-    } else {
-        f = find_area_face(u.x);
-    }
-    const float lo = f > 0 ? m_area_cdf[f - 1] : 0.f, hi = m_area_cdf[f];
-    u.x = hi > lo ? clamp((u.x - lo) / (hi - lo), 0.f, OneMinusEpsilon) : 0.f;
-
-    const uint32_t i0 = m_faces[3 * f], i1 = m_faces[3 * f + 1], i2 = m_faces[3 * f + 2];
-    const Point3f p0 = vertex_position(i0), p1 = vertex_position(i1), p2 = vertex_position(i2);
-    const Point2f b = warp::square_to_uniform_triangle(u);
-    const float b0 = 1.f - b.x - b.y;
-    ps.p = p0 * b0 + p1 * b.x + p2 * b.y;
-    if (!m_face_table.empty()) {
-        const float *t = &m_face_table[9 * f];
-        ps.n = Normal3f(t[0], t[1], t[2]);
-    } else {
-        ps.n = face_normal(f);
-    }
-    // b goes to ps.uv first: kept aside across the face_uv() call instead, it was copied from
-    // the stack as one 8-byte word over two fresh 4-byte stores (a store-forwarding stall).
-    ps.uv = b;
-    if (has_uvs()) ps.uv = face_uv(f, ps.uv);
-    ps.pdf = 1.f / m_area;
-    ps.delta = false;
-}
 
 } // namespace facet

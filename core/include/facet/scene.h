@@ -126,8 +126,8 @@ private:
         float inv_area = 0.f;       ///< of a triangle light: its area density
     };
     std::vector<EmitterEntry> m_emitter_table;
-    /// Per Embree geometry id: its shape, and the same shape as a Mesh when the hits on it are
-    /// Mesh::flat_hit() (computed inline, without the virtual call).
+    /// Per Embree geometry id: its shape, and the same shape as a Mesh when the scene computes
+    /// the hits on it itself.
     struct GeometryEntry {
         const Shape *shape = nullptr;
         const Mesh *flat_mesh = nullptr;
