@@ -291,11 +291,10 @@ void Scene::build(const Properties &props, Scene *previous) {
         EmitterEntry entry;
         entry.emitter = emitter.get();
         const Shape *shape = emitter->shape();
-        Color3f radiance;
-        if (shape && shape->is_mesh() && emitter->uniform_area_radiance(radiance) &&
-            shape->surface_area() > 0.f) {
+        const std::optional<Color3f> radiance = emitter->constant_radiance();
+        if (shape && shape->is_mesh() && radiance && shape->surface_area() > 0.f) {
             entry.mesh = static_cast<const Mesh *>(shape);
-            entry.radiance = radiance;
+            entry.radiance = *radiance;
             entry.inv_area = 1.f / shape->surface_area();
         }
         emitter->set_scene_index(uint32_t(m_emitter_table.size()));

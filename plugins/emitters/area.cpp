@@ -81,10 +81,9 @@ public:
         return {origin.spawn_ray(d), radiance_at(at) * (Pi / ps.pdf)};
     }
 
-    bool uniform_area_radiance(Color3f &radiance) const override {
-        if (m_radiance->is_spatially_varying()) return false;
-        radiance = m_radiance->mean();
-        return true;
+    std::optional<Color3f> constant_radiance() const override {
+        if (m_radiance->is_spatially_varying()) return std::nullopt;
+        return m_radiance->mean();
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {

@@ -5,6 +5,7 @@
 #include <facet/logger.h>
 #include <facet/object.h>
 
+#include <optional>
 #include <utility>
 
 namespace facet {
@@ -58,10 +59,13 @@ public:
         FACET_THROW("{} cannot sample emitted rays", to_string());
     }
 
-    /// For the scene's flat emitter table: true (with the radiance) for an emitter that is
-    /// exactly a constant `radiance` leaving the front side of its shape, sampled uniformly by
-    /// area, so that the scene may sample a triangle mesh carrying it without virtual calls.
-    virtual bool uniform_area_radiance(Color3f & /*radiance*/) const { return false; }
+    /// The emitter as a value, when it is the simplest surface emitter: one constant radiance
+    /// leaving the front side of its shape (the side its normal points to), the same at every
+    /// point and in every direction of that side, nothing from the back. An emitter that returns
+    /// it promises that eval(), sample_direction() and pdf_direction() are those of this value
+    /// with the shape's own direction sampling; the scene may then compute them from the value
+    /// and the shape. Default: none (the scene always asks the emitter).
+    virtual std::optional<Color3f> constant_radiance() const { return std::nullopt; }
     /// Position in the emitter list of the scene that holds it (set by the scene).
     uint32_t scene_index() const { return m_scene_index; }
     void set_scene_index(uint32_t index) { m_scene_index = index; }

@@ -116,9 +116,8 @@ private:
     std::vector<std::shared_ptr<Emitter>> m_environment;
     std::vector<std::shared_ptr<Sensor>> m_sensors;
     std::shared_ptr<Integrator> m_integrator;
-    /// One entry per emitter of m_emitters, in the same order. Constant-radiance area lights on
-    /// triangle meshes (the common light) are sampled and their pdf computed from the entry by
-    /// one non-virtual path; every other emitter goes through its own virtual methods.
+    /// One entry per emitter of m_emitters, in the same order: for an emitter with a
+    /// constant_radiance() on a mesh, that radiance and the mesh's area density.
     struct EmitterEntry {
         const Emitter *emitter = nullptr;
         const Mesh *mesh = nullptr; ///< set for a triangle light
