@@ -74,6 +74,13 @@ endif()
 step("render through FACET_PLUGIN_PATH" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PATH=${WORK}/phong-build
      ${FACET} render ${SOURCE_DIR}/tests/sdk/phong/scene.xml -o ${WORK}/phong2.exr -q -D spp=1)
 
+# An area light written against the Emitter interface alone (no constant_radiance()) renders
+# the image facet's own `area` renders: the scene's shortcut for constant lights on meshes
+# changes nothing a user's light can see.
+build_project(${SOURCE_DIR}/tests/sdk/plainarea ${WORK}/plainarea-build -DCMAKE_BUILD_TYPE=Release)
+step("plainarea against area" ${WORK}/plainarea-build/plainarea_check
+     ${SOURCE_DIR}/tests/sdk/plainarea/scene.xml ${WORK}/plainarea-build)
+
 # 3. The templates: `facet new-plugin <kind>` writes a project that builds (optimised without
 # being asked), lists its parameter table, renders the scene it comes with and, for the kinds
 # facet's chi2 tests, passes chi2.
