@@ -71,14 +71,14 @@ DirectionSample Shape::sample_direction(const Interaction &ref, const Point2f &u
     // Area density to solid angle: dA = r² / |cos θ| dω, computed as pdf_direction() does, so
     // that it gives back exactly this pdf for the sample.
     float cos_theta = absdot(ds.n, ds.d);
-    ds.pdf = cos_theta > 0.f ? ps.pdf * ds.dist * ds.dist / cos_theta : 0.f;
+    ds.pdf = cos_theta > 0.f ? ps.pdf * (ds.dist * ds.dist) / cos_theta : 0.f;
     return ds;
 }
 
 float Shape::pdf_direction(const Interaction &ref, const DirectionSample &ds) const {
     float cos_theta = absdot(ds.n, ds.d);
     if (!(cos_theta > 0.f)) return 0.f;
-    return pdf_position(ds) * ds.dist * ds.dist / cos_theta;
+    return pdf_position(ds) * (ds.dist * ds.dist) / cos_theta;
 }
 
 void Shape::set_emitter(std::shared_ptr<Emitter> emitter) {
