@@ -1,5 +1,5 @@
 # The plugin SDK test (label sdk): install this build into a scratch prefix, build tests/sdk/phong,
-# tests/sdk/plainarea and a `facet new-plugin` project of every kind out of tree against it,
+# tests/sdk/plain and a `facet new-plugin` project of every kind out of tree against it,
 # render and chi2-test them with the installed `facet`. See tests/sdk/run_sdk_test.cmake.
 if(NOT TARGET facet_cli)
     return()

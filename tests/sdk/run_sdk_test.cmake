@@ -74,12 +74,13 @@ endif()
 step("render through FACET_PLUGIN_PATH" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PATH=${WORK}/phong-build
      ${FACET} render ${SOURCE_DIR}/tests/sdk/phong/scene.xml -o ${WORK}/phong2.exr -q -D spp=1)
 
-# An area light written against the Emitter interface alone (no constant_radiance()) renders
-# the image facet's own `area` renders: the scene's shortcut for constant lights on meshes
-# changes nothing a user's light can see.
-build_project(${SOURCE_DIR}/tests/sdk/plainarea ${WORK}/plainarea-build -DCMAKE_BUILD_TYPE=Release)
-step("plainarea against area" ${WORK}/plainarea-build/plainarea_check
-     ${SOURCE_DIR}/tests/sdk/plainarea/scene.xml ${WORK}/plainarea-build)
+# An area light without constant_radiance() and a sampler that does not expose its generator,
+# written against the interfaces alone, render the images facet's own `area` and `independent`
+# render: the shortcuts for constant mesh lights and PCG32 samplers change nothing a user's
+# plugin can see.
+build_project(${SOURCE_DIR}/tests/sdk/plain ${WORK}/plain-build -DCMAKE_BUILD_TYPE=Release)
+step("plain plugins against facet's" ${WORK}/plain-build/plain_check
+     ${SOURCE_DIR}/tests/sdk/plain/scene.xml ${WORK}/plain-build)
 
 # 3. The templates: `facet new-plugin <kind>` writes a project that builds (optimised without
 # being asked), lists its parameter table, renders the scene it comes with and, for the kinds

@@ -35,10 +35,12 @@ public:
     uint32_t sample_index() const { return m_sample_index; }
     virtual float next_1d() = 0;
     virtual Point2f next_2d() = 0;
-    /// next_1d() and next_2d() for the hot paths (the render loop, the integrators): the same
-    /// values, without a virtual call when the sampler is one PCG32 stream per sample (it then
-    /// points m_stream at it, and its next_1d() and next_2d() must be these). The values of such
-    /// a sampler do not depend on the dimension, which these leave as it is.
+    /// next_1d() and next_2d(), for the callers that draw many values (the render loop, the
+    /// integrators). The contract: a sampler whose values are the successive floats of one PCG32
+    /// generator per sample (random.h) may expose that generator by pointing m_stream at it;
+    /// its next_1d() and next_2d() must then draw from it exactly as these do, and its values
+    /// may not depend on the dimension (which these leave as it is). Any sampler may leave
+    /// m_stream null: these then call next_1d() and next_2d(), and the values are the same.
     float draw_1d() {
         if (!m_stream) return next_1d();
         return m_stream->next_float();

@@ -63,5 +63,4 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::PlainArea, Emitter, "plainarea", "Constant area light (SDK test)",
-                    DOC)
+FACET_EXPORT_PLUGIN(facet::PlainArea, Emitter, "plainarea", "Constant area light (SDK test)", DOC)
