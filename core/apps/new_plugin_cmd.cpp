@@ -411,9 +411,9 @@ their mean is the estimate. Rays that hit nothing give 0. The value goes to all 
 
 // Conventions (facet/integrator.h): a SamplingIntegrator estimates the radiance along one camera
 // ray in sample(); facet's render loop takes the image in blocks and passes on all threads around
-// it (an integrator implements no loop of its own). The
-// estimate may use only the sampler for randomness (so the image is the same for any number of
-// threads), and sample() runs on many threads at once: it must not modify the integrator.
+// it (an integrator implements no loop of its own). The estimate may use only the sampler for
+// randomness (so the image is the same for any number of threads), and sample() runs on many
+// threads at once: it must not modify the integrator.
 // The base class reads timeout, samples_per_pass and block_size (rows of the table above).
 
 #include <facet/frame.h>
