@@ -193,6 +193,8 @@ private:
     /// The sample range, the sampler set to the whole render's sample count, the seed and the
     /// pass schedule; `what` names a sample in messages ("samples", "light paths").
     void plan(const Integrator &integrator, uint32_t cap, const char *what);
+    /// Logs what the render takes: "Starting <kind> (WxH, <spp> <what> in <n> passes, ...)".
+    void announce(const char *kind, const char *what) const;
     RenderResult run_sampling(const SamplingIntegrator &integrator);
     RenderResult run_light_tracing(const LightTracer &tracer);
     /// Samples [first, last) of every pixel of block `index` of the grid into `block`; false
@@ -254,6 +256,17 @@ void RenderJob::plan(const Integrator &integrator, uint32_t cap, const char *wha
     m_stop = StopCondition{m_opts.cancel, m_timeout, m_start};
 }
 
+void RenderJob::announce(const char *kind, const char *what) const {
+    const size_t passes = m_pass_start.size() - 1;
+    FACET_LOG(Info, "Starting {} ({}x{}, {} {} in {} pass{}{}, {} threads)", kind, m_window.size.x,
+              m_window.size.y, m_range.count, what, passes, passes == 1 ? "" : "es",
+              m_opts.pass_count > 1
+                  ? fmt::format(", part {} of {}", m_opts.pass_index, m_opts.pass_count)
+                  : "",
+              render_thread_count(m_opts));
+    if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
+}
+
 RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     if (m_opts.block_size < 0)
         FACET_THROW("the block size must be positive, got {}", m_opts.block_size);
@@ -277,13 +290,7 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     const BlockGrid grid(m_film, m_window, bs);
     const size_t blocks = grid.blocks(), passes = m_pass_start.size() - 1;
     const uint32_t spp = m_range.count;
-    FACET_LOG(Info, "Starting render job ({}x{}, {} samples in {} pass{}{}, {} threads)",
-              m_window.size.x, m_window.size.y, spp, passes, passes == 1 ? "" : "es",
-              m_opts.pass_count > 1
-                  ? fmt::format(", part {} of {}", m_opts.pass_index, m_opts.pass_count)
-                  : "",
-              render_thread_count(m_opts));
-    if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
+    announce("render job", "samples");
 
     m_merger = std::make_unique<BlockMerger>(*m_buffer, /*splat=*/false, blocks);
     std::atomic<uint64_t> samples_done{0};
@@ -398,15 +405,7 @@ RenderResult RenderJob::run_light_tracing(const LightTracer &tracer) {
     const uint64_t units = std::min<uint64_t>(UnitsPerPass, film_pixels);
     const size_t passes = m_pass_start.size() - 1;
     const uint32_t spp = m_range.count;
-    FACET_LOG(Info,
-              "Starting particle tracing ({}x{}, {} light paths per pixel in {} pass{}{}, {} "
-              "threads)",
-              m_window.size.x, m_window.size.y, spp, passes, passes == 1 ? "" : "es",
-              m_opts.pass_count > 1
-                  ? fmt::format(", part {} of {}", m_opts.pass_index, m_opts.pass_count)
-                  : "",
-              render_thread_count(m_opts));
-    if (m_timeout > 0.0) FACET_LOG(Info, "Timeout: {:.2f} seconds", m_timeout);
+    announce("particle tracing", "light paths per pixel");
 
     m_merger = std::make_unique<BlockMerger>(*m_buffer, /*splat=*/true, size_t(units));
     std::atomic<uint64_t> paths_done{0};
