@@ -50,6 +50,14 @@ struct SceneOptions {
 /// Adds -D, -a, -t, -s, -v, -q, --lenient and the scene argument to `app`.
 void add_scene_options(CLI::App &app, SceneOptions &opts);
 
+/// Applies -v/-q to the logger (load_scene() does too; a command calls it first when it logs
+/// before loading).
+void set_log_level(const SceneOptions &opts);
+
+/// Adds -m/--mode, the colour mode (Mitsuba's `-m` variant names), to `app`; its value is
+/// default_mode() unless given, for resolve_mode().
+void add_mode_option(CLI::App &app, std::string &mode);
+
 /// Applies -v/-q to the logger, -a to the plugin registry, fixes the thread count (warning for
 /// -t < 1) and the Embree device, then loads the scene with the -D values.
 std::shared_ptr<Scene> load_scene(SceneOptions &opts);

@@ -4,6 +4,7 @@
 #include "commands.h"
 
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/xml.h>
 
 #include <CLI/CLI.hpp>
@@ -16,7 +17,7 @@
 namespace fs = std::filesystem;
 
 int info_main(int argc, char **argv) {
-    std::string scene;
+    std::string scene, mode;
     std::vector<std::string> defines, dirs;
     int sensor = 0;
     bool film_size = false, lenient = false;
@@ -31,7 +32,9 @@ int info_main(int argc, char **argv) {
     app.add_flag("--film-size", film_size,
                  "Print only \"WIDTH HEIGHT\" of the sensor's film (for scripts)");
     app.add_flag("--lenient", lenient, "Unused -D values are warnings, not errors");
+    facet::cli::add_mode_option(app, mode);
     if (int code = facet::cli::parse(app, argc, argv); code >= 0) return code;
+    mode = facet::resolve_mode(mode);
 
     facet::LoadOptions load;
     load.lenient = lenient;
@@ -65,7 +68,7 @@ int info_main(int argc, char **argv) {
         return 0;
     }
     fmt::print("scene: {}\n", scene);
-    fmt::print("mode: scalar_rgb\n");
+    fmt::print("mode: {}\n", mode);
     fmt::print("film: {} x {} ({}, sensor {})\n", s.width, s.height, s.film, sensor);
     fmt::print("spp: {} ({})\n", s.spp, s.sampler);
     fmt::print("integrator: {}\n", info.integrator);

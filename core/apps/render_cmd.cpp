@@ -6,6 +6,7 @@
 #include <facet/image.h>
 #include <facet/integrator.h>
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/output_metadata.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
@@ -46,15 +47,28 @@ void add_scene_options(CLI::App &app, SceneOptions &opts) {
                  "Unused -D values and unused scene parameters are warnings, not errors");
 }
 
+void add_mode_option(CLI::App &app, std::string &mode) {
+    mode = default_mode();
+    app.add_option("-m,--mode", mode,
+                   fmt::format("Colour mode, by Mitsuba's variant names: {} (default {}); the "
+                               "llvm_, cuda_ and _ad_ names of a mode render as that mode",
+                               fmt::join(modes(), ", "), default_mode()))
+        ->type_name("MODE");
+}
+
 int effective_threads(int threads) { return capped_thread_count(std::max(threads, 0)); }
 
-std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
+void set_log_level(const SceneOptions &opts) {
     if (opts.verbose >= 2)
         Logger::set_level(LogLevel::Trace);
     else if (opts.verbose == 1)
         Logger::set_level(LogLevel::Debug);
     else if (opts.quiet)
         Logger::set_level(LogLevel::Warn);
+}
+
+std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
+    set_log_level(opts);
 
     if (opts.threads_given && opts.threads < 1) {
         FACET_LOG(Warn, "-t {} is less than 1: using 1 thread", opts.threads);
@@ -207,6 +221,7 @@ std::string format_seconds(double s) {
 /// The options of `facet render` beyond the scene's.
 struct RenderCommand {
     cli::SceneOptions scene;
+    std::string mode; ///< -m, resolved before the first scene loads
     std::vector<std::string> more_scenes;
     std::string output, ocio_config, display, view, looks;
     uint64_t seed = 0;
@@ -218,6 +233,7 @@ struct RenderCommand {
 
 void add_render_options(CLI::App &app, RenderCommand &c) {
     cli::add_scene_options(app, c.scene);
+    cli::add_mode_option(app, c.mode);
     app.add_option("more_scenes", c.more_scenes,
                    "Further scene files, rendered one after the other with the same options");
     app.add_option("-o,--output", c.output,
@@ -512,6 +528,8 @@ int render_main(int argc, char **argv) {
     c.pass_given = app.count("--pass") > 0;
     if (app.count("--spp") > 0 && c.spp < 1)
         FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", c.spp);
+    cli::set_log_level(c.scene); // -q hides the note of a vectorised mode name
+    c.mode = resolve_mode(c.mode);
 
     // Several scenes render one after the other; the first error or signal ends the sequence.
     for (const std::string &scene_path : scenes_to_render(c)) {

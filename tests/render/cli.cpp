@@ -385,6 +385,73 @@ TEST_F(CliTest, BadCropOrPassIsOneLineError) {
     EXPECT_NE(line.find("--passes"), std::string::npos) << line;
 }
 
+TEST_F(CliTest, ModeScalarRgbIsTheDefault) {
+    ASSERT_EQ(run("render scene.xml -q -o plain.exr").code, 0);
+    Result r = run("render scene.xml -q -m scalar_rgb -o moded.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_TRUE(facet::test::identical(facet::read_image(path("plain.exr")),
+                                       facet::read_image(path("moded.exr"))));
+    ASSERT_EQ(run("render scene.xml -q --mode scalar_rgb -o long_name.exr").code, 0);
+}
+
+TEST_F(CliTest, ModeLlvmRgbRendersAsScalarRgbWithOneNote) {
+    Result plain = run("render scene.xml -o plain.exr");
+    ASSERT_EQ(plain.code, 0) << plain.err;
+    // As Mitsuba users type it: `mitsuba -m llvm_rgb scene.xml`. One line more than without -m.
+    Result r = run("-m llvm_rgb scene.xml -o vectorised.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::vector<std::string> expected = lines(plain.err);
+    expected.insert(expected.begin(), "[I] mode \"llvm_rgb\": facet renders it as scalar_rgb "
+                                      "(facet has no vectorised or differentiable modes)");
+    EXPECT_EQ(lines(r.err), expected);
+    EXPECT_TRUE(facet::test::identical(facet::read_image(path("plain.exr")),
+                                       facet::read_image(path("vectorised.exr"))));
+    // -q: only warnings and errors.
+    r = run("render scene.xml -q -m cuda_ad_rgb -o quiet.exr");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+}
+
+TEST_F(CliTest, ModeFacetDoesNotRenderIsRefusedBeforeTheSceneLoads) {
+    // The scene file does not exist: the mode is refused first.
+    std::string line = expect_one_line_error("render missing.xml -m scalar_spectral");
+    EXPECT_EQ(line, "facet: error: facet does not render the mode \"scalar_spectral\"; the "
+                    "modes it renders: scalar_rgb");
+    line = expect_one_line_error("render scene.xml more.xml --mode llvm_ad_spectral_polarized");
+    EXPECT_NE(line.find("(nor scalar_spectral_polarized, its scalar form)"), std::string::npos)
+        << line;
+    EXPECT_EQ(files(), std::set<std::string>{"scene.xml"});
+}
+
+TEST_F(CliTest, UnknownModeListsTheModes) {
+    std::string line = expect_one_line_error("render scene.xml -m foo");
+    EXPECT_EQ(line, "facet: error: unknown mode \"foo\"; the modes facet renders: scalar_rgb");
+    line = expect_one_line_error("render scene.xml -m scalar_rbg");
+    EXPECT_NE(line.find("did you mean \"scalar_rgb\"?"), std::string::npos) << line;
+    EXPECT_EQ(files(), std::set<std::string>{"scene.xml"});
+    // --help names the modes.
+    Result r = run("render --help");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(
+        std::regex_search(r.out, std::regex(R"(-m,--mode MODE\s+Colour mode[^\n]*scalar_rgb)")))
+        << r.out;
+}
+
+TEST_F(CliTest, InfoPrintsTheResolvedMode) {
+    Result r = run("info scene.xml");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("\nmode: scalar_rgb\n"), std::string::npos) << r.out;
+    r = run("info scene.xml -m llvm_ad_rgb");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("\nmode: scalar_rgb\n"), std::string::npos) << r.out;
+    EXPECT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find("facet renders it as scalar_rgb"), std::string::npos) << r.err;
+    const std::string line = expect_one_line_error("info scene.xml -m scalar_mono");
+    EXPECT_NE(line.find("facet does not render the mode \"scalar_mono\""), std::string::npos)
+        << line;
+}
+
 /// Starts `facet render scene.xml -D res=<res> -D spp=<spp> -t 2 -o <image>`, waits until it
 /// renders, lets it run for `run_for`, sends `sig` and waits for it to exit. Returns the exit
 /// status, the seconds from the signal to the exit and stderr.
