@@ -450,9 +450,10 @@ struct Written {
 /// Writes the render's image to `out` with the file attributes of the render.
 Written write_image(const RenderCommand &c, const Sensor &sensor, const RenderResult &result,
                     const std::string &hash, const std::string &out, ImageWriteOptions wopts) {
-    add_metadata(wopts, render_file_metadata(render_file_info(
-                            result, sensor, hash,
-                            fs::absolute(c.scene.scene).lexically_normal().string(), c.seed)));
+    add_metadata(wopts,
+                 render_file_metadata(render_file_info(
+                     result, sensor, hash, fs::absolute(c.scene.scene).lexically_normal().string(),
+                     c.seed, c.mode)));
     cli::set_activity(fmt::format("writing \"{}\"", out));
     const auto write_start = std::chrono::steady_clock::now();
     Written written;

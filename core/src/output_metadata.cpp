@@ -123,7 +123,7 @@ void add_metadata(ImageWriteOptions &opts, const FileMetadata &metadata) {
 
 RenderFileInfo render_file_info(const RenderResult &result, const Sensor &sensor,
                                 const std::string &scene_hash, const std::string &scene_path,
-                                uint64_t seed) {
+                                uint64_t seed, const std::string &mode) {
     RenderFileInfo info;
     info.spp = result.spp;
     info.spp_target = result.spp_target;
@@ -139,6 +139,7 @@ RenderFileInfo render_file_info(const RenderResult &result, const Sensor &sensor
     info.scene_hash = scene_hash;
     info.scene_path = scene_path;
     info.seed = seed;
+    info.mode = mode;
     info.world_to_camera = sensor.to_world().inverse_matrix;
     info.world_to_ndc = sensor_world_to_ndc(sensor);
     return info;
@@ -159,6 +160,7 @@ FileMetadata render_file_metadata(const RenderFileInfo &info) {
     if (!info.scene_hash.empty()) s[attr::scene_hash] = info.scene_hash;
     if (!info.scene_path.empty()) s[attr::scene] = info.scene_path;
     if (info.seed) s[attr::seed] = std::to_string(*info.seed);
+    if (!info.mode.empty()) s[attr::mode] = info.mode;
     if (info.seconds) s[attr::render_time] = fmt::format("{:.3f}", *info.seconds);
     if (info.blocks)
         s[attr::blocks] = fmt::format("{}/{}", info.blocks->first, info.blocks->second);

@@ -8,6 +8,7 @@
 #include <facet/image.h>
 #include <facet/logger.h>
 #include <facet/merge.h>
+#include <facet/mode.h>
 #include <facet/output_metadata.h>
 #include <facet/params.h>
 #include <facet/plugin.h>
@@ -280,8 +281,8 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     // The attributes `facet render` writes, so that parts from here and from the CLI merge.
     const std::string scene_hash =
         scene_identity(s.text + s.edits, s.params, result.film_width, result.film_height);
-    const FileMetadata meta =
-        render_file_metadata(render_file_info(result, sensor, scene_hash, s.path, seed));
+    const FileMetadata meta = render_file_metadata(
+        render_file_info(result, sensor, scene_hash, s.path, seed, default_mode()));
     py::tuple image =
         py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
                        sensor.film().half(), window_of(result.image));

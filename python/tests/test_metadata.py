@@ -12,7 +12,7 @@ SMALL = dict(res=24, spp=2, max_depth=2)
 # Attributes whose values the CLI's and Python's renders of the same scene and seed share.
 AGREE = ["facet:scene_hash", "facet:seed", "facet:spp", "facet:spp_total", "facet:sample_offset",
          "facet:pass_index", "facet:pass_count", "facet:crop", "facet:film_size", "facet:scene",
-         "samplesPerPixel", "worldToCamera", "worldToNDC"]
+         "facet:mode", "samplesPerPixel", "worldToCamera", "worldToNDC"]
 
 
 def attributes(path):

@@ -392,7 +392,10 @@ TEST_F(CliTest, ModeScalarRgbIsTheDefault) {
     EXPECT_EQ(r.err, "");
     EXPECT_TRUE(facet::test::identical(facet::read_image(path("plain.exr")),
                                        facet::read_image(path("moded.exr"))));
+    EXPECT_EQ(attribute(path("plain.exr"), "facet:mode"), "scalar_rgb");
+    EXPECT_EQ(attribute(path("moded.exr"), "facet:mode"), "scalar_rgb");
     ASSERT_EQ(run("render scene.xml -q --mode scalar_rgb -o long_name.exr").code, 0);
+    EXPECT_EQ(attribute(path("long_name.exr"), "facet:mode"), "scalar_rgb");
 }
 
 TEST_F(CliTest, ModeLlvmRgbRendersAsScalarRgbWithOneNote) {
@@ -407,6 +410,7 @@ TEST_F(CliTest, ModeLlvmRgbRendersAsScalarRgbWithOneNote) {
     EXPECT_EQ(lines(r.err), expected);
     EXPECT_TRUE(facet::test::identical(facet::read_image(path("plain.exr")),
                                        facet::read_image(path("vectorised.exr"))));
+    EXPECT_EQ(attribute(path("vectorised.exr"), "facet:mode"), "scalar_rgb");
     // -q: only warnings and errors.
     r = run("render scene.xml -q -m cuda_ad_rgb -o quiet.exr");
     ASSERT_EQ(r.code, 0) << r.err;

@@ -168,7 +168,8 @@ merge::Part part_of(const RenderResult &r, const Sensor &sensor, const std::stri
     p.x = r.image.x;
     p.y = r.image.y;
     p.image = r.image;
-    p.metadata = render_file_metadata(render_file_info(r, sensor, "0123456789abcdef", "", 0));
+    p.metadata =
+        render_file_metadata(render_file_info(r, sensor, "0123456789abcdef", "", 0, "scalar_rgb"));
     return p;
 }
 
@@ -476,7 +477,7 @@ TEST(RenderParts, MetadataNamesThePart) {
     opts.crop = {{2, 1, 9, 8}};
     const Sensor &sensor = *scene->sensors().at(0);
     RenderResult r = render(*scene, sensor, opts);
-    auto m = render_file_metadata(render_file_info(r, sensor, "", "", 0)).strings;
+    auto m = render_file_metadata(render_file_info(r, sensor, "", "", 0, "scalar_rgb")).strings;
     EXPECT_EQ(m["facet:spp"], "3");
     EXPECT_EQ(m["facet:spp_total"], "6");
     EXPECT_EQ(m["facet:sample_offset"], "3");

@@ -33,6 +33,7 @@ inline constexpr const char *render_time = "facet:render_time"; ///< seconds, "1
 inline constexpr const char *scene = "facet:scene";             ///< the scene file, absolute
 inline constexpr const char *blocks = "facet:blocks"; ///< "done/total" work units, when stopped
 inline constexpr const char *merged_parts = "facet:merged_parts"; ///< parts of a merge
+inline constexpr const char *mode = "facet:mode"; ///< the colour mode, "scalar_rgb" (facet/mode.h)
 // Typed attributes, as pbrt-v4 writes them (int, float, 4×4 float matrices row-major for
 // column vectors).
 inline constexpr const char *samples_per_pixel = "samplesPerPixel";
@@ -68,18 +69,20 @@ struct RenderFileInfo {
     std::string scene_hash; ///< scene_identity() of the input; empty: not recorded
     std::string scene_path; ///< the scene file, absolute; empty for a scene from a string
     std::optional<uint64_t> seed;
+    std::string mode; ///< the colour mode rendered in (facet/mode.h); empty: not recorded
     std::optional<Matrix4f> world_to_camera, world_to_ndc; ///< the sensor's (below)
 };
 
 /// The file information of `result`, a render of `sensor` of the scene whose identity is
-/// `scene_hash`, loaded from `scene_path` (empty when from a string), with `seed`.
+/// `scene_hash`, loaded from `scene_path` (empty when from a string), with `seed`, in the colour
+/// mode `mode` (resolve_mode()'s).
 RenderFileInfo render_file_info(const RenderResult &result, const Sensor &sensor,
                                 const std::string &scene_hash, const std::string &scene_path,
-                                uint64_t seed);
+                                uint64_t seed, const std::string &mode);
 
 /// The attributes of a render's file, the only place they are built: the facet:* strings a
-/// merge needs (attr::spp ... attr::blocks) and pbrt-v4's typed samplesPerPixel,
-/// renderTimeSeconds, worldToCamera and worldToNDC.
+/// merge needs (attr::spp ... attr::blocks), the colour mode (attr::mode) and pbrt-v4's typed
+/// samplesPerPixel, renderTimeSeconds, worldToCamera and worldToNDC.
 FileMetadata render_file_metadata(const RenderFileInfo &info);
 
 /// Identity of a render's input, for checking that parts belong together: 16 hex digits of a
