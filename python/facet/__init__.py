@@ -34,6 +34,7 @@ __all__ = [
     "write",
     "read",
     "merge",
+    "modes",
     "plugins",
     "add_plugin_dir",
     "chi2",
@@ -378,7 +379,7 @@ class Image(tuple):
 
 
 def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_index=None, passes=1,
-           progress=None):
+           progress=None, mode=None):
     """Renders ``sensor`` of ``scene`` with its integrator and returns an ``Image``: a NumPy
     float32 array of shape (height, width, channels) and the channel names (R, G, B, then A and
     the AOVs when the scene asks for them). ``spp`` overrides the sampler's sample_count, ``seed``
@@ -394,7 +395,14 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
 
     ``progress`` is a callable, called on this thread with the fraction done (0 to 1, rising,
     1 at the end; an exception it raises stops the render and is raised here), or a bool: draw
-    the CLI's progress bar on stderr. None (the default) draws it when stderr is a terminal."""
+    the CLI's progress bar on stderr. None (the default) draws it when stderr is a terminal.
+
+    ``mode`` is the colour mode by Mitsuba's variant names (``-m`` of ``facet render``; ``modes()``
+    lists them, the default first): their ``llvm_``, ``cuda_`` and ``_ad_`` names render as the
+    scalar mode, with a note; a mode facet does not render raises ``facet.Error``, before the
+    render. The image's ``facet:mode`` metadata names the mode rendered."""
+    if mode is not None and not isinstance(mode, str):
+        raise TypeError(f"mode={mode!r}: expected a str such as 'scalar_rgb'")
     if progress is None:
         import sys
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
@@ -407,7 +415,8 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
         threads = min(int(threads), 2**31 - 1)
     pixels, channels, metadata, half, window = _facet.render(
         scene, spp, int(seed), int(sensor), threads,
-        None if crop is None else [int(v) for v in crop], int(pass_index), int(passes), progress)
+        None if crop is None else [int(v) for v in crop], int(pass_index), int(passes), progress,
+        mode)
     return Image(pixels, channels, metadata, half, window)
 
 
@@ -490,6 +499,12 @@ class Plugin(tuple):
     name = property(lambda self: self[0])
     kind = property(lambda self: self[1])
     description = property(lambda self: self[2])
+
+
+def modes():
+    """The colour modes facet renders in, by Mitsuba's variant names, the default first:
+    ``["scalar_rgb"]``."""
+    return list(_facet.modes())
 
 
 def plugins(kind=None):

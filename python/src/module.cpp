@@ -235,7 +235,9 @@ py::tuple window_of(const Image &img) {
 /// Returns (pixels, channel names, metadata, half, window).
 py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int sensor_index,
                     std::optional<int> threads, std::optional<std::array<int, 4>> crop,
-                    int pass_index, int pass_count, const py::object &progress) {
+                    int pass_index, int pass_count, const py::object &progress,
+                    const std::optional<std::string> &mode) {
+    const std::string render_mode = mode ? resolve_mode(*mode) : default_mode();
     const auto &sensors = s.scene->sensors();
     if (sensor_index < 0 || size_t(sensor_index) >= sensors.size())
         FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor_index,
@@ -282,7 +284,7 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     const std::string scene_hash =
         scene_identity(s.text + s.edits, s.params, result.film_width, result.film_height);
     const FileMetadata meta = render_file_metadata(
-        render_file_info(result, sensor, scene_hash, s.path, seed, default_mode()));
+        render_file_info(result, sensor, scene_hash, s.path, seed, render_mode));
     py::tuple image =
         py::make_tuple(to_array(result.image), result.image.channel_names, metadata_dict(meta),
                        sensor.film().half(), window_of(result.image));
@@ -666,7 +668,7 @@ PYBIND11_MODULE(_facet, m) {
           py::arg("search_path"));
     m.def("render", &render_py, py::arg("scene"), py::arg("spp"), py::arg("seed"),
           py::arg("sensor"), py::arg("threads"), py::arg("crop"), py::arg("pass_index"),
-          py::arg("pass_count"), py::arg("progress"));
+          py::arg("pass_count"), py::arg("progress"), py::arg("mode"));
     m.def("write", &write_py, py::arg("pixels"), py::arg("channels"), py::arg("path"),
           py::arg("half"), py::arg("metadata"), py::arg("ocio_config"), py::arg("display"),
           py::arg("view"), py::arg("looks"), py::arg("window"));
@@ -687,9 +689,10 @@ PYBIND11_MODULE(_facet, m) {
                                           py::arg("film_size") = py::make_tuple(s.width, s.height),
                                           py::arg("spp") = s.spp));
               return py::dict(py::arg("sensors") = sensors, py::arg("integrator") = info.integrator,
-                              py::arg("plugins") = info.plugins, py::arg("mode") = "scalar_rgb");
+                              py::arg("plugins") = info.plugins, py::arg("mode") = default_mode());
           });
     m.def("merge", &merge_py, py::arg("parts"));
+    m.def("modes", &modes);
     m.def("plugins", &plugins_py);
     m.def("add_plugin_dir", [](const std::string &dir) {
         PluginRegistry::instance().add_search_dir(checked_path(dir, "add_plugin_dir"));
