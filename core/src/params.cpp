@@ -289,7 +289,8 @@ SceneUpdate SceneParameters::update() {
             else
                 props.set(e.name, instance(e.child), e.location);
         }
-        stats.accel_rebuilt = m_scene->rebuild(props);
+        stats.geometries_built = m_scene->rebuild(props);
+        stats.accel_rebuilt = stats.geometries_built > 0;
     } catch (...) {
         for (auto it = undo.rbegin(); it != undo.rend(); ++it) {
             it->shape->set_bsdf(it->bsdf);

@@ -171,7 +171,7 @@ Scene::RenderLock::RenderLock(const Scene &scene) : m_scene(scene) {
 
 Scene::RenderLock::~RenderLock() { m_scene.m_renders.fetch_sub(1); }
 
-bool Scene::rebuild(const Properties &props) {
+size_t Scene::rebuild(const Properties &props) {
     int idle = 0;
     if (!m_renders.compare_exchange_strong(idle, -1)) {
         if (idle < 0) FACET_THROW("cannot update the scene: another update of it is running");
@@ -197,7 +197,8 @@ bool Scene::rebuild(const Properties &props) {
     std::swap(m_device, next.m_device);
     std::swap(m_rtc_scene, next.m_rtc_scene); // `next` releases the old one (or null)
     std::swap(m_robust, next.m_robust);
-    return !next.m_accel_reused;
+    std::swap(m_two_level, next.m_two_level);
+    return next.m_geometries_built;
 }
 
 void Scene::build(const Properties &props, Scene *previous) {
@@ -306,8 +307,9 @@ void Scene::build(const Properties &props, Scene *previous) {
     // As in Mitsuba 3: Embree's fast triangle test unless the scene asks for the robust
     // (watertight, slower) one.
     m_robust = props.get_bool("embree_use_robust_intersections", false);
+    m_two_level = props.get_bool("embree_two_level", false);
     if (previous && previous->m_rtc_scene && previous->m_shapes == m_shapes &&
-        previous->m_robust == m_robust) {
+        previous->m_robust == m_robust && previous->m_two_level == m_two_level) {
         // The same shapes (an update changed no geometry): the Embree scene is theirs.
         m_geometries = previous->m_geometries;
         m_bbox = previous->m_bbox;
@@ -317,13 +319,21 @@ void Scene::build(const Properties &props, Scene *previous) {
             if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
                 needs_scene->set_scene(*this);
         std::swap(m_rtc_scene, previous->m_rtc_scene); // last: nothing can fail after it
-        m_accel_reused = true;
         return;
     }
+    if (previous && previous->m_rtc_scene && previous->m_robust == m_robust &&
+        previous->m_two_level && m_two_level && replace_geometries(*previous))
+        return;
     const auto accel_start = std::chrono::steady_clock::now();
     m_rtc_scene = rtcNewScene(m_device);
-    rtcSetSceneFlags(m_rtc_scene, m_robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
-    rtcSetSceneBuildQuality(m_rtc_scene, RTC_BUILD_QUALITY_HIGH);
+    int flags = m_robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE;
+    // Two levels: a structure per geometry and one over their boxes, which Embree builds again
+    // alone when geometries change (the dynamic flag: without it the top level also splits
+    // the geometries' own nodes, and an edit cost 40 ms instead of 0.3).
+    if (m_two_level) flags |= RTC_SCENE_FLAG_DYNAMIC;
+    rtcSetSceneFlags(m_rtc_scene, RTCSceneFlags(flags));
+    rtcSetSceneBuildQuality(m_rtc_scene,
+                            m_two_level ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
     try {
         // Shape groups first, with the scene's triangle test: their instances (attached below)
         // only fetch the group's scene.
@@ -333,6 +343,10 @@ void Scene::build(const Properties &props, Scene *previous) {
         for (auto &shape : m_shapes) {
             RTCGeometry geom = shape->embree_geometry(m_device);
             if (!geom) continue; // a shape group: only visible through its instances
+            if (m_two_level) {
+                rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
+                rtcCommitGeometry(geom);
+            }
             unsigned id = rtcAttachGeometry(m_rtc_scene, geom);
             rtcReleaseGeometry(geom); // the scene holds it now
             if (id >= m_geometries.size()) m_geometries.resize(id + 1);
@@ -340,6 +354,7 @@ void Scene::build(const Properties &props, Scene *previous) {
             if (shape->is_mesh() && static_cast<const Mesh &>(*shape).has_flat_hit())
                 m_geometries[id].flat_mesh = static_cast<const Mesh *>(shape.get());
             m_bbox.expand(shape->bbox());
+            ++m_geometries_built;
         }
         rtcCommitScene(m_rtc_scene);
         m_accel_seconds =
@@ -360,6 +375,83 @@ void Scene::build(const Properties &props, Scene *previous) {
         m_device = nullptr;
         throw;
     }
+}
+
+bool Scene::replace_geometries(Scene &previous) {
+    // The shapes that are new objects in old places, as a transform edit leaves them. Shape
+    // groups (built into scenes of their own) and changed counts take the full build.
+    if (m_shapes.size() != previous.m_shapes.size()) return false;
+    std::vector<size_t> changed;
+    for (size_t i = 0; i < m_shapes.size(); ++i) {
+        if (m_shapes[i] == previous.m_shapes[i]) continue;
+        if (dynamic_cast<const ShapeGroup *>(m_shapes[i].get()) ||
+            dynamic_cast<const ShapeGroup *>(previous.m_shapes[i].get()))
+            return false;
+        changed.push_back(i);
+    }
+    std::vector<unsigned> ids(changed.size(), RTC_INVALID_GEOMETRY_ID);
+    for (size_t k = 0; k < changed.size(); ++k)
+        for (unsigned id = 0; id < previous.m_geometries.size(); ++id)
+            if (previous.m_geometries[id].shape == previous.m_shapes[changed[k]].get()) ids[k] = id;
+    if (std::count(ids.begin(), ids.end(), RTC_INVALID_GEOMETRY_ID) != 0) return false;
+
+    const auto accel_start = std::chrono::steady_clock::now();
+    m_geometries = previous.m_geometries;
+    for (size_t k = 0; k < changed.size(); ++k) {
+        const Shape *shape = m_shapes[changed[k]].get();
+        m_geometries[ids[k]] = GeometryEntry{shape, nullptr};
+        if (shape->is_mesh() && static_cast<const Mesh &>(*shape).has_flat_hit())
+            m_geometries[ids[k]].flat_mesh = static_cast<const Mesh *>(shape);
+    }
+    for (const GeometryEntry &geometry : m_geometries)
+        if (geometry.shape) m_bbox.expand(geometry.shape->bbox());
+
+    // A geometry's own structure is built as build() builds it.
+    auto set_scene = [&] {
+        for (auto &emitter : m_emitters) emitter->set_scene(*this);
+        for (auto &sensor : m_sensors)
+            if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
+                needs_scene->set_scene(*this);
+    };
+    // The new geometries take the old ones' ids in the old scene, the others keep their
+    // structures. On a failure the old geometries go back.
+    RTCScene scene = previous.m_rtc_scene;
+    std::vector<RTCGeometry> old(changed.size());
+    for (size_t k = 0; k < changed.size(); ++k) {
+        old[k] = rtcGetGeometry(scene, ids[k]);
+        rtcRetainGeometry(old[k]);
+        rtcDetachGeometry(scene, ids[k]);
+        RTCGeometry geom = m_shapes[changed[k]]->embree_geometry(m_device);
+        rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_HIGH);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(scene, geom, ids[k]);
+        rtcReleaseGeometry(geom);
+    }
+    auto restore = [&](bool failed) {
+        for (size_t k = 0; k < changed.size(); ++k) {
+            if (failed) {
+                rtcDetachGeometry(scene, ids[k]);
+                rtcAttachGeometryByID(scene, old[k], ids[k]);
+            }
+            rtcReleaseGeometry(old[k]);
+        }
+        if (failed) rtcCommitScene(scene);
+    };
+    try {
+        rtcCommitScene(scene);
+        if (RTCError err = rtcGetDeviceError(m_device); err != RTC_ERROR_NONE)
+            FACET_THROW("updating the Embree scene failed: {}", embree_error_name(err));
+        set_scene();
+    } catch (...) {
+        restore(true);
+        throw;
+    }
+    restore(false);
+    std::swap(m_rtc_scene, previous.m_rtc_scene); // last: nothing can fail after it
+    m_geometries_built = changed.size();
+    m_accel_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - accel_start).count();
+    return true;
 }
 
 Scene::~Scene() {

@@ -609,6 +609,7 @@ void bind_params(py::module_ &m) {
             d["shapes_created"] = u.shapes_created;
             d["shapes_relinked"] = u.shapes_relinked;
             d["accel_rebuilt"] = u.accel_rebuilt;
+            d["geometries_built"] = u.geometries_built;
             return d;
         });
     m.def(

@@ -15,6 +15,9 @@ struct SceneUpdate {
     size_t shapes_created = 0;  ///< shapes constructed again (their geometry loaded again)
     size_t shapes_relinked = 0; ///< shapes given a new BSDF or emitter, their geometry kept
     bool accel_rebuilt = false; ///< the Embree scene was built again
+    /// Embree geometries whose acceleration structure was built (those of the shapes built
+    /// again, or all of them when the whole Embree scene was).
+    size_t geometries_built = 0;
 };
 
 /// The parameters of a loaded scene (facet::traverse), keyed by path: the object's id when it

@@ -32,9 +32,10 @@ std::string scene_xml(std::map<std::string, std::string> v = {}) {
         {"box_to_world", ""},
         {"radius", "0.5"},
         {"radiance", "8, 6, 4"},
+        {"options", ""},
     };
     for (auto &[k, value] : v) d[k] = value;
-    return fmt::format(R"(<scene version="3.0.0">
+    return fmt::format(R"(<scene version="3.0.0">{options}
     <integrator type="path">{max_depth}</integrator>
     <sensor type="perspective">
         <float name="fov" value="40"/>
@@ -62,7 +63,8 @@ std::string scene_xml(std::map<std::string, std::string> v = {}) {
                        fmt::arg("sensor_to_world", d["sensor_to_world"]),
                        fmt::arg("width", d["width"]), fmt::arg("albedo", d["albedo"]),
                        fmt::arg("color0", d["color0"]), fmt::arg("box_to_world", d["box_to_world"]),
-                       fmt::arg("radius", d["radius"]), fmt::arg("radiance", d["radiance"]));
+                       fmt::arg("radius", d["radius"]), fmt::arg("radiance", d["radiance"]),
+                       fmt::arg("options", d["options"]));
 }
 
 std::shared_ptr<Scene> load(const std::string &xml) {
@@ -90,6 +92,9 @@ std::string matrix_xml(const float (&rows)[16]) {
     for (float v : rows) s += fmt::format("{} ", v);
     return R"(<matrix value=")" + s + R"("/>)";
 }
+
+/// The scene option that makes the Embree scene two-level.
+const char *const kTwoLevel = R"(<boolean name="embree_two_level" value="true"/>)";
 
 } // namespace
 
@@ -184,20 +189,55 @@ TEST(Params, AnUpdatedSceneRendersAsTheEditedSceneLoadedAfresh) {
          {{"max_depth", R"(<integer name="max_depth" value="2"/>)"}},
          false},
     };
-    for (const Edit &edit : edits) {
-        SCOPED_TRACE(edit.name);
-        auto scene = load(scene_xml());
-        const Image before = render_image(*scene);
-        SceneParameters params = traverse(scene);
-        edit.apply(params);
-        SceneUpdate u = params.update();
-        EXPECT_EQ(u.shapes_created, edit.geometry ? 1u : 0u);
-        EXPECT_EQ(u.accel_rebuilt, edit.geometry);
-        const Image after = render_image(*scene);
-        const Image fresh = render_image(*load(scene_xml(edit.xml)));
-        EXPECT_TRUE(same_pixels(after, fresh));
-        EXPECT_FALSE(same_pixels(after, before)); // the edit shows
+    // One-level (the default), where a changed shape builds the whole Embree scene again, and
+    // two-level, where it builds its own structure and the top level.
+    for (const char *options : {"", kTwoLevel}) {
+        for (const Edit &edit : edits) {
+            SCOPED_TRACE(std::string(edit.name) + (*options ? " (two-level)" : ""));
+            auto xml = [&](std::map<std::string, std::string> v) {
+                v["options"] = options;
+                return scene_xml(v);
+            };
+            auto scene = load(xml({}));
+            const Image before = render_image(*scene);
+            SceneParameters params = traverse(scene);
+            edit.apply(params);
+            SceneUpdate u = params.update();
+            EXPECT_EQ(u.shapes_created, edit.geometry ? 1u : 0u);
+            EXPECT_EQ(u.accel_rebuilt, edit.geometry);
+            EXPECT_EQ(u.geometries_built, edit.geometry ? (*options ? 1u : 4u) : 0u);
+            const Image after = render_image(*scene);
+            const Image fresh = render_image(*load(xml(edit.xml)));
+            EXPECT_TRUE(same_pixels(after, fresh));
+            EXPECT_FALSE(same_pixels(after, before)); // the edit shows
+        }
     }
+}
+
+TEST(Params, ATwoLevelSceneRebuildsOnlyTheEditedShapes) {
+    Transform box(Matrix4f::from_rows(kBoxRows));
+    std::map<std::string, std::string> v = {{"options", kTwoLevel}};
+    auto scene = load(scene_xml(v));
+    ASSERT_TRUE(scene->two_level());
+    SceneParameters params = traverse(scene);
+    // Successive edits, each against the Embree scene the last one left.
+    params.set("shape_1.to_world", box);
+    EXPECT_EQ(params.update().geometries_built, 1u);
+    v["box_to_world"] = R"(<transform name="to_world">)" + matrix_xml(kBoxRows) + "</transform>";
+    EXPECT_TRUE(same_pixels(render_image(*scene), render_image(*load(scene_xml(v)))));
+
+    params.set("shape_2.radius", 0.3);
+    params.set("shape_1.to_world", Transform());
+    EXPECT_EQ(params.update().geometries_built, 2u);
+    v["radius"] = "0.3";
+    v["box_to_world"] = "";
+    EXPECT_TRUE(same_pixels(render_image(*scene), render_image(*load(scene_xml(v)))));
+
+    // A value that does not touch geometry keeps every structure.
+    params.set("wall.reflectance", Color3f(0.3f));
+    EXPECT_EQ(params.update().geometries_built, 0u);
+    v["albedo"] = "0.3, 0.3, 0.3";
+    EXPECT_TRUE(same_pixels(render_image(*scene), render_image(*load(scene_xml(v)))));
 }
 
 TEST(Params, SharedObjectsAreRelinkedNotRebuilt) {
@@ -282,4 +322,40 @@ TEST(Params, ShapesBuiltAgainFindTheirFilesAsTheLoadDid) {
     EXPECT_TRUE(
         same_pixels(render_image(*scene), render_image(*load_scene(write("b.xml", moved)))));
     fs::remove_all(dir);
+}
+
+TEST(Params, MovingAnInstanceRendersAsTheEditedSceneLoadedAfresh) {
+    auto xml = [](const char *options, const std::string &to_world) {
+        return fmt::format(R"(<scene version="3.0.0">{}
+    <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+    <sensor type="perspective">
+        <transform name="to_world"><lookat origin="0, 2, 6" target="0, 0.5, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="16"/></film>
+    </sensor>
+    <shape type="shapegroup" id="group">
+        <shape type="cube"><transform name="to_world"><scale value="0.4"/></transform></shape>
+        <shape type="sphere"><point name="center" value="0, 0.8, 0"/><float name="radius" value="0.3"/></shape>
+    </shape>
+    <shape type="instance"><ref id="group"/>
+        <transform name="to_world"><translate x="-1"/></transform></shape>
+    <shape type="instance"><ref id="group"/><transform name="to_world">{}</transform></shape>
+    <shape type="rectangle">
+        <transform name="to_world"><rotate x="1" angle="90"/><translate y="3"/></transform>
+        <emitter type="area"><rgb name="radiance" value="8, 6, 4"/></emitter>
+    </shape>
+</scene>)",
+                           options, to_world);
+    };
+    for (const char *options : {"", kTwoLevel}) {
+        SCOPED_TRACE(*options ? "two-level" : "one-level");
+        auto scene = load(xml(options, R"(<translate x="1"/>)"));
+        SceneParameters params = traverse(scene);
+        params.set("shape_2.to_world", Transform(Matrix4f::from_rows(kBoxRows)));
+        SceneUpdate u = params.update();
+        EXPECT_EQ(u.shapes_created, 1u);
+        EXPECT_EQ(u.geometries_built, *options ? 1u : 3u); // the instances and the light
+        EXPECT_TRUE(same_pixels(render_image(*scene),
+                                render_image(*load(xml(options, matrix_xml(kBoxRows))))));
+    }
 }
