@@ -285,6 +285,24 @@ std::vector<std::string> scenes_to_render(const RenderCommand &c) {
             FACET_THROW("scene file \"{}\" {} (nothing was rendered)", scenes[i],
                         exists_error ? exists_error.message() : std::string("does not exist"));
     }
+    // Two scenes whose images would take one name (a/scene.xml and b/scene.xml with -o a
+    // folder): the second would replace the first's image.
+    std::map<fs::path, size_t> images;
+    for (size_t i = 0; i < scenes.size() && scenes.size() > 1; ++i) {
+        const fs::path scene(scenes[i]);
+        std::error_code ec;
+        fs::path image = c.output.empty() ? fs::weakly_canonical(scene, ec).parent_path()
+                                          : fs::weakly_canonical(c.output, ec);
+        image /= scene.stem();
+        auto [it, added] = images.emplace(image, i);
+        if (!added)
+            FACET_THROW("scenes \"{}\" and \"{}\" would both write {}.*: render them to "
+                        "different folders (nothing was rendered)",
+                        scenes[it->second], scenes[i],
+                        (c.output.empty() ? scene.parent_path() / scene.stem()
+                                          : fs::path(c.output) / scene.stem())
+                            .string());
+    }
     return scenes;
 }
 

@@ -161,6 +161,17 @@ TEST_F(CliTest, SeveralScenesRenderOneAfterTheOther) {
     const std::string err = expect_one_line_error("render scene.xml red.xml -o one.exr");
     EXPECT_NE(err.find("-o must name a folder"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(m_dir / "one.exr"));
+    // Two scenes of one name would write one image: refused before anything renders.
+    fs::create_directories(m_dir / "other");
+    write_file(m_dir / "other" / "scene.xml", red);
+    fs::create_directories(m_dir / "same");
+    std::string same = expect_one_line_error("render scene.xml red.xml other/scene.xml -o same/");
+    EXPECT_NE(same.find("\"scene.xml\" and \"other/scene.xml\" would both write same/scene.*"),
+              std::string::npos)
+        << same;
+    EXPECT_TRUE(fs::is_empty(m_dir / "same"));
+    same = expect_one_line_error("render scene.xml ./scene.xml");
+    EXPECT_NE(same.find("would both write"), std::string::npos) << same;
     // A missing scene is refused before anything renders; the first error while loading or
     // rendering ends the sequence, and the scenes before it keep their images.
     r = run("render scene.xml missing.xml red.xml -q -o seq/");
