@@ -158,6 +158,31 @@ def _write_ply(path, n):
     return len(tris)
 
 
+def test_environment_scale_and_a_default_value(cornell, tmp_path):
+    """An envmap's scale, a parameter the scene leaves at its default: the emitter alone is
+    built again (its image is shared, not decoded again), and the render is the edited XML's."""
+    materials = cornell.parents[1] / "materials"
+    small = dict(res=24, spp=4, max_depth=3)
+    scene = facet.load_file(materials / "diffuse.xml", **small)
+    before = _render(scene)
+    params = facet.traverse(scene)
+    assert "emitter_0.scale" not in params.keys()
+    params["emitter_0.scale"] = 0.25
+    stats = params.update()
+    assert stats["objects_created"] == 1 and stats["geometries_built"] == 0
+    after = _render(scene)
+    preview = (materials / "common" / "preview.xml").read_text()
+    envmap = '<string name="filename" value="common/sky.hdr"/>'
+    assert envmap in preview
+    (tmp_path / "common").mkdir()
+    (tmp_path / "common" / "preview.xml").write_text(
+        preview.replace(envmap, envmap + '<float name="scale" value="0.25"/>'))
+    (tmp_path / "diffuse.xml").write_text((materials / "diffuse.xml").read_text())
+    fresh = facet.load_file(tmp_path / "diffuse.xml", search_path=[materials], **small)
+    assert np.array_equal(after, _render(fresh))
+    assert not np.array_equal(after, before)
+
+
 @pytest.mark.parametrize("two_level", [False, True])
 def test_heavy_scene_updates_rebuild_only_what_changed(cornell, tmp_path, two_level):
     """The Cornell box with a 200k-triangle mesh: an edit rebuilds only the objects it touches
