@@ -162,6 +162,7 @@ struct BenchCommand {
     std::string reference;
     int rounds = 6;
     double target_rmse = 0.0;
+    bool machine = false;
 };
 
 void add_bench_options(CLI::App &app, BenchCommand &c) {
@@ -179,6 +180,9 @@ void add_bench_options(CLI::App &app, BenchCommand &c) {
                    "Equal-error mode: also report the CPU time to reach this RMSE (interpolated "
                    "on the log-log curve, or extrapolated with RMSE ~ 1/sqrt(time))")
         ->check(CLI::PositiveNumber);
+    app.add_flag("--machine", c.machine,
+                 "Also print the figures as one line of key=value pairs, starting with "
+                 "\"machine:\"");
 }
 
 /// The --reference image, checked against the size of the sensor's film.
@@ -300,13 +304,14 @@ Replayed replay_timed(const RayRecording &recording, const Scene &scene, uint64_
 /// Embree alone: the queries of a render at fewer samples, at most RecordBudget of them (36
 /// bytes each), sent to Embree again; their CPU time per ray, times the rays of the measured
 /// render `m`, is Embree's share of it. Gives the signals back (uninstall_interrupt_handler).
-void print_embree_share(const Scene &scene, const Sensor &sensor, const RenderOptions &ropts,
-                        const Measured &m) {
+/// Returns the share (0 to 1), or a negative value when it was skipped.
+double print_embree_share(const Scene &scene, const Sensor &sensor, const RenderOptions &ropts,
+                          const Measured &m) {
     const uint64_t rays = m.rays.total();
     if (rays == 0) {
         uninstall_interrupt_handler();
         fmt::print("embree alone: skipped (the render sent no ray to Embree)\n");
-        return;
+        return -1.0;
     }
     constexpr size_t RecordBudget = size_t(1) << 20;
     RenderOptions record = ropts;
@@ -321,7 +326,7 @@ void print_embree_share(const Scene &scene, const Sensor &sensor, const RenderOp
     const RayRecording::Replay &replay = replayed.timed;
     if (replay.rays == 0) {
         fmt::print("embree alone: skipped (no ray recorded)\n");
-        return;
+        return -1.0;
     }
     const double samples = std::max<double>(1.0, double(m.result.samples));
     const double cpu = std::max(m.cpu_seconds, 1e-9);
@@ -341,6 +346,19 @@ void print_embree_share(const Scene &scene, const Sensor &sensor, const RenderOp
                "{:.1f} CPU-ns); the rest, {:.1f} CPU-ns per sample, is facet's\n",
                100.0 * embree_cpu / cpu, mega(double(rays)), 1e9 * per_ray,
                1e9 * std::max(cpu - embree_cpu, 0.0) / samples);
+    return embree_cpu / cpu;
+}
+
+/// The figures of the bench as one line of key=value pairs (--machine): samples are camera
+/// samples (pixels x spp), time is CPU time; embree_share is "-" when it was not measured.
+void print_machine_line(const Measured &m, int spp, int threads, double embree_share) {
+    const double samples = std::max<double>(1.0, double(m.result.samples));
+    const uint64_t rays = m.rays.total();
+    fmt::print("machine: spp={} threads={} samples={} rays={} cpu_seconds={:.6f} "
+               "cpu_ns_per_sample={:.3f} rays_per_sample={:.4f} embree_share={}\n",
+               spp, threads, m.result.samples, rays, m.cpu_seconds, 1e9 * m.cpu_seconds / samples,
+               double(rays) / samples,
+               embree_share < 0.0 ? std::string("-") : fmt::format("{:.4f}", embree_share));
 }
 
 } // namespace
@@ -382,6 +400,7 @@ int bench_main(int argc, char **argv) {
     throw_if_interrupted(m.result);
     print_render_cost(m, threads, counter);
     if (!c.reference.empty()) print_equal_error(c, *scene, sensor, ropts, m, ref_image);
-    print_embree_share(*scene, sensor, ropts, m);
+    const double share = print_embree_share(*scene, sensor, ropts, m);
+    if (c.machine) print_machine_line(m, c.spp, threads, share);
     return 0;
 }
