@@ -1,8 +1,9 @@
 # `facet bench` (label bench): the equal-error mode (tests/bench/equal_error_test.sh) on the
 # Cornell box, an environment-lit material scene and a large area light close to a floor
 # (near-light), and the replay that measures Embree's share (tests/bench/embree_share_test.sh) on
-# the first two, at tiny resolutions. tests/bench/make_ply.py writes the 1M-triangle PLY of the
-# README's loading benchmark (not a test: it takes seconds).
+# the first two, at tiny resolutions; `facet bench --suite` on a suite file of two scenes, one of
+# them missing (tests/bench/suite_test.sh). tests/bench/make_ply.py writes the 1M-triangle PLY of
+# the README's loading benchmark (not a test: it takes seconds).
 if(TARGET facet_cli)
     foreach(scene cornell-box/scene.xml materials/rough-copper.xml near-light/scene.xml)
         get_filename_component(_name ${scene} NAME_WE)
@@ -21,6 +22,11 @@ if(TARGET facet_cli)
                          -D res=32 -D max_depth=4)
         set_tests_properties(bench.embree_share.${_dir} PROPERTIES LABELS bench TIMEOUT 300)
     endforeach()
+    # `facet bench --suite` (tests/bench/suite_test.sh): a tiny Cornell box and a missing scene.
+    add_test(NAME bench.suite
+             COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bench/suite_test.sh $<TARGET_FILE:facet_cli>
+                     ${PROJECT_SOURCE_DIR}/scenes ${CMAKE_CURRENT_BINARY_DIR}/bench-suite)
+    set_tests_properties(bench.suite PROPERTIES LABELS bench TIMEOUT 60)
 endif()
 
 # The statistics counters and the recording and replay of Embree queries behind `facet bench`:

@@ -182,7 +182,7 @@ void add_bench_options(CLI::App &app, BenchCommand &c) {
         ->check(CLI::PositiveNumber);
     app.add_flag("--machine", c.machine,
                  "Also print the figures as one line of key=value pairs, starting with "
-                 "\"machine:\"");
+                 "\"machine:\" (what `facet bench --suite` reads)");
 }
 
 /// The --reference image, checked against the size of the sensor's film.
@@ -364,12 +364,17 @@ void print_machine_line(const Measured &m, int spp, int threads, double embree_s
 } // namespace
 
 int bench_main(int argc, char **argv) {
+    for (int i = 1; i < argc; ++i)
+        if (std::strcmp(argv[i], "--suite") == 0 || std::strncmp(argv[i], "--suite=", 8) == 0)
+            return bench_suite_main(argc, argv);
     BenchCommand c;
     CLI::App app("Measure samples and rays per CPU second of the scene's integrator and the share "
                  "of its CPU time that is Embree's own work; with --reference, the error against "
                  "a reference image as a function of CPU time",
                  "facet bench");
     add_bench_options(app, c);
+    app.footer("facet bench --suite FILE [--runs N] [-t T] [--root DIR] benches the scenes "
+               "FILE lists, each in a process of its own (see facet bench --suite --help)");
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
 
     cli::SceneOptions &opts = c.scene;

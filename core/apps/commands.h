@@ -16,6 +16,8 @@ class App;
 int render_main(int argc, char **argv);
 int plugins_main(int argc, char **argv);
 int bench_main(int argc, char **argv);
+/// `facet bench --suite FILE` (bench_suite.cpp): bench_main() hands its arguments over.
+int bench_suite_main(int argc, char **argv);
 int compare_main(int argc, char **argv);
 /// `facet merge` (merge_cmd.cpp): puts the parts of a split render back together.
 int merge_main(int argc, char **argv);

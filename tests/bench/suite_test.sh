@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# `facet bench --suite`: a suite file of two scenes, a tiny Cornell box and a scene file that does
+# not exist, written in the format of a suite (comments, blank lines, aligned columns). Checks
+# that both rows are printed, the good one with its figures and a peak memory above 0, the
+# failing one with its error, and that the command exits non-zero after running both.
+#   suite_test.sh <facet> <scenes folder> <work folder>
+set -uo pipefail
+facet=$1 scenes=$2 work=$3
+mkdir -p "$work"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+cat >"$work/suite.txt" <<'SUITE'
+# name | scene file | -D arguments
+cbox    | cornell-box/scene.xml | -D res=16 -D max_depth=3 -D spp=4
+
+missing | no-such/scene.xml     | -D spp=4
+SUITE
+out=$("$facet" bench --suite "$work/suite.txt" --root "$scenes" --runs 2 -t 2 2>&1)
+rc=$?
+printf '%s\n' "$out"
+[ "$rc" -ne 0 ] || fail "exit code 0 with a failing scene"
+grep -Eq '^scene +CPU-ns/sample +rays/sample +Embree % +peak MiB$' <<<"$out" || fail "no header"
+row=$(grep -E '^cbox +[0-9.]+ +[0-9.]+ +([0-9.]+|-) +[0-9.]+$' <<<"$out") || fail "no cbox row"
+mib=$(awk '{ print $NF }' <<<"$row")
+awk -v m="$mib" 'BEGIN { exit !(m > 0) }' || fail "peak MiB $mib"
+grep -Eq '^missing +error: .*no-such/scene\.xml.*does not exist' <<<"$out" ||
+    fail "no error row for the missing scene"
+grep -q '1 of 2 scenes failed' <<<"$out" || fail "no failure count"
+
+# Without --root, scene paths are relative to the suite file's folder.
+mkdir -p "$work/here"
+cp -r "$scenes/cornell-box" "$work/here/"
+printf 'cbox | cornell-box/scene.xml | -D res=8 -D max_depth=2 -D spp=1\n' >"$work/here/suite.txt"
+out=$("$facet" bench --suite "$work/here/suite.txt" -t 1 2>&1) || fail "suite without --root: $out"
+grep -Eq '^cbox +[0-9.]+ ' <<<"$out" || fail "no row without --root: $out"
+echo "PASS"
