@@ -5,6 +5,7 @@
 //   write.cpp          write_image() of every format but EXR, and the checks of an output path
 //   read.cpp           read_image() and its variants: opening a file and reading its pixels
 //   header_checks.cpp  the hostile-header checks made before OpenImageIO opens or reads a file
+//                      (EXR's are in libfacet, ../exr_headers.cpp: libfacet_read needs them too)
 //   png_messages.cpp   keeps libpng from printing its own error messages
 //   module.cpp         the table libfacet calls the module through (its one exported symbol)
 
@@ -38,8 +39,6 @@ std::vector<uint8_t> to_display_8bit(const Image &image, const std::vector<int> 
 
 // header_checks.cpp: each throws the error read_image() gives for a hostile header.
 
-/// An EXR's headers, scanned before OpenEXR reads them (nothing for another format).
-void check_exr_headers(const std::string &path);
 /// A BMP's header, read before OpenImageIO decodes it (nothing for another format).
 void check_bmp_header(const std::string &path);
 /// A TIFF's strips as OpenImageIO will buffer them (`spec`: the file's, as opened).

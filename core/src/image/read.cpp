@@ -1,5 +1,6 @@
 // read_image() and its variants: the readers facet allows, the checks of a header's sizes, and
 // the pixels read in bands of rows.
+#include "exr_headers.h"
 #include "image_module.h"
 
 #include <facet/checked.h>
