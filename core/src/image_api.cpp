@@ -1,6 +1,7 @@
 // The functions of facet/image.h in libfacet: they load libfacet_image (image/, every use of
-// OpenImageIO and OpenColorIO) the first time one needs it and forward to it. See
-// image_library.h for the structure.
+// OpenImageIO and OpenColorIO), libfacet_exr (writing EXR) or libfacet_read (reading EXR, PNG
+// and JPEG) the first time one needs it and forward to it. See image_library.h for the
+// structure.
 
 #include "image_library.h"
 
@@ -36,6 +37,9 @@ const Module ImageModule{"libfacet_image.so", "FACET_IMAGE_LIBRARY", FACET_IMAGE
 const Module ExrModule{"libfacet_exr.so", "FACET_EXR_LIBRARY", FACET_EXR_LIBRARY_ENTRY,
                        FACET_EXR_LIBRARY_VERSION,
                        "EXR writer (OpenEXR, needed to write .exr images)"};
+const Module ReadModule{"libfacet_read.so", "FACET_READ_LIBRARY", FACET_READ_LIBRARY_ENTRY,
+                        FACET_READ_LIBRARY_VERSION,
+                        "image reader (OpenEXR, libpng and libjpeg, reading those formats)"};
 
 std::string module_path(const Module &module) {
     if (const char *env = std::getenv(module.env); env && *env) return env;
@@ -76,6 +80,27 @@ std::atomic<const detail::ExrLibrary *> g_exr{nullptr};
 
 const detail::ImageLibrary &library() { return load(ImageModule, g_library); }
 const detail::ExrLibrary &exr_library() { return load(ExrModule, g_exr); }
+
+/// libfacet_read, or null when it cannot be loaded: libfacet_image then reads every image (the
+/// same pixels, and OpenImageIO's memory), and the reason is logged once.
+const detail::ReadLibrary *read_library() {
+    static std::atomic<const detail::ReadLibrary *> slot{nullptr};
+    static const detail::ReadLibrary *const table = []() -> const detail::ReadLibrary * {
+        try {
+            return &load(ReadModule, slot);
+        } catch (const std::exception &e) {
+            FACET_LOG(Warn, "{}; images are read by the image library instead", e.what());
+            return nullptr;
+        }
+    }();
+    return table;
+}
+
+/// `read` filled by libfacet_read when it reads `path`; false leaves the file to libfacet_image.
+bool lean_read(const std::string &path, detail::LeanRead &read) {
+    const detail::ReadLibrary *lib = read_library();
+    return lib && lib->read(path, read);
+}
 
 std::string lower_extension(const std::string &path) {
     std::string ext = fs::path(path).extension().string();
@@ -184,13 +209,28 @@ DisplayView resolve_display_view(const ImageWriteOptions &opts) {
     return library().resolve_display_view(opts);
 }
 
-Image read_image(const std::string &path) { return library().read_image(path); }
+Image read_image(const std::string &path) {
+    detail::LeanRead read;
+    if (lean_read(path, read)) return std::move(read.image);
+    return library().read_image(path);
+}
 
 ImageFile read_image_file(const std::string &path) { return library().read_image_file(path); }
 
-ImageHeader read_image_header(const std::string &path) { return library().read_image_header(path); }
+ImageHeader read_image_header(const std::string &path) {
+    detail::LeanRead read;
+    read.header_only = true;
+    if (lean_read(path, read)) return ImageHeader{std::move(read.image), read.keeps_bytes};
+    return library().read_image_header(path);
+}
 
-ByteImage read_image_bytes(const std::string &path) { return library().read_image_bytes(path); }
+ByteImage read_image_bytes(const std::string &path) {
+    detail::LeanRead read;
+    read.want_bytes = true;
+    if (lean_read(path, read))
+        return ByteImage{std::move(read.image), std::move(read.bytes), read.values};
+    return library().read_image_bytes(path);
+}
 
 std::string ocio_config_path(const std::string &explicit_path) {
     return library().ocio_config_path(explicit_path);

@@ -1,7 +1,8 @@
 // libfacet_image (OpenImageIO, OpenColorIO) is loaded the first time an image file other than an
-// EXR output is touched, not before: loading a scene, rendering it and writing the render to
-// .exr (libfacet_exr, OpenEXR alone) leave it unloaded, and the first image read or write of
-// another format loads it. One process per unit executable: this file's tests are its only ones,
+// EXR output or an EXR, PNG or JPEG input is touched, not before: loading a scene, rendering it,
+// writing the render to .exr (libfacet_exr, OpenEXR alone) and reading those files
+// (libfacet_read) leave it unloaded, and the first image read or write of another format loads
+// it. One process per unit executable: this file's tests are its only ones,
 // in order.
 
 #include <facet/image.h>
@@ -53,10 +54,16 @@ TEST(ImageLibrary, ARenderToExrNeverLoadsIt) {
     EXPECT_FALSE(image_library_loaded()) << "loaded by loading or rendering the scene";
     scene->sensors().front()->film().write(r.image, out.string(), {});
     EXPECT_FALSE(image_library_loaded()) << "loaded to write an EXR";
+    // EXR, PNG and JPEG files are read by libfacet_read (OpenEXR, libpng, libjpeg).
     Image back = read_image(out.string());
-    EXPECT_TRUE(image_library_loaded());
     EXPECT_EQ(back.width, 8);
     EXPECT_EQ(back.height, 8);
+    const std::string common = FACET_SOURCE_DIR "/scenes/materials/common/";
+    EXPECT_GT(read_image_bytes(common + "hammered_height.png").bytes.size(), 0u);
+    EXPECT_FALSE(image_library_loaded()) << "loaded to read an EXR or a PNG";
+    // Other formats are read by OpenImageIO.
+    EXPECT_GT(read_image(common + "sky.hdr").width, 0);
+    EXPECT_TRUE(image_library_loaded());
     fs::remove_all(out.parent_path());
 }
 
