@@ -103,7 +103,7 @@ public:
         m_height = img.height;
         // Grey (and grey + alpha) images are grey; an alpha channel is ignored.
         int colour_channels = img.channels >= 3 ? 3 : 1;
-        m_pixels.resize(size_t(m_width) * m_height);
+        m_texels.assign(size_t(m_width + 1) * m_height, Texel{});
         for (int y = 0; y < m_height; ++y)
             for (int x = 0; x < m_width; ++x) {
                 Color3f c;
@@ -117,7 +117,8 @@ public:
                                    y);
                 // Negative values are kept, as Mitsuba keeps them; only the sampling table
                 // clamps at zero.
-                m_pixels[size_t(y) * m_width + x] = c;
+                texel(x, y).radiance = c;
+                if (x == 0) texel(m_width, y).radiance = c; // column W is column 0 again
             }
         build_distribution();
         m_flags = EmitterFlags::Infinite | EmitterFlags::SpatiallyVarying;
@@ -220,10 +221,21 @@ private:
         return g;
     }
 
-    const Color3f &pixel(int x, int y) const {
-        if (x >= m_width) x -= m_width; // column W is column 0 again
-        return m_pixels[size_t(y) * m_width + x];
+    // The radiance and the sampling table of a grid point share a texel, so that a lookup and
+    // the density of the same direction (eval() and pdf_direction(), or the two halves of
+    // sample_direction()) read the same cache lines: in a map larger than the cache each
+    // texel row read is a miss, and separate arrays took twice as many.
+    struct Texel {
+        Color3f radiance;   ///< the pixel, times `scale`
+        float weight = 0.f; ///< the sampling table's value (see build_distribution())
+    };
+    Texel &texel(int x, int y) { return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
+    const Texel &texel(int x, int y) const {
+        return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)];
     }
+
+    /// Pixel (x, y) for x in [0, W]: column W is column 0 again.
+    const Color3f &pixel(int x, int y) const { return texel(x, y).radiance; }
 
     Color3f lookup(const GridPoint &g) const {
         const int i = g.i, j = g.j;
@@ -244,7 +256,7 @@ private:
 
     bool sampling_enabled() const { return m_importance && m_total > 0.0; }
 
-    float table(int i, int j) const { return m_table[size_t(j) * size_t(m_width + 1) + size_t(i)]; }
+    float table(int i, int j) const { return texel(i, j).weight; }
 
     Point2f sample_uv(Point2f u) const {
         float uc = u.x;
@@ -279,7 +291,7 @@ private:
         double sum = 0.0;
         float min_lum = Infinity;
         for (size_t k = 0; k < lum.size(); ++k) {
-            lum[k] = m_pixels[k].luminance();
+            lum[k] = pixel(int(k % size_t(W)), int(k / size_t(W))).luminance();
             sum += double(lum[k]);
             min_lum = std::min(min_lum, lum[k]);
         }
@@ -290,23 +302,23 @@ private:
             offset = float(sum / double(lum.size()));
             if (offset - min_lum <= 0.01f * offset) offset = 0.f;
         }
-        m_table.assign(size_t(W + 1) * H, 0.f);
         for (int j = 0; j < H; ++j) {
             // Zero on the pole rows (sin of a float π is slightly negative).
             float sin_theta = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
             if (j == H - 1) sin_theta = 0.f;
             for (int i = 0; i <= W; ++i)
-                m_table[size_t(j) * size_t(W + 1) + size_t(i)] =
+                texel(i, j).weight =
                     std::max(lum[size_t(j) * W + size_t(i % W)] - offset, 0.f) * sin_theta;
         }
         // Scaled by a power of two so that the largest entry lies in [1, 2): the density is
         // unchanged to the last bit (every operation on the table scales exactly), and the
         // sampling's squares neither underflow for a very dark map nor overflow for a very bright
         // one, nor does the density's normalisation (cells / total) overflow.
-        const float max_entry = *std::max_element(m_table.begin(), m_table.end());
+        float max_entry = 0.f;
+        for (const Texel &t : m_texels) max_entry = std::max(max_entry, t.weight);
         if (max_entry > 0.f && std::isfinite(max_entry)) {
             const float to_unit = std::ldexp(1.f, -std::ilogb(max_entry));
-            for (float &v : m_table) v *= to_unit;
+            for (Texel &t : m_texels) t.weight *= to_unit;
         }
         std::vector<float> cells(size_t(W) * size_t(H - 1));
         for (int j = 0; j + 1 < H; ++j)
@@ -324,8 +336,7 @@ private:
     Transform m_to_world;
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
-    std::vector<Color3f> m_pixels;
-    std::vector<float> m_table;
+    std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels and the sampling table
     DiscreteDistribution m_cells;
     double m_total = 0.0;
     float m_density_scale = 0.f;
