@@ -185,9 +185,10 @@ void add_bench_options(CLI::App &app, BenchCommand &c) {
                  "\"machine:\" (what `facet bench --suite` reads)");
 }
 
-/// The --reference image, checked against the size of the sensor's film.
-Image read_reference(const std::string &reference, const Sensor &sensor) {
-    Image ref_image = read_image(reference);
+/// The --reference image (its header only when `header_only`), checked against the size of the
+/// sensor's film.
+Image read_reference(const std::string &reference, const Sensor &sensor, bool header_only) {
+    Image ref_image = header_only ? read_image_header(reference).image : read_image(reference);
     Point2i size = sensor.film().crop_size();
     if (ref_image.width != size.x || ref_image.height != size.y || ref_image.channels < 3)
         FACET_THROW("--reference {}: {}x{} pixels with {} channels, expected {}x{} with at "
@@ -351,14 +352,16 @@ double print_embree_share(const Scene &scene, const Sensor &sensor, const Render
 
 /// The figures of the bench as one line of key=value pairs (--machine): samples are camera
 /// samples (pixels x spp), time is CPU time; embree_share is "-" when it was not measured.
-void print_machine_line(const Measured &m, int spp, int threads, double embree_share) {
+/// rmse: of the render against --reference ("-" without one).
+void print_machine_line(const Measured &m, int spp, int threads, double embree_share, double rmse) {
     const double samples = std::max<double>(1.0, double(m.result.samples));
     const uint64_t rays = m.rays.total();
     fmt::print("machine: spp={} threads={} samples={} rays={} cpu_seconds={:.6f} "
-               "cpu_ns_per_sample={:.3f} rays_per_sample={:.4f} embree_share={}\n",
+               "cpu_ns_per_sample={:.3f} rays_per_sample={:.4f} embree_share={} rmse={}\n",
                spp, threads, m.result.samples, rays, m.cpu_seconds, 1e9 * m.cpu_seconds / samples,
                double(rays) / samples,
-               embree_share < 0.0 ? std::string("-") : fmt::format("{:.4f}", embree_share));
+               embree_share < 0.0 ? std::string("-") : fmt::format("{:.4f}", embree_share),
+               rmse < 0.0 ? std::string("-") : fmt::format("{:.9g}", rmse));
 }
 
 } // namespace
@@ -384,7 +387,9 @@ int bench_main(int argc, char **argv) {
         FACET_THROW("-s {}: the scene has {} sensor(s)", opts.sensor, sensors.size());
     const Sensor &sensor = *sensors[size_t(opts.sensor)];
     const int threads = cli::effective_threads(opts.threads);
-    const Image ref_image = c.reference.empty() ? Image() : read_reference(c.reference, sensor);
+    // The reference's size is checked before the render, its pixels read after it: they are not
+    // part of the render's peak memory.
+    if (!c.reference.empty()) read_reference(c.reference, sensor, true);
 
     RenderOptions ropts;
     ropts.threads = opts.threads;
@@ -404,8 +409,12 @@ int bench_main(int argc, char **argv) {
     const Measured m = measure_render(*scene, sensor, ropts, &counter);
     throw_if_interrupted(m.result);
     print_render_cost(m, threads, counter);
+    const Image ref_image =
+        c.reference.empty() ? Image() : read_reference(c.reference, sensor, false);
     if (!c.reference.empty()) print_equal_error(c, *scene, sensor, ropts, m, ref_image);
     const double share = print_embree_share(*scene, sensor, ropts, m);
-    if (c.machine) print_machine_line(m, c.spp, threads, share);
+    if (c.machine)
+        print_machine_line(m, c.spp, threads, share,
+                           c.reference.empty() ? -1.0 : rmse(m.result.image, ref_image));
     return 0;
 }

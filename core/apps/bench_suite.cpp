@@ -4,6 +4,15 @@
 // --machine ...`), so that a scene's peak memory (the child's ru_maxrss, from wait4()) is its own
 // and a scene that fails, even by crashing, does not stop the others. The child's figures are
 // read from its "machine:" line.
+//
+// With --references DIR, each scene is also measured at equal error: DIR/<name>.exr is a render of
+// the scene at many samples per pixel (rendered first, by `facet render` in a child, when it is
+// missing, and kept for later runs), the child bench gives its render's RMSE against it, and the
+// table prints the CPU time the render would need to reach an RMSE of 0.01 (RMSE² · CPU-s · 10⁴,
+// as the error of an unbiased estimator falls with 1/√time). Two builds' figures then compare
+// their estimators as well as their speed: one that reaches the same error sooner is faster even
+// if each sample costs more. The reference's own error adds about spp/reference-spp to RMSE²
+// (1/64 at the defaults below), the same for both builds.
 
 #include "commands.h"
 
@@ -141,6 +150,7 @@ ChildRun run_child(const std::vector<std::string> &args) {
 /// The figures of one run of a scene, or its error.
 struct Figures {
     double ns_per_sample = 0.0, rays_per_sample = 0.0, embree_share = -1.0, peak_mib = 0.0;
+    double equal_error_seconds = -1.0; ///< CPU-s to an RMSE of 0.01; -1 without a reference
     std::string error;
 };
 
@@ -174,19 +184,43 @@ std::string child_error(const ChildRun &run) {
     return last.empty() ? how : fmt::format("{} ({})", how, last);
 }
 
-Figures bench_once(const SuiteEntry &e, int threads, bool threads_given) {
-    std::vector<std::string> args = {"facet", "bench", e.scene, "--machine"};
+/// The scene's arguments for a child `facet` command: its -D defines, and -t when given.
+void add_scene_arguments(std::vector<std::string> &args, const SuiteEntry &e, int threads,
+                         bool threads_given) {
     for (const std::string &d : e.defines) {
         args.push_back("-D");
         args.push_back(d);
     }
-    if (!e.spp.empty()) {
-        args.push_back("--spp");
-        args.push_back(e.spp);
-    }
     if (threads_given) {
         args.push_back("-t");
         args.push_back(std::to_string(threads));
+    }
+}
+
+/// Renders the reference `path` of `e` at `spp` in a child `facet render`; throws its error.
+void render_reference(const SuiteEntry &e, const std::string &path, int spp, int threads,
+                      bool threads_given) {
+    std::vector<std::string> args = {"facet", "render", e.scene, "-o", path, "-q"};
+    add_scene_arguments(args, e, threads, threads_given);
+    args.push_back("--spp");
+    args.push_back(std::to_string(spp));
+    fmt::print("reference {}: rendering {} at {} spp\n", e.name, path, spp);
+    std::fflush(stdout);
+    const ChildRun run = run_child(args);
+    if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0)
+        FACET_THROW("reference {}: {}", e.name, child_error(run));
+}
+
+Figures bench_once(const SuiteEntry &e, int threads, bool threads_given,
+                   const std::string &reference) {
+    std::vector<std::string> args = {"facet", "bench", e.scene, "--machine"};
+    if (!reference.empty()) {
+        args.insert(args.end(), {"--reference", reference, "--rounds", "1"});
+    }
+    add_scene_arguments(args, e, threads, threads_given);
+    if (!e.spp.empty()) {
+        args.push_back("--spp");
+        args.push_back(e.spp);
     }
     const ChildRun run = run_child(args);
     Figures f;
@@ -203,6 +237,10 @@ Figures bench_once(const SuiteEntry &e, int threads, bool threads_given) {
         auto share = values.find("embree_share");
         if (share != values.end() && share->second != "-")
             f.embree_share = std::stod(share->second);
+        if (!reference.empty()) {
+            const double rmse = std::stod(values.at("rmse"));
+            f.equal_error_seconds = rmse * rmse * std::stod(values.at("cpu_seconds")) * 1e4;
+        }
     } catch (const std::exception &) {
         f.error = "unreadable machine: line in the bench's output";
     }
@@ -218,31 +256,35 @@ double median(std::vector<double> v) {
 /// The medians of the runs, figure by figure (the first error if a run failed).
 Figures medians(const std::vector<Figures> &runs) {
     Figures m;
-    std::vector<double> ns, rays, share, mib;
+    std::vector<double> ns, rays, share, mib, equal;
     for (const Figures &f : runs) {
         if (!f.error.empty()) return f;
         ns.push_back(f.ns_per_sample);
         rays.push_back(f.rays_per_sample);
         mib.push_back(f.peak_mib);
         if (f.embree_share >= 0.0) share.push_back(f.embree_share);
+        if (f.equal_error_seconds >= 0.0) equal.push_back(f.equal_error_seconds);
     }
     m.ns_per_sample = median(ns);
     m.rays_per_sample = median(rays);
     m.peak_mib = median(mib);
     m.embree_share = share.empty() ? -1.0 : median(share);
+    m.equal_error_seconds = equal.empty() ? -1.0 : median(equal);
     return m;
 }
 
 } // namespace
 
 int bench_suite_main(int argc, char **argv) {
-    std::string suite, root;
-    int runs = 1, threads = 0;
+    std::string suite, root, references;
+    int runs = 1, threads = 0, reference_spp = 1024;
     CLI::App app("Bench every scene of a suite file, each in a process of its own, and print one "
                  "table: CPU-ns per camera sample (pixel sample), rays per sample, Embree's share "
                  "of the CPU time and the process's peak memory; with --runs N, the medians of N "
                  "runs. Each line of FILE is `name | scene file | -D key=value ...` (# starts a "
-                 "comment line); -D spp=N is also the bench's --spp",
+                 "comment line); -D spp=N is also the bench's --spp. With --references DIR, "
+                 "also the CPU-s each render would need to reach an RMSE of 0.01 against "
+                 "DIR/<name>.exr (rendered at --reference-spp when missing)",
                  "facet bench --suite");
     app.add_option("--suite", suite, "The suite file")->required();
     app.add_option("--runs", runs, "Runs of each scene (default 1); the table has their medians")
@@ -251,11 +293,32 @@ int bench_suite_main(int argc, char **argv) {
         app.add_option("-t,--threads", threads, "Render threads (default: all cores)");
     app.add_option("--root", root,
                    "Folder the scene paths are relative to (default: the suite file's)");
+    app.add_option("--references", references,
+                   "Folder of the equal-error references, DIR/<name>.exr: a missing one is "
+                   "rendered first and kept");
+    app.add_option("--reference-spp", reference_spp,
+                   "Samples per pixel of a reference rendered by --references (default 1024)")
+        ->check(CLI::PositiveNumber);
     if (int code = facet::cli::parse(app, argc, argv); code >= 0) return code;
 
     const fs::path base = root.empty() ? fs::path(suite).parent_path() : fs::path(root);
     const std::vector<SuiteEntry> entries = read_suite(suite, base);
     if (entries.empty()) FACET_THROW("--suite {}: no scene in it", suite);
+
+    // The references first, so that the table is printed in one piece.
+    std::vector<std::string> reference_of(entries.size());
+    if (!references.empty()) {
+        std::error_code ec;
+        fs::create_directories(references, ec);
+        if (!fs::is_directory(references, ec))
+            FACET_THROW("--references {}: not a folder and cannot be made one", references);
+        for (size_t i = 0; i < entries.size(); ++i) {
+            reference_of[i] = (fs::path(references) / (entries[i].name + ".exr")).string();
+            if (!fs::exists(reference_of[i], ec))
+                render_reference(entries[i], reference_of[i], reference_spp, threads,
+                                 threads_opt->count() > 0);
+        }
+    }
 
     size_t width = 5;
     for (const SuiteEntry &e : entries) width = std::max(width, e.name.size());
@@ -265,13 +328,15 @@ int bench_suite_main(int argc, char **argv) {
                threads_opt->count()
                    ? fmt::format("{} thread{}", std::max(threads, 1), threads > 1 ? "s" : "")
                    : std::string("all cores"));
-    fmt::print("{:<{}}  {:>14}  {:>11}  {:>8}  {:>8}\n", "scene", width, "CPU-ns/sample",
-               "rays/sample", "Embree %", "peak MiB");
+    fmt::print("{:<{}}  {:>14}  {:>11}  {:>8}  {:>8}{}\n", "scene", width, "CPU-ns/sample",
+               "rays/sample", "Embree %", "peak MiB",
+               references.empty() ? "" : fmt::format("  {:>13}", "s to RMSE .01"));
     int failed = 0;
-    for (const SuiteEntry &e : entries) {
+    for (size_t i = 0; i < entries.size(); ++i) {
+        const SuiteEntry &e = entries[i];
         std::vector<Figures> all;
         for (int r = 0; r < runs; ++r) {
-            all.push_back(bench_once(e, threads, threads_opt->count() > 0));
+            all.push_back(bench_once(e, threads, threads_opt->count() > 0, reference_of[i]));
             if (!all.back().error.empty()) break;
         }
         const Figures m = medians(all);
@@ -279,11 +344,14 @@ int bench_suite_main(int argc, char **argv) {
             ++failed;
             fmt::print("{:<{}}  error: {}\n", e.name, width, m.error);
         } else {
-            fmt::print("{:<{}}  {:>14.1f}  {:>11.2f}  {:>8}  {:>8.1f}\n", e.name, width,
+            fmt::print("{:<{}}  {:>14.1f}  {:>11.2f}  {:>8}  {:>8.1f}{}\n", e.name, width,
                        m.ns_per_sample, m.rays_per_sample,
                        m.embree_share < 0.0 ? std::string("-")
                                             : fmt::format("{:.1f}", 100.0 * m.embree_share),
-                       m.peak_mib);
+                       m.peak_mib,
+                       m.equal_error_seconds < 0.0
+                           ? std::string()
+                           : fmt::format("  {:>13.4g}", m.equal_error_seconds));
         }
         std::fflush(stdout);
     }

@@ -21,6 +21,6 @@ awk -v a="$replayed" -v b="$rays" 'BEGIN { exit !(a >= b && b > 0) }' ||
     fail "replayed $replayed Mrays, fewer than the render's $rays"
 grep -Eq "^share       : Embree's own work is [0-9]+\.[0-9]% of the render's CPU time \($rays Mrays at [0-9.]+ CPU-ns\); the rest, [0-9.]+ CPU-ns per sample, is facet's$" \
     <<<"$out" || fail "no share line"
-grep -Eq '^machine: spp=4 threads=[0-9]+ samples=[0-9]+ rays=[0-9]+ cpu_seconds=[0-9.]+ cpu_ns_per_sample=[0-9.]+ rays_per_sample=[0-9.]+ embree_share=[0-9.]+$' \
+grep -Eq '^machine: spp=4 threads=[0-9]+ samples=[0-9]+ rays=[0-9]+ cpu_seconds=[0-9.]+ cpu_ns_per_sample=[0-9.]+ rays_per_sample=[0-9.]+ embree_share=[0-9.]+ rmse=-$' \
     <<<"$out" || fail "no machine: line"
 echo "PASS"

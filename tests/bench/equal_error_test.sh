@@ -2,7 +2,7 @@
 # `facet bench --reference` (the equal-error mode) on a scene at tiny settings: renders a
 # reference, runs the bench against it and checks the output's format and sense: one row per
 # round (spp doubling, CPU-s, RMSE, efficiency), an error that falls with the sample count, and
-# the time to a target RMSE.
+# the time to a target RMSE; and the rmse= of the --machine line.
 #   equal_error_test.sh <facet> <scene.xml> <work dir> [-D key=value]...
 set -euo pipefail
 facet=$1 scene=$2 work=$3
@@ -30,4 +30,12 @@ awk '{lo=1/($3*$3*($2+0.0005)); hi=($2>0.0005)?1/($3*$3*($2-0.0005)):1e300;
     fail "the efficiency column is not 1/(RMSE² · CPU-s)"
 grep -Eq '^ +RMSE 0\.001 reached after [0-9.]+ CPU-s \((interpolated|extrapolated with RMSE ~ 1/sqrt\(time\))\)$' \
     <<<"$out" || fail "no time to the target RMSE"
+# --machine gives the first round's RMSE (what `facet bench --suite --references` reads): the
+# same render, the same error.
+machine=$("$facet" bench "$scene" "$@" --spp 1 --rounds 1 -t 1 --reference "$ref" --machine |
+    grep '^machine: ') || fail "no machine: line"
+rmse=$(sed -nE 's/.* rmse=([0-9.e+-]+)( .*)?$/\1/p' <<<"$machine")
+first=$(awk 'NR==1{print $3}' <<<"$rows")
+awk -v a="$rmse" -v b="$first" 'BEGIN{exit !(a > 0 && a - b < 1e-5 * b && b - a < 1e-5 * b)}' ||
+    fail "machine: rmse=$rmse, the first round's RMSE is $first"
 echo "PASS"
