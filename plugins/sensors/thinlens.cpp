@@ -106,16 +106,11 @@ public:
         if (!(dist2 > 0.f)) return {ds, Color3f(0.f)};
         ds.dist = std::sqrt(dist2);
         ds.d = to_lens / ds.dist;
-        if (local.z < m_near_clip || local.z > m_far_clip) return {ds, Color3f(0.f)};
-        const Vector3f w = local - lens_p;
-        if (!(w.z > 0.f)) return {ds, Color3f(0.f)};
-        const float t = m_focus_distance / w.z;
-        const float fx = lens_p.x + w.x * t, fy = lens_p.y + w.y * t;
-        const float fu = 0.5f * (1.f - fx / (m_focus_distance * m_tan_x));
-        const float fv = 0.5f * (1.f - fy / (m_focus_distance * m_tan_y));
-        if (!(fu >= 0.f && fu < 1.f && fv >= 0.f && fv < 1.f)) return {ds, Color3f(0.f)};
+        Point2f film;
+        if (!film_position(local, lens_p, film)) return {ds, Color3f(0.f)};
         const Point2i size = m_film->size();
-        ds.uv = Point2f(fu * float(size.x), fv * float(size.y));
+        ds.uv = Point2f(film.x * float(size.x), film.y * float(size.y));
+        const Vector3f w = local - lens_p;
         const float cos_theta = w.z / norm(w);
         ds.pdf = ds.delta ? 1.f : dist2 / (cos_theta * Pi * m_aperture_radius * m_aperture_radius);
         const float weight =
@@ -130,9 +125,15 @@ public:
         // rounded, and must keep its density.
         const float r2 = m_aperture_radius * m_aperture_radius;
         if (lens.x * lens.x + lens.y * lens.y > r2 * (1.f + 1e-4f)) return 0.f;
-        const Vector3f w = m_world_to_local.apply_point(ref.p) - Point3f(lens.x, lens.y, 0.f);
+        const Point3f local = m_world_to_local.apply_point(ref.p);
+        const Point3f lens_p(lens.x, lens.y, 0.f);
+        // Zero where sample_direction() gives no sample: the ray from this lens point to the
+        // reference point must pass through the film (and the point lie in the clipping range).
+        Point2f film;
+        if (!film_position(local, lens_p, film)) return 0.f;
+        const Vector3f w = local - lens_p;
         const float dist2 = dot(w, w);
-        if (!(w.z > 0.f) || !(dist2 > 0.f)) return 0.f;
+        if (!(dist2 > 0.f)) return 0.f;
         const float cos_theta = w.z / std::sqrt(dist2);
         return dist2 / (cos_theta * Pi * m_aperture_radius * m_aperture_radius);
     }
@@ -144,6 +145,20 @@ public:
     }
 
 private:
+    /// The film position in [0, 1)² of the camera ray from lens point `lens_p` through the local
+    /// point `local`: false when there is none (outside the clipping range, behind the lens, or
+    /// off the film).
+    bool film_position(const Point3f &local, const Point3f &lens_p, Point2f &film) const {
+        if (local.z < m_near_clip || local.z > m_far_clip) return false;
+        const Vector3f w = local - lens_p;
+        if (!(w.z > 0.f)) return false;
+        const float t = m_focus_distance / w.z;
+        const float fx = lens_p.x + w.x * t, fy = lens_p.y + w.y * t;
+        film.x = 0.5f * (1.f - fx / (m_focus_distance * m_tan_x));
+        film.y = 0.5f * (1.f - fy / (m_focus_distance * m_tan_y));
+        return film.x >= 0.f && film.x < 1.f && film.y >= 0.f && film.y < 1.f;
+    }
+
     float m_tan_x = 1.f, m_tan_y = 1.f;
     float m_aperture_radius = 0.f, m_focus_distance = 1.f;
     float m_near_clip = 1e-2f, m_far_clip = 1e4f;
