@@ -10,6 +10,7 @@
 
 #include <facet/image.h>
 #include <facet/logger.h>
+#include <facet/qmc.h>
 
 #include <Imath/ImathBox.h>
 #include <Imath/half.h>
@@ -49,6 +50,7 @@
 using namespace facet;
 using facet::detail::ImageLibrary;
 using facet::detail::ReadLibrary;
+using facet::qmc::hash32;
 namespace fs = std::filesystem;
 
 namespace {
@@ -91,15 +93,6 @@ const ReadLibrary *read_module() {
     return table;
 }
 
-uint32_t hash(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-
 /// Bytes with structure (gradients, a few edges) and noise; every 8-bit code when w >= 256.
 std::vector<uint8_t> byte_pixels(int w, int h, int c, uint32_t seed) {
     std::vector<uint8_t> v(size_t(w) * h * c);
@@ -107,7 +100,7 @@ std::vector<uint8_t> byte_pixels(int w, int h, int c, uint32_t seed) {
         for (int x = 0; x < w; ++x)
             for (int k = 0; k < c; ++k) {
                 const size_t i = (size_t(y) * w + x) * c + k;
-                const uint32_t r = hash(uint32_t(i) * 2654435761u + seed);
+                const uint32_t r = hash32(uint32_t(i) * 2654435761u + seed);
                 int value = (x * 255 / std::max(w - 1, 1) + 37 * k + 11 * y) & 255;
                 if (y % 3 == 1)
                     value = int(r & 255); // noise rows
@@ -122,7 +115,7 @@ std::vector<uint8_t> byte_pixels(int w, int h, int c, uint32_t seed) {
 std::vector<uint16_t> short_pixels(int w, int h, int c, uint32_t seed) {
     std::vector<uint16_t> v(size_t(w) * h * c);
     for (size_t i = 0; i < v.size(); ++i) {
-        const uint32_t r = hash(uint32_t(i) + seed);
+        const uint32_t r = hash32(uint32_t(i) + seed);
         const int x = int((i / size_t(c)) % size_t(w));
         v[i] = i % 7 == 3 ? uint16_t(r) : uint16_t(x * 65535 / std::max(w - 1, 1) ^ (r & 0xff));
     }
@@ -137,7 +130,7 @@ std::vector<float> float_pixels(int w, int h, int c, uint32_t seed) {
         for (int x = 0; x < w; ++x)
             for (int k = 0; k < c; ++k) {
                 const size_t i = (size_t(y) * w + x) * c + k;
-                const uint32_t r = hash(uint32_t(i) + seed);
+                const uint32_t r = hash32(uint32_t(i) + seed);
                 float value = 0.013f * float(x) + 0.029f * float(y) + 0.31f * float(k) +
                               float(r & 0xffff) * (1.f / 65536.f);
                 switch (r >> 28) {
@@ -751,7 +744,7 @@ TEST_F(LeanReader, ExrFilesMatchTheImageModule) {
                                      0x007fffffu, 0x3f800000u, 0xbf800000u, 0x7fffffffu};
         std::vector<uint32_t> px(size_t(12 * 5 * 3));
         for (size_t i = 0; i < px.size(); ++i)
-            px[i] = i % 3 == 0 ? specials[(i / 3) % 12] : hash(uint32_t(i));
+            px[i] = i % 3 == 0 ? specials[(i / 3) % 12] : hash32(uint32_t(i));
         return oiio_write(p, exr_spec(12, 5, {"R", "G", "B"}, FLOAT, "none"), FLOAT, px.data());
     });
 
@@ -815,7 +808,7 @@ TEST_F(LeanReader, ExrFilesMatchTheImageModule) {
     });
     add("uint-rgb.exr", Expect::Decline, [&](const std::string &p) {
         std::vector<uint32_t> px(11 * 7 * 3);
-        for (size_t i = 0; i < px.size(); ++i) px[i] = hash(uint32_t(i));
+        for (size_t i = 0; i < px.size(); ++i) px[i] = hash32(uint32_t(i));
         return oiio_write(p, exr_spec(11, 7, {"R", "G", "B"}, OIIO::TypeDesc::UINT),
                           OIIO::TypeDesc::UINT, px.data());
     });
@@ -944,7 +937,7 @@ TEST_F(LeanReader, PngFilesMatchTheImageModule) {
                                          : PNG_COLOR_TYPE_RGB_ALPHA;
         png.data.resize(png.rowbytes() * size_t(h));
         for (size_t i = 0; i < png.data.size(); ++i)
-            png.data[i] = uint8_t(hash(uint32_t(i) + seed) >> ((i % 5) * 3));
+            png.data[i] = uint8_t(hash32(uint32_t(i) + seed) >> ((i % 5) * 3));
         return png;
     };
     auto with = [&](PngFile png) {
@@ -970,17 +963,17 @@ TEST_F(LeanReader, PngFilesMatchTheImageModule) {
         PngFile pal = packed(37, 23, 1, bits, uint32_t(55 + bits));
         pal.color_type = PNG_COLOR_TYPE_PALETTE;
         for (int i = 0; i < (1 << bits); ++i)
-            pal.palette.push_back({png_byte(hash(uint32_t(i)) & 255),
-                                   png_byte(hash(uint32_t(i) + 1) & 255), png_byte(i * 3)});
+            pal.palette.push_back({png_byte(hash32(uint32_t(i)) & 255),
+                                   png_byte(hash32(uint32_t(i) + 1) & 255), png_byte(i * 3)});
         add(fmt::format("palette-{}bit.png", bits), Expect::Either, with(pal));
     }
     {
         PngFile pal = packed(41, 17, 1, 8, 60);
         pal.color_type = PNG_COLOR_TYPE_PALETTE;
         for (int i = 0; i < 256; ++i)
-            pal.palette.push_back({png_byte(i), png_byte(255 - i), png_byte(hash(uint32_t(i)))});
+            pal.palette.push_back({png_byte(i), png_byte(255 - i), png_byte(hash32(uint32_t(i)))});
         add("palette-8bit.png", Expect::Either, with(pal));
-        for (int i = 0; i < 200; ++i) pal.trans_alpha.push_back(png_byte(hash(uint32_t(i + 9))));
+        for (int i = 0; i < 200; ++i) pal.trans_alpha.push_back(png_byte(hash32(uint32_t(i + 9))));
         add("palette-trns.png", Expect::Either, with(pal));
         pal.interlace = true;
         add("palette-trns-interlaced.png", Expect::Either, with(pal));
@@ -1139,7 +1132,7 @@ TEST_F(LeanReader, TruncatedAndDamagedFilesAreDeclinedOrMatch) {
         }
         for (int k = 0; k < 6; ++k) {
             std::string damaged = bytes;
-            const size_t at = 8 + hash(uint32_t(k) + 1000) % (damaged.size() - 8);
+            const size_t at = 8 + hash32(uint32_t(k) + 1000) % (damaged.size() - 8);
             damaged[at] = char(damaged[at] ^ 0x5a);
             const std::string name = fmt::format("flip-{}-{}", at, src);
             put_file(path(name), damaged);
