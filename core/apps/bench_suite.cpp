@@ -197,9 +197,10 @@ void add_scene_arguments(std::vector<std::string> &args, const SuiteEntry &e, in
     }
 }
 
-/// Renders the reference `path` of `e` at `spp` in a child `facet render`; throws its error.
-void render_reference(const SuiteEntry &e, const std::string &path, int spp, int threads,
-                      bool threads_given) {
+/// Renders the reference `path` of `e` at `spp` in a child `facet render`; returns its error
+/// ("" when it rendered).
+std::string render_reference(const SuiteEntry &e, const std::string &path, int spp, int threads,
+                             bool threads_given) {
     std::vector<std::string> args = {"facet", "render", e.scene, "-o", path, "-q"};
     add_scene_arguments(args, e, threads, threads_given);
     args.push_back("--spp");
@@ -208,7 +209,8 @@ void render_reference(const SuiteEntry &e, const std::string &path, int spp, int
     std::fflush(stdout);
     const ChildRun run = run_child(args);
     if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0)
-        FACET_THROW("reference {}: {}", e.name, child_error(run));
+        return "reference: " + child_error(run);
+    return {};
 }
 
 Figures bench_once(const SuiteEntry &e, int threads, bool threads_given,
@@ -305,8 +307,9 @@ int bench_suite_main(int argc, char **argv) {
     const std::vector<SuiteEntry> entries = read_suite(suite, base);
     if (entries.empty()) FACET_THROW("--suite {}: no scene in it", suite);
 
-    // The references first, so that the table is printed in one piece.
-    std::vector<std::string> reference_of(entries.size());
+    // The references first, so that the table is printed in one piece. A scene whose reference
+    // fails prints that error in its row, as a scene that fails its bench does.
+    std::vector<std::string> reference_of(entries.size()), reference_error(entries.size());
     if (!references.empty()) {
         std::error_code ec;
         fs::create_directories(references, ec);
@@ -315,8 +318,8 @@ int bench_suite_main(int argc, char **argv) {
         for (size_t i = 0; i < entries.size(); ++i) {
             reference_of[i] = (fs::path(references) / (entries[i].name + ".exr")).string();
             if (!fs::exists(reference_of[i], ec))
-                render_reference(entries[i], reference_of[i], reference_spp, threads,
-                                 threads_opt->count() > 0);
+                reference_error[i] = render_reference(entries[i], reference_of[i], reference_spp,
+                                                      threads, threads_opt->count() > 0);
         }
     }
 
@@ -335,7 +338,11 @@ int bench_suite_main(int argc, char **argv) {
     for (size_t i = 0; i < entries.size(); ++i) {
         const SuiteEntry &e = entries[i];
         std::vector<Figures> all;
-        for (int r = 0; r < runs; ++r) {
+        if (!reference_error[i].empty()) {
+            all.emplace_back();
+            all.back().error = reference_error[i];
+        }
+        for (int r = 0; r < runs && reference_error[i].empty(); ++r) {
             all.push_back(bench_once(e, threads, threads_opt->count() > 0, reference_of[i]));
             if (!all.back().error.empty()) break;
         }

@@ -56,4 +56,12 @@ out=$("$facet" bench --suite "$work/one.txt" --root "$scenes" --references "$wor
 grep -q '^reference ' <<<"$out" && fail "the reference was rendered again"
 [ "$(stat -c %Y "$work/refs/cbox.exr")" = "$before" ] || fail "the reference changed"
 grep -Eq '^cbox .* [0-9.e+-]+$' <<<"$out" || fail "no row on the second run"
+# A scene whose reference cannot be rendered prints that error in its row; the others still run.
+out=$("$facet" bench --suite "$work/suite.txt" --root "$scenes" --references "$work/refs" -t 2 2>&1)
+rc=$?
+printf '%s\n' "$out"
+[ "$rc" -ne 0 ] || fail "exit code 0 with a scene whose reference failed"
+grep -Eq '^missing +error: reference: .*no-such/scene\.xml.*does not exist' <<<"$out" ||
+    fail "no reference error in the missing scene's row"
+grep -Eq '^cbox .* [0-9.e+-]+$' <<<"$out" || fail "no cbox row next to the failed reference"
 echo "PASS"
