@@ -47,6 +47,7 @@ struct SceneOptions {
     int verbose = 0;                      ///< number of -v
     bool quiet = false;                   ///< -q
     bool lenient = false;                 ///< --lenient
+    std::string mode;                     ///< the colour mode (-m, resolved); empty: the default
 };
 
 /// Adds -D, -a, -t, -s, -v, -q, --lenient and the scene argument to `app`.

@@ -38,6 +38,7 @@ int info_main(int argc, char **argv) {
 
     facet::LoadOptions load;
     load.lenient = lenient;
+    load.mode = mode;
     for (const std::string &value : dirs) {
         size_t start = 0;
         while (start <= value.size()) {

@@ -82,6 +82,7 @@ std::shared_ptr<Scene> load_scene(SceneOptions &opts) {
 
     LoadOptions load;
     load.lenient = opts.lenient;
+    load.mode = opts.mode;
     for (const std::string &value : opts.plugin_dirs) {
         size_t start = 0;
         while (start <= value.size()) {
@@ -549,6 +550,7 @@ int render_main(int argc, char **argv) {
         FACET_THROW("--spp {}: the number of samples per pixel must be at least 1", c.spp);
     cli::set_log_level(c.scene); // -q hides the note of a vectorised mode name
     c.mode = resolve_mode(c.mode);
+    c.scene.mode = c.mode;
 
     // Several scenes render one after the other; the first error or signal ends the sequence.
     for (const std::string &scene_path : scenes_to_render(c)) {

@@ -90,8 +90,8 @@ ConductorIOR read_conductor_ior(const Properties &props) {
         } catch (const Error &e) {
             throw Error(props.location("material"), e.message());
         }
-        result.eta = std::make_shared<ConstantTexture>(eta_k.first);
-        result.k = std::make_shared<ConstantTexture>(eta_k.second);
+        result.eta = std::make_shared<ConstantTexture>(in_mode(eta_k.first, props.mode()));
+        result.k = std::make_shared<ConstantTexture>(in_mode(eta_k.second, props.mode()));
     }
     return result;
 }

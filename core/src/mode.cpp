@@ -41,7 +41,7 @@ bool has_mode(const std::string &name) {
 } // namespace
 
 const std::vector<std::string> &modes() {
-    static const std::vector<std::string> list = {"scalar_rgb"};
+    static const std::vector<std::string> list = {"scalar_rgb", "scalar_mono"};
     return list;
 }
 
@@ -72,6 +72,23 @@ std::string resolve_mode(const std::string &name) {
     const std::string close = closest_name(lower, accepted);
     FACET_THROW("unknown mode \"{}\"{}; the modes facet renders: {}", name,
                 close.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", close), list);
+}
+
+ColourMode colour_mode(const std::string &mode) {
+    if (mode == "scalar_rgb") return ColourMode::RGB;
+    if (mode == "scalar_mono") return ColourMode::Mono;
+    FACET_THROW("\"{}\" is no mode facet renders (expected one of: {})", mode,
+                fmt::join(modes(), ", "));
+}
+
+const char *mode_name(ColourMode mode) {
+    switch (mode) {
+    case ColourMode::Mono:
+        return "scalar_mono";
+    case ColourMode::RGB:
+        break;
+    }
+    return "scalar_rgb";
 }
 
 } // namespace facet

@@ -240,6 +240,7 @@ SceneUpdate SceneParameters::update() {
         if (!recreate[i]) continue;
         const Node &node = d.nodes[i];
         Properties props(node.plugin);
+        props.set_mode(d.mode);
         props.set_id(node.id);
         props.set_location(node.location);
         for (const auto &e : entries_of(i)) {
@@ -281,6 +282,7 @@ SceneUpdate SceneParameters::update() {
 
         const Node &root = d.nodes[d.root];
         Properties props(root.plugin);
+        props.set_mode(d.mode);
         props.set_id(root.id);
         props.set_location(root.location);
         for (const auto &e : root.entries) {

@@ -229,7 +229,7 @@ Transform Properties::get_transform(const std::string &name, const Transform &de
 Color3f Properties::spectrum_value(const SpectrumTexture &spectrum, const std::string &name,
                                    const Location &loc, SpectrumKind kind) const {
     try {
-        return spectrum.value(kind);
+        return in_mode(spectrum.value(kind), m_mode);
     } catch (const Error &err) {
         if (err.location().valid()) throw;
         FACET_THROW_AT(loc.valid() ? loc : m_location, "parameter \"{}\": {}", name, err.message());
@@ -238,13 +238,13 @@ Color3f Properties::spectrum_value(const SpectrumTexture &spectrum, const std::s
 
 Color3f Properties::get_color(const std::string &name, SpectrumKind kind) const {
     const Entry &e = require(name);
-    if (auto v = std::get_if<Color3f>(&e.value)) return *v;
+    if (auto v = std::get_if<Color3f>(&e.value)) return in_mode(*v, m_mode);
     if (auto v = std::get_if<double>(&e.value)) return Color3f(float(*v));
     if (auto v = std::get_if<int64_t>(&e.value)) return Color3f(float(*v));
     if (auto v = std::get_if<Vector3f>(&e.value)) return Color3f(v->x, v->y, v->z);
     if (auto v = std::get_if<SpectrumData>(&e.value)) {
         try {
-            return spectrum_to_rgb(*v, kind);
+            return in_mode(spectrum_to_rgb(*v, kind), m_mode);
         } catch (const Error &err) {
             FACET_THROW_AT(e.location.valid() ? e.location : m_location, "parameter \"{}\": {}",
                            name, err.message());
@@ -258,7 +258,7 @@ Color3f Properties::get_color(const std::string &name, SpectrumKind kind) const 
 
 Color3f Properties::get_color(const std::string &name, const Color3f &def,
                               SpectrumKind kind) const {
-    return has(name) ? get_color(name, kind) : def;
+    return has(name) ? get_color(name, kind) : in_mode(def, m_mode);
 }
 
 std::shared_ptr<Object> Properties::object_entry(const std::string &name) const {
@@ -296,7 +296,7 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, float def,
 
 std::shared_ptr<Texture> Properties::texture(const std::string &name, const Color3f &def,
                                              SpectrumKind kind) const {
-    if (!has(name)) return std::make_shared<ConstantTexture>(def);
+    if (!has(name)) return std::make_shared<ConstantTexture>(in_mode(def, m_mode));
     return texture(name, kind);
 }
 

@@ -198,6 +198,7 @@ size_t Scene::rebuild(const Properties &props) {
     std::swap(m_rtc_scene, next.m_rtc_scene); // `next` releases the old one (or null)
     std::swap(m_robust, next.m_robust);
     std::swap(m_two_level, next.m_two_level);
+    std::swap(m_mode, next.m_mode);
     return next.m_geometries_built;
 }
 
@@ -213,6 +214,7 @@ void Scene::build(const Properties &props, Scene *previous) {
         ~FlushDenormals() { _mm_setcsr(csr); }
     } flush_denormals;
 
+    m_mode = props.mode();
     for (const auto &[name, obj] : props.objects()) {
         if (!obj) continue;
         const Location &loc = props.location(name);
@@ -274,6 +276,7 @@ void Scene::build(const Properties &props, Scene *previous) {
         std::shared_ptr<BSDF> &bsdf = shape.emitter() ? default_emitter_bsdf : default_bsdf;
         if (!bsdf) {
             Properties props("diffuse");
+            props.set_mode(m_mode);
             if (shape.emitter()) props.set_float("reflectance", 0.0);
             bsdf = registry.create_as<BSDF>(ObjectType::BSDF, props);
         }

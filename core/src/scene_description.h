@@ -42,6 +42,7 @@ struct SceneDescription {
     std::vector<Node> nodes; ///< in creation order: children before the objects holding them
     size_t root = NoNode;    ///< the <scene>
     bool lenient = false;    ///< LoadOptions::lenient of the load
+    ColourMode mode = ColourMode::RGB; ///< LoadOptions::mode of the load
     /// The folders the load found files in (the scene's, <path> entries, the search path): the
     /// file resolver of the objects built again.
     FileResolver resolver;

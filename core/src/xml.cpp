@@ -13,6 +13,7 @@
 
 #include <facet/frame.h>
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/resolver.h>
@@ -358,7 +359,9 @@ private:
 
 class Loader {
 public:
-    explicit Loader(const LoadOptions &opts) : m_opts(opts) {
+    explicit Loader(const LoadOptions &opts)
+        : m_opts(opts),
+          m_mode(colour_mode(opts.mode.empty() ? default_mode() : resolve_mode(opts.mode))) {
         for (const auto &[key, value] : opts.params) m_params[key] = Parameter{value, true, false};
         update_keys();
     }
@@ -496,6 +499,7 @@ private:
     std::shared_ptr<SceneDescription> describe(size_t root) const {
         auto d = std::make_shared<SceneDescription>();
         d->lenient = m_opts.lenient;
+        d->mode = m_mode;
         d->resolver = file_resolver(); // this load's folders (the guard restores the caller's)
         std::unordered_map<size_t, size_t> index; // m_nodes -> d->nodes
         for (size_t i : m_created) {
@@ -1291,6 +1295,7 @@ private:
     std::shared_ptr<Object> instantiate(size_t index) {
         if (m_nodes[index].instance) return m_nodes[index].instance;
         Properties props(m_nodes[index].plugin);
+        props.set_mode(m_mode);
         props.set_id(m_nodes[index].id);
         props.set_location(m_nodes[index].location);
         for (const Entry &e : m_nodes[index].entries) {
@@ -1332,6 +1337,7 @@ private:
     }
 
     const LoadOptions &m_opts;
+    const ColourMode m_mode; ///< every object's (Properties::mode())
     std::vector<std::unique_ptr<SourceFile>> m_sources;
     std::deque<ObjectNode> m_nodes;
     std::map<std::string, IdEntry> m_ids;

@@ -116,7 +116,8 @@ public:
                                    "envmap: \"{}\" has a non-finite pixel at ({}, {})", m_path, x,
                                    y);
                 // Negative values are kept, as Mitsuba keeps them; only the sampling table
-                // clamps at zero.
+                // clamps at zero. The mono mode renders the luminance.
+                c = in_mode(c, props.mode());
                 texel(x, y).radiance = c;
                 if (x == 0) texel(m_width, y).radiance = c; // column W is column 0 again
             }

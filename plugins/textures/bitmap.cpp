@@ -12,7 +12,8 @@ that flip v (OBJ, by default) therefore show the image's top row at the file's v
 RGB on load, unless `raw` is set (for data such as roughness, opacity or normal maps); EXR, HDR
 and PFM images are linear already and are used as stored. Grey images give grey colours (an
 alpha channel is ignored). `eval_1` (scalar parameters such as a roughness) returns the grey
-value, or the luminance of a colour image.
+value, or the luminance of a colour image. In the mono mode a colour image's `eval` is its
+luminance too, unless `raw` is set (a normal map keeps its three channels).
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -125,11 +126,15 @@ public:
         m_floats = t.bytes.empty() ? t.floats.data() : nullptr;
         m_bytes = t.bytes.empty() ? nullptr : t.bytes.data();
         m_table = t.table.data();
-        m_mean = t.mean;
-        m_max = t.max;
+        // The mono mode renders a colour image's luminance (interpolating luminances is taking
+        // the luminance of the interpolated colour: both are linear).
+        m_luminance = props.mode() == ColourMode::Mono && !m_raw && m_channels == 3;
+        m_mean = m_luminance ? in_mode(t.mean, ColourMode::Mono) : t.mean;
+        m_max = t.max; // in mono a bound: no luminance exceeds the largest channel
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
+        if (m_luminance) return Color3f(eval_1(si));
         Point2f uv = to_uv(si.uv);
         if (m_bytes) return m_channels == 1 ? Color3f(lookup<1, true>(uv).r) : lookup<3, true>(uv);
         return m_channels == 1 ? Color3f(lookup<1, false>(uv).r) : lookup<3, false>(uv);
@@ -260,6 +265,7 @@ private:
     std::string m_filename, m_path;
     FilterType m_filter = FilterType::Bilinear;
     WrapMode m_wrap = WrapMode::Repeat;
+    bool m_luminance = false; ///< eval() gives the luminance (the mono mode, colour images)
     bool m_raw = false;
     float m_uv_matrix[6] = {1, 0, 0, 0, 1, 0};
     int m_width = 0, m_height = 0, m_channels = 3;

@@ -10,7 +10,8 @@ is multiplied by `scale`. PLY files provide attributes from their extra properti
 colours have `vertex_color`.
 
 Colour queries (a reflectance) accept attributes of 1 channel (a grey) or 3 channels; scalar
-queries (a roughness, a blend weight, an opacity) need 1 channel. Naming an attribute that a
+queries (a roughness, a blend weight, an opacity) need 1 channel. In the mono mode a colour
+query of a 3-channel attribute gives its luminance. Naming an attribute that a
 shape using the texture does not have is an error when the scene loads, naming the shape and
 listing the attributes it has (shapes other than PLY and serialized meshes have none).
 
@@ -48,6 +49,7 @@ public:
                            "or \"face_\"",
                            m_name);
         m_scale = float(props.get_float("scale", 1.0));
+        m_mode = props.mode();
         if (!std::isfinite(m_scale))
             FACET_THROW_AT(props.location("scale"), "mesh_attribute: scale must be finite, got {}",
                            m_scale);
@@ -65,7 +67,7 @@ public:
         mesh->eval_attribute(*a, si, v);
         if (a->channels == 1) return Color3f(v[0] * m_scale);
         if (a->channels != 3) throw_channels(*mesh, *a, "a colour query needs 1 or 3");
-        return Color3f(v[0], v[1], v[2]) * m_scale;
+        return in_mode(Color3f(v[0], v[1], v[2]) * m_scale, m_mode);
     }
 
     float eval_1(const SurfaceInteraction &si) const override {
@@ -105,6 +107,7 @@ private:
 
     std::string m_name;
     float m_scale = 1.f;
+    ColourMode m_mode = ColourMode::RGB;
 };
 
 } // namespace facet

@@ -58,25 +58,37 @@ def _params(params):
     return {k: _param_value(k, v) for k, v in params.items()}
 
 
-def load_file(path, *, lenient=False, search_path=(), **params):
+def _mode(mode):
+    if mode is not None and not isinstance(mode, str):
+        raise TypeError(f"mode={mode!r}: expected a str such as 'scalar_rgb'")
+    return mode
+
+
+def load_file(path, *, lenient=False, search_path=(), mode=None, **params):
     """Loads a Mitsuba 3 XML scene. Keyword arguments are the ``$name`` values (the ``-D`` options
     of ``facet render``): ``facet.load_file("scene.xml", spp=64, res=256)``. ``lenient`` turns
-    unused parameters into warnings, ``search_path`` adds folders for meshes and textures."""
-    return _facet.load_file(_os.fspath(path), _params(params), lenient, [_os.fspath(p) for p in search_path])
+    unused parameters into warnings, ``search_path`` adds folders for meshes and textures.
+    ``mode`` is the colour mode the scene is built for and renders in (``-m`` of ``facet
+    render``; ``modes()`` lists them; None: the default), as Mitsuba's ``set_variant`` chooses it
+    before a load; the scene's ``mode`` attribute names it."""
+    return _facet.load_file(_os.fspath(path), _params(params), lenient,
+                            [_os.fspath(p) for p in search_path], _mode(mode))
 
 
-def scene_info(path, *, lenient=False, search_path=(), **params):
+def scene_info(path, *, lenient=False, search_path=(), mode=None, **params):
     """What a scene file declares, from parsing it alone (no plugin created, no mesh read, no BVH
     built; ``facet info`` on the command line): a dict with ``sensors`` (each a dict of
     ``plugin``, ``film``, ``sampler``, ``film_size`` (width, height) and ``spp``),
     ``integrator``, ``plugins`` (names by kind) and ``mode``."""
     return _facet.scene_info(_os.fspath(path), _params(params), lenient,
-                             [_os.fspath(p) for p in search_path])
+                             [_os.fspath(p) for p in search_path], _mode(mode))
 
 
-def load_string(xml, *, lenient=False, search_path=(), **params):
-    """Loads a scene given as XML text; locations in errors read ``string:line:col``."""
-    return _facet.load_string(xml, _params(params), lenient, [_os.fspath(p) for p in search_path])
+def load_string(xml, *, lenient=False, search_path=(), mode=None, **params):
+    """Loads a scene given as XML text; locations in errors read ``string:line:col``. The
+    arguments are those of ``load_file``."""
+    return _facet.load_string(xml, _params(params), lenient,
+                              [_os.fspath(p) for p in search_path], _mode(mode))
 
 
 class SceneParameters:
@@ -300,7 +312,7 @@ def dict_to_xml(d):
     return _dict_to_xml(d, _dict_kinds(), "", indent="    ")
 
 
-def load_dict(d, *, lenient=False, search_path=()):
+def load_dict(d, *, lenient=False, search_path=(), mode=None):
     """Builds a scene from Mitsuba's dictionary form::
 
         scene = facet.load_dict({
@@ -320,7 +332,7 @@ def load_dict(d, *, lenient=False, search_path=()):
     ``"filename"``), ``{"type": "ref", "id": ...}`` and nested objects. The dict becomes the
     XML text ``dict_to_xml`` returns and loads like ``load_string`` (relative file names are
     found from the current folder and ``search_path``)."""
-    return load_string(dict_to_xml(d), lenient=lenient, search_path=search_path)
+    return load_string(dict_to_xml(d), lenient=lenient, search_path=search_path, mode=mode)
 
 
 class Image(tuple):
@@ -397,12 +409,12 @@ def render(scene, spp=None, seed=0, sensor=0, threads=None, crop=None, pass_inde
     1 at the end; an exception it raises stops the render and is raised here), or a bool: draw
     the CLI's progress bar on stderr. None (the default) draws it when stderr is a terminal.
 
-    ``mode`` is the colour mode by Mitsuba's variant names (``-m`` of ``facet render``; ``modes()``
-    lists them, the default first): their ``llvm_``, ``cuda_`` and ``_ad_`` names render as the
-    scalar mode, with a note; a mode facet does not render raises ``facet.Error``, before the
-    render. The image's ``facet:mode`` metadata names the mode rendered."""
-    if mode is not None and not isinstance(mode, str):
-        raise TypeError(f"mode={mode!r}: expected a str such as 'scalar_rgb'")
+    The render is in the colour mode the scene was loaded in (``load_file``'s ``mode``; the
+    image's ``facet:mode`` metadata names it). ``mode``, by Mitsuba's variant names (``modes()``
+    lists facet's; the ``llvm_``, ``cuda_`` and ``_ad_`` names stand for the scalar mode, with a
+    note), checks it: a mode facet does not render, or another than the scene's, raises
+    ``facet.Error`` before the render."""
+    _mode(mode)
     if progress is None:
         import sys
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())

@@ -70,12 +70,15 @@ const std::string &checked_path(const std::string &path, const char *what) {
 }
 
 LoadOptions load_options(const std::map<std::string, std::string> &params, bool lenient,
-                         const std::vector<std::string> &search_path) {
+                         const std::vector<std::string> &search_path,
+                         const std::optional<std::string> &mode) {
     for (const std::string &dir : search_path) checked_path(dir, "search_path");
     LoadOptions opts;
     opts.params = params;
     opts.lenient = lenient;
     opts.search_path = search_path;
+    // Resolved here, with the GIL held: the note of a vectorised name is logged once.
+    opts.mode = mode ? resolve_mode(*mode) : default_mode();
     return opts;
 }
 
@@ -88,9 +91,10 @@ std::shared_ptr<Scene> as_scene(std::shared_ptr<Object> obj, const std::string &
 }
 
 PyScene load_file_py(const std::string &path, const std::map<std::string, std::string> &params,
-                     bool lenient, const std::vector<std::string> &search_path) {
+                     bool lenient, const std::vector<std::string> &search_path,
+                     const std::optional<std::string> &mode) {
     checked_path(path, "load_file");
-    LoadOptions opts = load_options(params, lenient, search_path);
+    LoadOptions opts = load_options(params, lenient, search_path, mode);
     if (!fs::exists(path)) FACET_THROW("scene file \"{}\" does not exist", path);
     PyScene s;
     s.path = fs::absolute(path).lexically_normal().string();
@@ -103,10 +107,11 @@ PyScene load_file_py(const std::string &path, const std::map<std::string, std::s
 }
 
 PyScene load_string_py(const std::string &xml, const std::map<std::string, std::string> &params,
-                       bool lenient, const std::vector<std::string> &search_path) {
+                       bool lenient, const std::vector<std::string> &search_path,
+                       const std::optional<std::string> &mode) {
     PyScene s;
     s.params = params;
-    LoadOptions opts = load_options(params, lenient, search_path);
+    LoadOptions opts = load_options(params, lenient, search_path, mode);
     py::gil_scoped_release release;
     s.scene = as_scene(facet::load_string(xml, opts), "string");
     return s;
@@ -237,7 +242,13 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
                     std::optional<int> threads, std::optional<std::array<int, 4>> crop,
                     int pass_index, int pass_count, const py::object &progress,
                     const std::optional<std::string> &mode) {
-    const std::string render_mode = mode ? resolve_mode(*mode) : default_mode();
+    // The scene's objects were built for one mode (load_file's mode=); a render in another
+    // would need them built again.
+    const std::string render_mode = mode_name(s.scene->mode());
+    if (mode && resolve_mode(*mode) != render_mode)
+        FACET_THROW("mode=\"{}\": the scene was loaded in {}; load it with mode=\"{}\" to "
+                    "render it in that mode",
+                    *mode, render_mode, resolve_mode(*mode));
     const auto &sensors = s.scene->sensors();
     if (sensor_index < 0 || size_t(sensor_index) >= sensors.size())
         FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor_index,
@@ -646,6 +657,7 @@ PYBIND11_MODULE(_facet, m) {
     py::class_<PyScene>(m, "Scene", "A loaded scene (facet.load_file / facet.load_string)")
         .def_property_readonly("path", [](const PyScene &s) { return s.path; })
         .def_property_readonly("params", [](const PyScene &s) { return s.params; })
+        .def_property_readonly("mode", [](const PyScene &s) { return mode_name(s.scene->mode()); })
         .def_property_readonly("sensor_count",
                                [](const PyScene &s) { return s.scene->sensors().size(); })
         .def(
@@ -664,9 +676,9 @@ PYBIND11_MODULE(_facet, m) {
 
     bind_params(m);
     m.def("load_file", &load_file_py, py::arg("path"), py::arg("params"), py::arg("lenient"),
-          py::arg("search_path"));
+          py::arg("search_path"), py::arg("mode"));
     m.def("load_string", &load_string_py, py::arg("xml"), py::arg("params"), py::arg("lenient"),
-          py::arg("search_path"));
+          py::arg("search_path"), py::arg("mode"));
     m.def("render", &render_py, py::arg("scene"), py::arg("spp"), py::arg("seed"),
           py::arg("sensor"), py::arg("threads"), py::arg("crop"), py::arg("pass_index"),
           py::arg("pass_count"), py::arg("progress"), py::arg("mode"));
@@ -676,12 +688,14 @@ PYBIND11_MODULE(_facet, m) {
     m.def("read", &read_py, py::arg("path"));
     m.def("scene_info",
           [](const std::string &path, const std::map<std::string, std::string> &params,
-             bool lenient, const std::vector<std::string> &search_path) {
+             bool lenient, const std::vector<std::string> &search_path,
+             const std::optional<std::string> &mode) {
               if (!fs::exists(path)) FACET_THROW("scene file \"{}\" does not exist", path);
               SceneInfo info;
+              const LoadOptions opts = load_options(params, lenient, search_path, mode);
               {
                   py::gil_scoped_release release;
-                  info = scene_info(path, load_options(params, lenient, search_path));
+                  info = scene_info(path, opts);
               }
               py::list sensors;
               for (const auto &s : info.sensors)
@@ -690,7 +704,7 @@ PYBIND11_MODULE(_facet, m) {
                                           py::arg("film_size") = py::make_tuple(s.width, s.height),
                                           py::arg("spp") = s.spp));
               return py::dict(py::arg("sensors") = sensors, py::arg("integrator") = info.integrator,
-                              py::arg("plugins") = info.plugins, py::arg("mode") = default_mode());
+                              py::arg("plugins") = info.plugins, py::arg("mode") = opts.mode);
           });
     m.def("merge", &merge_py, py::arg("parts"));
     m.def("modes", &modes);

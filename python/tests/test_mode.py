@@ -17,7 +17,7 @@ def scene(cornell):
 
 
 def test_modes_lists_the_default_first():
-    assert facet.modes() == ["scalar_rgb"]
+    assert facet.modes() == ["scalar_rgb", "scalar_mono"]
 
 
 def test_scalar_rgb_is_the_default(scene):
@@ -61,3 +61,58 @@ def test_mode_must_be_a_string(scene):
 
 def test_scene_info_names_the_mode(cornell):
     assert facet.scene_info(cornell)["mode"] == facet.modes()[0]
+
+
+@pytest.fixture
+def mono(cornell):
+    return facet.load_file(cornell, mode="scalar_mono", **SMALL)
+
+
+def test_a_scene_renders_in_the_mode_it_was_loaded_in(scene, mono):
+    assert scene.mode == "scalar_rgb" and mono.mode == "scalar_mono"
+    image = facet.render(mono, seed=1, progress=False)
+    assert image.metadata["facet:mode"] == "scalar_mono"
+    pixels = np.asarray(image)
+    # Mono: every channel holds the luminance. The Cornell box's red and green walls make an rgb
+    # render's channels differ.
+    assert np.array_equal(pixels[..., 0], pixels[..., 1])
+    assert np.array_equal(pixels[..., 0], pixels[..., 2])
+    assert pixels[..., 0].max() > 0
+    rgb = np.asarray(facet.render(scene, seed=1, progress=False))
+    assert not np.array_equal(rgb[..., 0], rgb[..., 1])
+    # Same as naming the mode, and as the vectorised name of it.
+    assert np.array_equal(pixels, np.asarray(facet.render(mono, seed=1, progress=False,
+                                                          mode="scalar_mono")))
+    assert np.array_equal(pixels, np.asarray(facet.render(mono, seed=1, progress=False,
+                                                          mode="llvm_ad_mono")))
+
+
+def test_the_cli_renders_the_same_mono_image(mono, cornell, facet_cli, cli_env, tmp_path):
+    out = tmp_path / "mono.exr"
+    args = [str(facet_cli), "render", str(cornell), "-m", "scalar_mono", "--seed", "1", "-q",
+            "-o", str(out)] + [f"-D{k}={v}" for k, v in SMALL.items()]
+    subprocess.run(args, env=cli_env, check=True)
+    pixels, channels = facet.read(out)
+    image = np.asarray(facet.render(mono, seed=1, progress=False))  # the film's float16 below
+    assert np.array_equal(pixels[..., :3], image[..., :3].astype(np.float16).astype(np.float32))
+
+
+def test_rendering_in_another_mode_than_the_loaded_one_is_an_error(scene, mono):
+    with pytest.raises(facet.Error, match='the scene was loaded in scalar_rgb; load it with '
+                                          'mode="scalar_mono"'):
+        facet.render(scene, progress=False, mode="scalar_mono")
+    with pytest.raises(facet.Error, match="loaded in scalar_mono"):
+        facet.render(mono, progress=False, mode="cuda_rgb")
+
+
+def test_every_loader_takes_the_mode(cornell):
+    assert facet.load_string(open(cornell).read(), search_path=[cornell.parent],
+                             mode="scalar_mono", **SMALL).mode == "scalar_mono"
+    d = {"type": "scene", "ball": {"type": "sphere"}}
+    assert facet.load_dict(d, mode="scalar_mono").mode == "scalar_mono"
+    assert facet.load_dict(d).mode == "scalar_rgb"
+    assert facet.scene_info(cornell, mode="llvm_mono")["mode"] == "scalar_mono"
+    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono"):
+        facet.load_file(cornell, mode="scalar_spectral")
+    with pytest.raises(TypeError, match="mode=1"):
+        facet.load_file(cornell, mode=1)

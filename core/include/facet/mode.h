@@ -1,5 +1,8 @@
 #pragma once
 
+#include <facet/color.h>
+
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -7,8 +10,8 @@
 /// the one place a name a user typed (`facet render -m`, Python's `mode=`) becomes a mode.
 namespace facet {
 
-/// The modes facet renders in, the default first: {"scalar_rgb"}. The one list: a mode added
-/// here is accepted by every resolve_mode() caller, with its vectorised names.
+/// The modes facet renders in, the default first: {"scalar_rgb", "scalar_mono"}. The one list: a
+/// mode added here is accepted by every resolve_mode() caller, with its vectorised names.
 const std::vector<std::string> &modes();
 
 /// The mode of a render that names none: modes().front().
@@ -24,5 +27,28 @@ const std::string &default_mode();
  * - anything else: throws facet::Error listing modes(), with the nearest valid name.
  */
 std::string resolve_mode(const std::string &name);
+
+/**
+ * The colour of a render, fixed when its scene is loaded (LoadOptions::mode): every plugin reads
+ * it from Properties::mode() and turns the colours it is given into what the mode renders.
+ * - `RGB`: linear Rec.709 RGB.
+ * - `Mono`: luminance. facet renders it with the RGB value type holding three equal values: every
+ *   colour a scene gives (rgb, spectrum, image texel, vertex colour) becomes its luminance
+ *   (Rec.709 Y, which is CIE Y) when it is read, so every channel of every value along a path is
+ *   the same and the image's R = G = B is the mono image.
+ */
+enum class ColourMode : uint8_t { RGB, Mono };
+
+/// The ColourMode of one of modes() (a name resolve_mode() returned); throws facet::Error for any
+/// other name.
+ColourMode colour_mode(const std::string &mode);
+/// The name of a ColourMode in modes(): "scalar_rgb", "scalar_mono".
+const char *mode_name(ColourMode mode);
+
+/// A colour a scene gives (linear Rec.709) as `mode` renders it: in Mono its luminance in every
+/// channel, otherwise unchanged.
+inline Color3f in_mode(const Color3f &c, ColourMode mode) {
+    return mode == ColourMode::Mono ? Color3f(c.luminance()) : c;
+}
 
 } // namespace facet

@@ -2,6 +2,7 @@
 
 #include <facet/color.h>
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/object.h>
 #include <facet/spectrum.h>
 #include <facet/transform.h>
@@ -34,6 +35,11 @@ public:
     /// Where the object itself was declared.
     const Location &location() const { return m_location; }
     void set_location(const Location &loc) { m_location = loc; }
+    /// The colour mode the object is built for (the scene's, LoadOptions::mode). get_color() and
+    /// texture() already give colours as the mode renders them (luminance in Mono); a plugin
+    /// that reads colours itself (an image, vertex colours) converts them as the mode says.
+    ColourMode mode() const { return m_mode; }
+    void set_mode(ColourMode mode) { m_mode = mode; }
 
     // -- Setters (the loader's side) --------------------------------------------------------
     /// Adds an entry; a second entry of the same name is an error unless `overwrite` is set.
@@ -67,12 +73,13 @@ public:
     Vector3f get_vector(const std::string &name, const Vector3f &def) const;
     Transform get_transform(const std::string &name) const;
     Transform get_transform(const std::string &name, const Transform &def) const;
-    /// A float, rgb or spectrum (converted as `kind` says).
+    /// A float, rgb or spectrum (converted as `kind` says, then to the mode's colour).
     Color3f get_color(const std::string &name, SpectrumKind kind = SpectrumKind::Reflectance) const;
     Color3f get_color(const std::string &name, const Color3f &def,
                       SpectrumKind kind = SpectrumKind::Reflectance) const;
 
-    /// A texture-valued parameter: a number, an rgb, a spectrum or a nested texture.
+    /// A texture-valued parameter: a number, an rgb, a spectrum or a nested texture (constants in
+    /// the mode's colour; a texture plugin converts its own values).
     std::shared_ptr<Texture> texture(const std::string &name,
                                      SpectrumKind kind = SpectrumKind::Reflectance) const;
     std::shared_ptr<Texture> texture(const std::string &name, float def,
@@ -123,6 +130,7 @@ private:
 
     std::string m_plugin_name, m_id;
     Location m_location;
+    ColourMode m_mode = ColourMode::RGB;
     std::vector<Entry> m_entries;
     std::unordered_map<std::string, size_t> m_index; ///< name -> position in m_entries
     mutable std::vector<std::string> m_requested;

@@ -78,6 +78,9 @@ public:
     /// The scene option `embree_use_robust_intersections` (default false, as in Mitsuba 3):
     /// Embree's robust (watertight) triangle test instead of its fast one.
     bool robust_intersections() const { return m_robust; }
+    /// The colour mode the scene's objects were built for (LoadOptions::mode); a render of the
+    /// scene renders in it.
+    ColourMode mode() const { return m_mode; }
     std::string to_string() const override;
 
     /// The object descriptions the loader built the scene from (for traverse()); null for a
@@ -156,6 +159,7 @@ private:
     /// scene came from `previous` as it was).
     size_t m_geometries_built = 0;
     bool m_two_level = false; ///< the scene option `embree_two_level`
+    ColourMode m_mode = ColourMode::RGB;
 };
 
 /// Embree device shared by all scenes of the process; `threads` = 0 lets Embree decide.

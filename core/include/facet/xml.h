@@ -16,6 +16,9 @@ struct LoadOptions {
     bool lenient = false;
     /// Extra folders for relative file names (after the scene's own folder).
     std::vector<std::string> search_path;
+    /// The colour mode every object is built for (facet/mode.h), by any name resolve_mode()
+    /// accepts; empty: default_mode().
+    std::string mode;
 };
 
 /// Loads a Mitsuba 3 XML file (the whole grammar: objects, properties, transforms, ref, default,

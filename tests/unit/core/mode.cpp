@@ -49,14 +49,35 @@ TEST(Mode, EveryListedModeResolvesToItselfSilently) {
 }
 
 TEST(Mode, VectorisedNamesRenderAsTheScalarModeWithOneNote) {
-    for (const char *name : {"llvm_rgb", "cuda_rgb", "llvm_ad_rgb", "cuda_ad_rgb"}) {
-        const Resolved r = resolve(name);
-        EXPECT_EQ(r.mode, "scalar_rgb") << name;
-        EXPECT_EQ(r.error, "") << name;
-        EXPECT_EQ(r.log, fmt::format("[I] mode \"{}\": facet renders it as scalar_rgb (facet has "
-                                     "no vectorised or differentiable modes)\n",
-                                     name));
+    for (const char *colour : {"rgb", "mono"})
+        for (const char *prefix : {"llvm_", "cuda_", "llvm_ad_", "cuda_ad_"}) {
+            const std::string name = std::string(prefix) + colour;
+            const Resolved r = resolve(name);
+            EXPECT_EQ(r.mode, std::string("scalar_") + colour) << name;
+            EXPECT_EQ(r.error, "") << name;
+            EXPECT_EQ(r.log, fmt::format("[I] mode \"{}\": facet renders it as scalar_{} (facet "
+                                         "has no vectorised or differentiable modes)\n",
+                                         name, colour));
+        }
+}
+
+TEST(Mode, EveryModeHasItsColourMode) {
+    EXPECT_EQ(colour_mode("scalar_rgb"), ColourMode::RGB);
+    EXPECT_EQ(colour_mode("scalar_mono"), ColourMode::Mono);
+    for (const std::string &mode : modes()) EXPECT_EQ(mode_name(colour_mode(mode)), mode);
+    try {
+        colour_mode("llvm_mono");
+        ADD_FAILURE() << "an unresolved name was accepted";
+    } catch (const Error &e) {
+        EXPECT_CONTAINS(e.what(), "scalar_rgb, scalar_mono");
     }
+}
+
+TEST(Mode, MonoIsTheLuminanceInEveryChannel) {
+    const Color3f c(0.8f, 0.4f, 0.1f);
+    EXPECT_EQ(in_mode(c, ColourMode::RGB), c);
+    const float y = 0.212671f * 0.8f + 0.715160f * 0.4f + 0.072169f * 0.1f;
+    EXPECT_EQ(in_mode(c, ColourMode::Mono), Color3f(y));
 }
 
 TEST(Mode, TheNoteFollowsTheLogLevel) {
@@ -70,13 +91,13 @@ TEST(Mode, TheNoteFollowsTheLogLevel) {
 
 TEST(Mode, MitsubaModesFacetLacksAreRefusedByName) {
     for (const char *name :
-         {"scalar_mono", "scalar_spectral", "scalar_spectral_polarized", "scalar_mono_polarized",
+         {"scalar_spectral", "scalar_spectral_polarized", "scalar_mono_polarized",
           "scalar_rgb_polarized", "scalar_spectral_double", "scalar_rgb_double",
           "scalar_mono_polarized_double"}) {
         const Resolved r = resolve(name);
         EXPECT_EQ(r.mode, "") << name;
         EXPECT_EQ(r.error, fmt::format("facet does not render the mode \"{}\"; the modes it "
-                                       "renders: scalar_rgb",
+                                       "renders: scalar_rgb, scalar_mono",
                                        name));
         EXPECT_EQ(r.log, "") << name;
     }
@@ -86,24 +107,26 @@ TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
     const std::vector<std::pair<const char *, const char *>> cases = {
         {"llvm_spectral", "scalar_spectral"},
         {"cuda_ad_spectral_polarized", "scalar_spectral_polarized"},
-        {"llvm_ad_mono", "scalar_mono"},
         {"cuda_rgb_polarized", "scalar_rgb_polarized"},
         {"llvm_ad_rgb_double", "scalar_rgb_double"},
     };
     for (const auto &[name, scalar] : cases) {
         const Resolved r = resolve(name);
         EXPECT_EQ(r.error, fmt::format("facet does not render the mode \"{}\" (nor {}, its scalar "
-                                       "form); the modes it renders: scalar_rgb",
+                                       "form); the modes it renders: scalar_rgb, scalar_mono",
                                        name, scalar));
         EXPECT_EQ(r.log, "") << name;
     }
 }
 
 TEST(Mode, UnknownNamesListTheModesWithTheNearestName) {
-    EXPECT_EQ(resolve("foo").error, "unknown mode \"foo\"; the modes facet renders: scalar_rgb");
-    EXPECT_EQ(resolve("").error, "unknown mode \"\"; the modes facet renders: scalar_rgb");
+    EXPECT_EQ(resolve("foo").error,
+              "unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono");
+    EXPECT_EQ(resolve("").error,
+              "unknown mode \"\"; the modes facet renders: scalar_rgb, scalar_mono");
     EXPECT_EQ(resolve("scalar_rbg").error, "unknown mode \"scalar_rbg\" (did you mean "
-                                           "\"scalar_rgb\"?); the modes facet renders: scalar_rgb");
+                                           "\"scalar_rgb\"?); the modes facet renders: scalar_rgb, "
+                                           "scalar_mono");
     EXPECT_CONTAINS(resolve("llvm_rg").error, "(did you mean \"llvm_rgb\"?)");
     EXPECT_CONTAINS(resolve("SCALAR_RGB").error, "(did you mean \"scalar_rgb\"?)");
     // Not Mitsuba's names: scalar has no _ad_ form, and rgb comes before _polarized.
