@@ -1,9 +1,10 @@
 # The compatibility suite (label compat): every scene of compat/data/peer-scenes rendered at its
 # test spp and checked against Mitsuba 3's own image of it (compat/data/peer-renders) with
-# `facet compare`, one ctest per line of compat/scenes.txt. A scene that needs a plugin that does
-# not exist in plugins/ yet is registered DISABLED, with the missing plugins named (configure
-# output, the test's FACET_MISSING_PLUGINS property and environment); it enables itself once
-# they exist.
+# `facet compare`, one ctest per line of compat/scenes.txt, and one per other colour mode with a
+# reference in compat/data/peer-renders-modes (`<name>-mono`, label compat-mono). A scene that
+# needs a plugin that does not exist in plugins/ yet is registered DISABLED, with the missing
+# plugins named (configure output, the test's FACET_MISSING_PLUGINS property and environment); it
+# enables itself once they exist. compat/disabled.txt disables known gaps, each with its reason.
 # Also the GoogleTest files in compat/ (the checks of `facet compare` itself).
 
 if(NOT TARGET facet_cli)
@@ -15,6 +16,9 @@ facet_add_test_folder(compat)
 set(FACET_COMPAT_DIR ${CMAKE_CURRENT_SOURCE_DIR}/compat)
 set(FACET_COMPAT_SCENES ${FACET_COMPAT_DIR}/data/peer-scenes)
 set(FACET_COMPAT_REFS ${FACET_COMPAT_DIR}/data/peer-renders)
+# References in the other colour modes: <name>_<mode>_mean_rgb.exr, one test <name>-<mode> each.
+set(FACET_COMPAT_MODE_REFS ${FACET_COMPAT_DIR}/data/peer-renders-modes)
+set(FACET_COMPAT_MODES mono)
 set(FACET_COMPAT_WORK ${CMAKE_BINARY_DIR}/tests/compat)
 file(MAKE_DIRECTORY ${FACET_COMPAT_WORK})
 
@@ -111,6 +115,8 @@ endfunction()
 # The suite must cover every reference and every scene file; a reference without a line in
 # scenes.txt is a configuration error, not a test that silently does not exist.
 file(GLOB _compat_means RELATIVE ${FACET_COMPAT_REFS} ${FACET_COMPAT_REFS}/*_mean_rgb.exr)
+file(GLOB _compat_mode_means RELATIVE ${FACET_COMPAT_MODE_REFS}
+     ${FACET_COMPAT_MODE_REFS}/*_mean_rgb.exr)
 set(_compat_included "")
 foreach(_f IN LISTS _compat_xml)
     _compat_scene_files(${_f} _files)
@@ -126,6 +132,7 @@ if(_compat_cores LESS 1)
 endif()
 
 set(_compat_names "")
+set(_compat_mode_names "")
 set(_compat_scenes "")
 set(_compat_disabled 0)
 foreach(_line IN LISTS _compat_lines)
@@ -161,15 +168,71 @@ foreach(_line IN LISTS _compat_lines)
     set_tests_properties(${_name} PROPERTIES LABELS compat PROCESSORS ${_compat_cores}
                          TIMEOUT 1800)
 
+    set(_tests ${_name})
+    # The same scene in each other mode with a reference.
+    foreach(_mode IN LISTS FACET_COMPAT_MODES)
+        set(_mode_mean ${FACET_COMPAT_MODE_REFS}/${_name}_${_mode}_mean_rgb.exr)
+        set(_mode_var ${FACET_COMPAT_MODE_REFS}/${_name}_${_mode}_var_xyz.exr)
+        if(NOT EXISTS ${_mode_mean})
+            continue()
+        endif()
+        if(NOT EXISTS ${_mode_var})
+            message(FATAL_ERROR "compat: ${_mode_mean} has no ${_mode_var}")
+        endif()
+        add_test(NAME ${_name}-${_mode}
+                 COMMAND ${CMAKE_COMMAND} -DFACET=$<TARGET_FILE:facet_cli>
+                         -DNAME=${_name}-${_mode} -DSCENE=${_scene} -DMEAN=${_mode_mean}
+                         -DVAR=${_mode_var} -DSPP=${_spp} -DMODE=scalar_${_mode}
+                         -DWORK=${FACET_COMPAT_WORK} -P ${FACET_COMPAT_DIR}/run_scene.cmake)
+        set_tests_properties(${_name}-${_mode} PROPERTIES LABELS "compat;compat-${_mode}"
+                             PROCESSORS ${_compat_cores} TIMEOUT 1800)
+        list(APPEND _tests ${_name}-${_mode})
+        list(APPEND _compat_mode_names ${_name}_${_mode})
+    endforeach()
+
     _compat_missing_plugins(${_scene} _missing)
     if(_missing)
         string(REPLACE ";" ", " _missing "${_missing}")
         # The reason is a property of its own and, so that `ctest --show-only=json-v1` shows it,
         # also the test's environment (a disabled test never runs, so this sets nothing).
-        set_tests_properties(${_name} PROPERTIES DISABLED TRUE FACET_MISSING_PLUGINS "${_missing}"
-                             ENVIRONMENT "FACET_MISSING_PLUGINS=${_missing}")
-        message(STATUS "compat: ${_name} is disabled: it needs ${_missing}, not in plugins/")
-        math(EXPR _compat_disabled "${_compat_disabled} + 1")
+        foreach(_test IN LISTS _tests)
+            set_tests_properties(${_test} PROPERTIES DISABLED TRUE
+                                 FACET_MISSING_PLUGINS "${_missing}"
+                                 ENVIRONMENT "FACET_MISSING_PLUGINS=${_missing}")
+            message(STATUS "compat: ${_test} is disabled: it needs ${_missing}, not in plugins/")
+            math(EXPR _compat_disabled "${_compat_disabled} + 1")
+        endforeach()
+    endif()
+endforeach()
+
+# Known gaps: DISABLED, with the reason printed at configure time and kept in the test's
+# FACET_DISABLED_REASON property and environment.
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${FACET_COMPAT_DIR}/disabled.txt)
+file(STRINGS ${FACET_COMPAT_DIR}/disabled.txt _compat_disabled_lines)
+foreach(_line IN LISTS _compat_disabled_lines)
+    if(_line STREQUAL "" OR _line MATCHES "^#")
+        continue()
+    endif()
+    string(REGEX MATCH "^([^ ]+) +(.+)$" _ok "${_line}")
+    if(NOT _ok)
+        message(FATAL_ERROR "compat/disabled.txt: \"${_line}\": expected <test> <reason>")
+    endif()
+    set(_test ${CMAKE_MATCH_1})
+    set(_why "${CMAKE_MATCH_2}")
+    if(NOT TEST ${_test})
+        message(FATAL_ERROR "compat/disabled.txt: ${_test} is no compat test")
+    endif()
+    set_tests_properties(${_test} PROPERTIES DISABLED TRUE FACET_DISABLED_REASON "${_why}"
+                         ENVIRONMENT "FACET_DISABLED_REASON=${_why}")
+    message(STATUS "compat: ${_test} is disabled: ${_why}")
+    math(EXPR _compat_disabled "${_compat_disabled} + 1")
+endforeach()
+
+foreach(_m IN LISTS _compat_mode_means)
+    string(REGEX REPLACE "_mean_rgb\\.exr$" "" _m "${_m}")
+    if(NOT _m IN_LIST _compat_mode_names)
+        message(FATAL_ERROR "compat: reference ${_m} (peer-renders-modes) has no line in "
+                            "compat/scenes.txt, or its mode is not in FACET_COMPAT_MODES")
     endif()
 endforeach()
 
@@ -186,6 +249,8 @@ foreach(_f IN LISTS _compat_xml)
 endforeach()
 
 list(LENGTH _compat_names _compat_count)
+list(LENGTH _compat_mode_names _compat_mode_count)
+math(EXPR _compat_count "${_compat_count} + ${_compat_mode_count}")
 math(EXPR _compat_enabled "${_compat_count} - ${_compat_disabled}")
-message(STATUS "compat: ${_compat_count} peer scenes, ${_compat_enabled} enabled, "
-               "${_compat_disabled} disabled (waiting for plugins)")
+message(STATUS "compat: ${_compat_count} peer scene renders, ${_compat_enabled} enabled, "
+               "${_compat_disabled} disabled (waiting for plugins, or in compat/disabled.txt)")

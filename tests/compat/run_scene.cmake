@@ -4,6 +4,7 @@
 # standard errors from the reference's: a bias the per-pixel rule cannot see). The render and the z image stay in WORK.
 # Inputs: -DFACET=<facet binary> -DNAME=<test name> -DSCENE=<scene file> -DMEAN=<reference mean>
 #         -DVAR=<reference variance> -DSPP=<test spp> -DWORK=<scratch folder>
+#         [-DMODE=<colour mode, facet render -m>]
 
 foreach(v FACET NAME SCENE MEAN VAR SPP WORK)
     if(NOT DEFINED ${v})
@@ -15,9 +16,13 @@ set(image ${WORK}/${NAME}.exr)
 set(z_image ${WORK}/${NAME}_z.exr)
 file(REMOVE ${image} ${z_image})
 
-message("facet render ${SCENE} -D spp=${SPP} -o ${image}")
+set(mode_args "")
+if(DEFINED MODE)
+    set(mode_args -m ${MODE})
+endif()
+message("facet render ${SCENE} ${mode_args} -D spp=${SPP} -o ${image}")
 string(TIMESTAMP start "%s")
-execute_process(COMMAND ${FACET} render ${SCENE} -D spp=${SPP} -q -o ${image}
+execute_process(COMMAND ${FACET} render ${SCENE} ${mode_args} -D spp=${SPP} -q -o ${image}
                 RESULT_VARIABLE code)
 string(TIMESTAMP end "%s")
 math(EXPR seconds "${end} - ${start}")
