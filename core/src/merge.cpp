@@ -2,6 +2,7 @@
 #include <facet/film.h>
 #include <facet/logger.h>
 #include <facet/merge.h>
+#include <facet/mode.h>
 
 #include <fmt/format.h>
 
@@ -351,6 +352,15 @@ Merged merge_parts(const std::vector<Part> &parts) {
                             : std::strcmp(key, attr::spp_total) == 0 ? "sample counts"
                                                                      : "scenes");
         }
+        // A part written before parts recorded their mode was rendered in the default one.
+        const auto mode_of = [](const Part &part) {
+            auto it = part.metadata.strings.find(attr::mode);
+            return it == part.metadata.strings.end() ? default_mode() : it->second;
+        };
+        if (mode_of(p) != mode_of(first))
+            FACET_THROW("{} was rendered in the mode {}, {} in {}: parts of different colour "
+                        "modes",
+                        p.name, mode_of(p), first.name, mode_of(first));
         if (auto it = p.metadata.strings.find(attr::spp_target); it != p.metadata.strings.end())
             FACET_THROW("{} is incomplete: its render was stopped after {} of {} samples per "
                         "pixel",

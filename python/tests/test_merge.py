@@ -90,6 +90,13 @@ def test_merge_refuses_bad_sets(scene, cornell):
         facet.merge([top, other])
     with pytest.raises(facet.Error, match="different seeds"):
         facet.merge([top, facet.render(scene, seed=9, crop=(0, 20, 40, 40))])
+    mono = facet.load_file(cornell, mode="scalar_mono", **SMALL)
+    with pytest.raises(facet.Error, match="rendered in the mode scalar_mono, .* in scalar_rgb: "
+                                          "parts of different colour modes"):
+        facet.merge([top, facet.render(mono, crop=(0, 20, 40, 40))])
+    assert facet.merge([facet.render(mono, crop=(0, 0, 40, 20)),
+                        facet.render(mono, crop=(0, 20, 40, 40))]).metadata["facet:mode"] == \
+        "scalar_mono"
     with pytest.raises(facet.Error, match="pass 1 of 2 is missing"):
         facet.merge([facet.render(scene, pass_index=0, passes=2)])
     with pytest.raises(facet.Error, match="no parts"):
