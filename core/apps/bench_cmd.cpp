@@ -21,6 +21,7 @@
 #include "stats.h"
 
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
@@ -167,6 +168,7 @@ struct BenchCommand {
 
 void add_bench_options(CLI::App &app, BenchCommand &c) {
     cli::add_scene_options(app, c.scene);
+    cli::add_mode_option(app, c.scene.mode);
     app.add_option("--spp", c.spp,
                    "Samples per pixel (default 16); with --reference, of the first round")
         ->check(CLI::PositiveNumber);
@@ -379,6 +381,8 @@ int bench_main(int argc, char **argv) {
     app.footer("facet bench --suite FILE [--runs N] [-t T] [--root DIR] benches the scenes "
                "FILE lists, each in a process of its own (see facet bench --suite --help)");
     if (int code = cli::parse(app, argc, argv); code >= 0) return code;
+    cli::set_log_level(c.scene); // -q hides the note of a vectorised mode name
+    c.scene.mode = resolve_mode(c.scene.mode);
 
     cli::SceneOptions &opts = c.scene;
     std::shared_ptr<Scene> scene = cli::load_scene(opts);

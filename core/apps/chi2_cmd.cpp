@@ -6,6 +6,7 @@
 #include <facet/checked.h>
 #include <facet/chi2.h>
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
 
@@ -180,9 +181,19 @@ std::string join_args(int argc, char **argv) {
 
 // -- facet chi2 bsdf ------------------------------------------------------------------------------
 
+/// -m, the colour mode the plugin is built in (Mitsuba's variant names, as `facet render -m`):
+/// what a BSDF samples can depend on its colours (a plastic's lobe weights), so each mode is a
+/// test of its own. (`--mode` of `chi2 bsdf` is the transport mode.)
+void add_colour_mode(CLI::App &app, std::string &mode) {
+    mode = default_mode();
+    app.add_option("-m,--colour-mode", mode,
+                   fmt::format("Colour mode the plugin is built in: {} (default {})",
+                               fmt::join(modes(), ", "), default_mode()));
+}
+
 struct BsdfCommand {
     CommonOptions common;
-    std::string name, xml, wi_text, mode = "radiance";
+    std::string name, xml, wi_text, mode = "radiance", colour_mode;
     std::vector<std::string> params;
     float theta = 30.f, phi = 0.f;
     int component = -1;
@@ -203,6 +214,7 @@ CLI::App *add_bsdf_command(CLI::App &app, BsdfCommand &c) {
     bsdf->add_option("--phi", c.phi, "Incident azimuth in degrees (default 0)");
     bsdf->add_option("--component", c.component, "Test only this component (lobe) index");
     bsdf->add_option("--mode", c.mode, "Transport mode: radiance (default) or importance");
+    add_colour_mode(*bsdf, c.colour_mode);
     add_common(*bsdf, c.common);
     return bsdf;
 }
@@ -234,7 +246,7 @@ int run_bsdf(BsdfCommand &c, const std::string &everything) {
         if (c.name.empty()) FACET_THROW("name the BSDF plugin to test (or give --xml)");
         text = chi2_object_xml(ObjectType::BSDF, c.name, c.params);
     }
-    BSDFAdapter adapter(text, wi, ctx);
+    BSDFAdapter adapter(text, wi, ctx, resolve_mode(c.colour_mode));
     return run(adapter, c.common, slug("bsdf", c.name, everything));
 }
 
@@ -242,7 +254,7 @@ int run_bsdf(BsdfCommand &c, const std::string &everything) {
 
 struct EmitterCommand {
     CommonOptions common;
-    std::string name, xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle";
+    std::string name, xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle", colour_mode;
     std::vector<std::string> params;
     bool emission = false;
 };
@@ -264,6 +276,7 @@ CLI::App *add_emitter_command(CLI::App &app, EmitterCommand &c) {
     emitter->add_option(
         "--shape", c.shape,
         "Shape an area emitter sits on (default rectangle: 2x2 at z = 0, facing +z)");
+    add_colour_mode(*emitter, c.colour_mode);
     add_common(*emitter, c.common);
     return emitter;
 }
@@ -284,10 +297,10 @@ int run_emitter(EmitterCommand &c, const std::string &everything) {
         scene = EmitterAdapter::scene_xml(c.name, c.params, c.shape);
     }
     if (c.emission) {
-        EmissionAdapter adapter(scene);
+        EmissionAdapter adapter(scene, 0, resolve_mode(c.colour_mode));
         return run(adapter, c.common, slug("emission", c.name, everything));
     }
-    EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]));
+    EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]), 0, resolve_mode(c.colour_mode));
     return run(adapter, c.common, slug("emitter", c.name, everything));
 }
 

@@ -132,8 +132,11 @@ std::string vec_str(const Vector3f &v) {
     return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x, v.y, v.z);
 }
 
-template <typename T> std::shared_ptr<T> load_as(const std::string &xml, ObjectType kind) {
-    std::shared_ptr<Object> obj = load_string(xml);
+template <typename T>
+std::shared_ptr<T> load_as(const std::string &xml, ObjectType kind, const std::string &mode = "") {
+    LoadOptions opts;
+    opts.mode = mode;
+    std::shared_ptr<Object> obj = load_string(xml, opts);
     if (!obj || obj->type() != kind)
         FACET_THROW("expected a {} but the XML describes a {}", object_type_name(kind),
                     obj ? object_type_name(obj->type()) : "nothing");
@@ -158,8 +161,9 @@ BSDFAdapter::BSDFAdapter(const Properties &props, const Vector3f &wi, const BSDF
     init();
 }
 
-BSDFAdapter::BSDFAdapter(const std::string &xml, const Vector3f &wi, const BSDFContext &ctx)
-    : m_bsdf(load_as<BSDF>(xml, ObjectType::BSDF)), m_ctx(ctx) {
+BSDFAdapter::BSDFAdapter(const std::string &xml, const Vector3f &wi, const BSDFContext &ctx,
+                         const std::string &mode)
+    : m_bsdf(load_as<BSDF>(xml, ObjectType::BSDF, mode)), m_ctx(ctx) {
     m_si.wi = wi;
     init();
 }
@@ -229,8 +233,9 @@ std::string BSDFAdapter::to_string() const {
 
 // -- Emitters ---------------------------------------------------------------------------------
 
-EmitterAdapter::EmitterAdapter(const std::string &scene_xml, const Point3f &ref, size_t index) {
-    m_scene = load_as<Scene>(scene_xml, ObjectType::Scene);
+EmitterAdapter::EmitterAdapter(const std::string &scene_xml, const Point3f &ref, size_t index,
+                               const std::string &mode) {
+    m_scene = load_as<Scene>(scene_xml, ObjectType::Scene, mode);
     const auto &emitters = m_scene->emitters();
     if (index >= emitters.size())
         FACET_THROW("EmitterAdapter: the scene has {} emitters, no emitter {}", emitters.size(),
@@ -317,8 +322,9 @@ std::string EmitterAdapter::to_string() const {
 
 // -- Emission directions ----------------------------------------------------------------------
 
-EmissionAdapter::EmissionAdapter(const std::string &scene_xml, size_t index) {
-    m_scene = load_as<Scene>(scene_xml, ObjectType::Scene);
+EmissionAdapter::EmissionAdapter(const std::string &scene_xml, size_t index,
+                                 const std::string &mode) {
+    m_scene = load_as<Scene>(scene_xml, ObjectType::Scene, mode);
     const auto &emitters = m_scene->emitters();
     if (index >= emitters.size())
         FACET_THROW("EmissionAdapter: the scene has {} emitters, no emitter {}", emitters.size(),

@@ -192,8 +192,10 @@ public:
     BSDFAdapter(std::shared_ptr<BSDF> bsdf, const Vector3f &wi, const BSDFContext &ctx = {});
     /// Creates the plugin from properties through the registry.
     BSDFAdapter(const Properties &props, const Vector3f &wi, const BSDFContext &ctx = {});
-    /// Loads `<bsdf version="3.0.0" type="...">...</bsdf>` with load_string.
-    BSDFAdapter(const std::string &xml, const Vector3f &wi, const BSDFContext &ctx = {});
+    /// Loads `<bsdf version="3.0.0" type="...">...</bsdf>` with load_string, in colour mode
+    /// `mode` (LoadOptions::mode: empty is the default).
+    BSDFAdapter(const std::string &xml, const Vector3f &wi, const BSDFContext &ctx = {},
+                const std::string &mode = "");
 
     int sample_dim() const override { return 3; }
     Chi2Sample sample(const float *u) const override;
@@ -216,8 +218,10 @@ private:
 /// pdf() of a direction traces a ray in that scene to find the point it reaches.
 class EmitterAdapter : public Chi2Adapter {
 public:
-    /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it.
-    EmitterAdapter(const std::string &scene_xml, const Point3f &ref, size_t index = 0);
+    /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it. The scene is
+    /// loaded in colour mode `mode` (LoadOptions::mode: empty is the default).
+    EmitterAdapter(const std::string &scene_xml, const Point3f &ref, size_t index = 0,
+                   const std::string &mode = "");
     EmitterAdapter(std::shared_ptr<Scene> scene, std::shared_ptr<Emitter> emitter,
                    const Point3f &ref);
     ~EmitterAdapter() override;
@@ -243,8 +247,10 @@ private:
 /// emitters with one origin (point-like lights such as spot): what a light tracer draws.
 class EmissionAdapter : public Chi2Adapter {
 public:
-    /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it.
-    explicit EmissionAdapter(const std::string &scene_xml, size_t index = 0);
+    /// `scene_xml` is a whole <scene> with at least one emitter; `index` picks it; `mode` as for
+    /// EmitterAdapter.
+    explicit EmissionAdapter(const std::string &scene_xml, size_t index = 0,
+                             const std::string &mode = "");
     explicit EmissionAdapter(std::shared_ptr<Emitter> emitter);
 
     int sample_dim() const override { return 2; }
