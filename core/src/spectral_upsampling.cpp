@@ -18,14 +18,15 @@ namespace {
 
 constexpr const char *TableName = "rgb2spec_srgb.bin";
 constexpr char Magic[8] = {'F', 'C', 'T', 'R', '2', 'S', '\0', '\0'};
-constexpr uint32_t Version = 1;
+constexpr uint32_t Version = 2;
 
 /// The table written by core/scripts/rgb2spec_opt.cpp (its header comment gives the layout):
 /// three tables, by largest channel, of n (scale) x n (y) x n (x) cells of 3 coefficients for
-/// λ in nm.
+/// λ in nm; the scale of the largest channel and the ratios of the other two to it (x, y) at
+/// the cells.
 struct Table {
     int n = 0;
-    std::vector<float> scale;
+    std::vector<float> scale, ratio;
     std::vector<float> coeffs;
 };
 
@@ -53,13 +54,14 @@ Table load_table() {
                     Version);
     Table t;
     uint32_t n = read_u32(data.data() + 12);
-    size_t expected = 16 + 4 * (size_t(n) + 9 * size_t(n) * n * n);
+    size_t expected = 16 + 4 * (2 * size_t(n) + 9 * size_t(n) * n * n);
     if (n < 3 || n > 256 || data.size() != expected)
         FACET_THROW("\"{}\": {} bytes for a table of resolution {}, expected {}", path, data.size(),
                     n, expected);
     t.n = int(n);
     const unsigned char *p = data.data() + 16;
     for (uint32_t k = 0; k < n; ++k, p += 4) t.scale.push_back(read_f32(p));
+    for (uint32_t k = 0; k < n; ++k, p += 4) t.ratio.push_back(read_f32(p));
     t.coeffs.resize(9 * size_t(n) * n * n);
     for (float &c : t.coeffs) {
         c = read_f32(p);
@@ -67,9 +69,19 @@ Table load_table() {
         if (!std::isfinite(c)) FACET_THROW("\"{}\": a coefficient is not finite", path);
     }
     for (uint32_t k = 1; k < n; ++k)
-        if (!(t.scale[k] > t.scale[k - 1]))
-            FACET_THROW("\"{}\": the scale axis is not increasing", path);
+        if (!(t.scale[k] > t.scale[k - 1]) || !(t.ratio[k] > t.ratio[k - 1]))
+            FACET_THROW("\"{}\": an axis of the table is not increasing", path);
+    if (t.ratio.front() != 0.f || t.ratio.back() != 1.f)
+        FACET_THROW("\"{}\": the ratio axis does not span [0, 1]", path);
     return t;
+}
+
+/// The cell of `axis` holding `v` and the position in it, in [0, 1] (clamped to the axis).
+int locate(const std::vector<float> &axis, float v, float &f) {
+    int i = int(std::upper_bound(axis.begin(), axis.end(), v) - axis.begin()) - 1;
+    i = clamp(i, 0, int(axis.size()) - 2);
+    f = (v - axis[size_t(i)]) / (axis[size_t(i) + 1] - axis[size_t(i)]);
+    return i;
 }
 
 const Table &table() {
@@ -125,13 +137,10 @@ SigmoidPolynomial rgb_to_sigmoid(const Color3f &rgb_in) {
     int l = 0;
     if (rgb[1] > rgb[l]) l = 1;
     if (rgb[2] > rgb[l]) l = 2;
-    float z = rgb[l];
-    float x = rgb[(l + 1) % 3] / z * float(n - 1), y = rgb[(l + 2) % 3] / z * float(n - 1);
-    int xi = std::min(int(x), n - 2), yi = std::min(int(y), n - 2);
-    int zi = int(std::upper_bound(t.scale.begin(), t.scale.end(), z) - t.scale.begin()) - 1;
-    zi = clamp(zi, 0, n - 2);
-    float fx = x - float(xi), fy = y - float(yi);
-    float fz = (z - t.scale[size_t(zi)]) / (t.scale[size_t(zi) + 1] - t.scale[size_t(zi)]);
+    float z = rgb[l], fx, fy, fz;
+    int xi = locate(t.ratio, rgb[(l + 1) % 3] / z, fx);
+    int yi = locate(t.ratio, rgb[(l + 2) % 3] / z, fy);
+    int zi = locate(t.scale, z, fz);
 
     float c[3] = {0.f, 0.f, 0.f};
     for (int dz = 0; dz < 2; ++dz)

@@ -11,9 +11,10 @@
 ///
 /// The round trip: for a linear Rec.709 reflectance `rgb` in [0, 1]^3, the spectrum s of
 /// rgb_to_sigmoid(rgb) integrated by facet's rgb mode, spectrum_to_rgb(s, Reflectance), gives
-/// rgb ⊙ W, W = spectrum_to_rgb(1) = (0.99899, 0.99887, 0.99880), the white of that quadrature:
-/// the table is fitted so that 0, a grey g and 1 are the constant spectra 0, g and 1 (what a
-/// spectral render of a white reflectance needs).
+/// rgb ⊙ W within 1e-3 per channel, but for a few colours very near white (up to 2.1e-3 there:
+/// tests/unit/core/spectral_upsampling.cpp). W = spectrum_to_rgb(1) = (0.99899, 0.99887,
+/// 0.99880) is the white of that quadrature: the table is fitted so that 0, a grey g and 1 are
+/// the constant spectra 0, g and 1 (what a spectral render of a white reflectance needs).
 namespace facet {
 
 /// s(λ) = S(c0 λ² + c1 λ + c2) with S(x) = 1/2 + x / (2 sqrt(1 + x²)), λ in nm: a smooth
@@ -35,9 +36,9 @@ struct SigmoidPolynomial {
 };
 
 /// The smooth reflectance spectrum of a linear Rec.709 colour: each channel clamped to [0, 1]
-/// (NaN taken as 0), then the coefficients interpolated trilinearly in the table (the paper's
-/// lookup). Black and white are exact: {0, 0, -inf} and {0, 0, +inf}. Throws facet::Error if
-/// the table cannot be read (the first call reads it; later calls only look up).
+/// (NaN taken as 0), then the coefficients interpolated trilinearly between the table's cells
+/// (the paper's lookup). Black and white are exact: {0, 0, -inf} and {0, 0, +inf}. Throws
+/// facet::Error if the table cannot be read (the first call reads it; later calls only look up).
 SigmoidPolynomial rgb_to_sigmoid(const Color3f &rgb);
 
 /// The path of the coefficient table rgb_to_sigmoid reads.
