@@ -30,7 +30,7 @@ import facet
 
 __all__ = ["render", "tile_windows", "render_part", "scene_hash"]
 
-# (path, params) -> (content hash, scene), least recently used first; at most _CACHE_SIZE.
+# (path, params, mode) -> (content hash, scene), least recently used first; at most _CACHE_SIZE.
 _CACHE_SIZE = 4
 _scenes = collections.OrderedDict()
 
@@ -107,10 +107,11 @@ def scene_hash(scene_path, params=None):
     return h.hexdigest()
 
 
-def _scene(path, params, content_hash):
-    """The worker's scene for (path, params) whose files hash to ``content_hash`` (None: as they
-    are now), loaded again when they have changed; the least recently used beyond _CACHE_SIZE go."""
-    key = (path, tuple(sorted(params.items())))
+def _scene(path, params, content_hash, mode=None):
+    """The worker's scene for (path, params) in colour mode ``mode`` whose files hash to
+    ``content_hash`` (None: as they are now), loaded again when they have changed; the least
+    recently used beyond _CACHE_SIZE go."""
+    key = (path, tuple(sorted(params.items())), mode)
     if content_hash is None:
         content_hash = scene_hash(path, params)
     entry = _scenes.get(key)
@@ -118,7 +119,7 @@ def _scene(path, params, content_hash):
         _scenes.move_to_end(key)
         return entry[1]
     _scenes.pop(key, None)  # an older version: replaced
-    scene = facet.load_file(path, **params)
+    scene = facet.load_file(path, mode=mode, **params)
     # After the load: the files it read are the ones hashed (or an edit since shows).
     mine = scene_hash(path, params)
     if mine != content_hash:
@@ -146,11 +147,12 @@ def _worker_threads():
 
 
 def render_part(scene_path, params, crop, pass_index, passes, spp=None, seed=0, sensor=0,
-                threads=None, content_hash=None):
-    """One task: renders window ``crop`` of pass ``pass_index`` of ``passes`` and returns it as a
-    plain dict (what ``facet.merge`` takes back with ``facet.Image.from_part``). ``content_hash``
-    is the client's ``scene_hash()`` of the scene: the worker checks its files against it."""
-    scene = _scene(scene_path, params, content_hash)
+                threads=None, content_hash=None, mode=None):
+    """One task: renders window ``crop`` of pass ``pass_index`` of ``passes`` in colour mode
+    ``mode`` (None: the default) and returns it as a plain dict (what ``facet.merge`` takes back
+    with ``facet.Image.from_part``). ``content_hash`` is the client's ``scene_hash()`` of the
+    scene: the worker checks its files against it."""
+    scene = _scene(scene_path, params, content_hash, mode)
     if threads is None:
         threads = _worker_threads()
     image = facet.render(scene, spp=spp, seed=seed, sensor=sensor, threads=threads, crop=crop,
@@ -159,11 +161,12 @@ def render_part(scene_path, params, crop, pass_index, passes, spp=None, seed=0, 
 
 
 def render(scene_path, client, tiles=(2, 2), passes=1, spp=None, seed=0, sensor=0, threads=None,
-           params=None, output=None):
+           params=None, output=None, mode=None):
     """Renders ``scene_path`` on the workers of the Dask ``client`` and returns the merged
     ``facet.Image``; writes it to ``output`` too when given. ``params`` are the scene's ``$name``
     values (``-D``), ``threads`` the threads of each task (default: its worker's ``nthreads``,
-    the ``threads_per_worker`` of a LocalCluster)."""
+    the ``threads_per_worker`` of a LocalCluster), ``mode`` the colour mode (``-m``; None: the
+    default)."""
     scene_path = os.path.abspath(os.fspath(scene_path))
     params = {k: facet._param_value(k, v) for k, v in (params or {}).items()}
     if int(passes) < 1:
@@ -171,14 +174,16 @@ def render(scene_path, client, tiles=(2, 2), passes=1, spp=None, seed=0, sensor=
     # The hash first: an edit while the client parses the scene then shows on the workers.
     content_hash = scene_hash(scene_path, params)
     # The film size, from parsing the scene (no plugin, mesh or BVH on the client).
-    sensors = facet.scene_info(scene_path, **params)["sensors"]
+    info = facet.scene_info(scene_path, mode=mode, **params)  # also checks the mode here
+    mode = info["mode"]
+    sensors = info["sensors"]
     if not 0 <= int(sensor) < len(sensors):
         raise facet.Error(f"sensor {sensor}: the scene has {len(sensors)} sensors")
     width, height = sensors[int(sensor)]["film_size"]
     windows = tile_windows(width, height, tiles)
     futures = [
         client.submit(render_part, scene_path, params, crop, p, int(passes), spp, seed, sensor,
-                      threads, content_hash, pure=False)
+                      threads, content_hash, mode, pure=False)
         for p in range(int(passes))
         for crop in windows
     ]

@@ -48,6 +48,17 @@ def test_tiles_are_bit_identical_to_one_process(client, cornell, tmp_path):
     assert np.array_equal(facet.read(out)[0], facet.read(mine)[0])
 
 
+def test_a_mono_render_is_bit_identical_to_one_process(client, cornell):
+    image = facet.distributed.render(cornell, client, tiles=(2, 1), params=PARAMS, seed=2,
+                                     mode="llvm_mono")
+    single = facet.render(facet.load_file(cornell, mode="scalar_mono", **PARAMS), seed=2)
+    assert image.metadata["facet:mode"] == "scalar_mono"
+    assert np.array_equal(image.pixels, single.pixels)
+    assert np.array_equal(image.pixels[..., 0], image.pixels[..., 1])
+    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono"):
+        facet.distributed.render(cornell, client, params=PARAMS, mode="scalar_spectral")
+
+
 def test_passes_are_bit_identical_to_one_process(client, cornell):
     image = facet.distributed.render(cornell, client, tiles=(2, 2), passes=2, params=PARAMS)
     scene = facet.load_file(cornell, **PARAMS)
