@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -93,15 +94,16 @@ TEST(SpectralUpsampling, RoundTripOfRandomColors) {
     expect_round_trip(colors, "random colours");
 }
 
-// Disabled: the requirement is not met everywhere near white. 150 of these 20000 colours within
-// 0.02 of white are off by more than 1e-3, the worst by 2.1e-3; of 10^6 uniform colours 4 are
-// (the worst by 1.4e-3), all with the largest channel above 0.99. The fit is not the cause (every
-// cell of the table reproduces its colour within 3.2e-7): near white a spectrum is 1 less a small
-// deficit, whose coefficients grow like 1 / sqrt(distance to white) in a direction set by the
-// deficit's colour, and that colour turns across a single cell there, so interpolating the
-// coefficients misses. Run it with
-// --gtest_also_run_disabled_tests.
-TEST(SpectralUpsampling, DISABLED_RoundTripNearWhite) {
+// A known gap, skipped with its reason: near white the requirement is not met everywhere. The
+// fit is not the cause (every cell of the table reproduces its colour within 3.2e-7): near white
+// a spectrum is 1 less a small deficit, whose coefficients grow like 1 / sqrt(distance to white)
+// in a direction set by the deficit's colour, and that colour turns across a single cell there,
+// so interpolating the coefficients misses. FACET_KNOWN_GAPS=1 runs it.
+TEST(SpectralUpsampling, RoundTripNearWhite) {
+    if (!std::getenv("FACET_KNOWN_GAPS"))
+        GTEST_SKIP() << "known gap: 150 of 20000 colours within 0.02 of white miss 1e-3 (worst "
+                        "2.1e-3; of 10^6 uniform colours 4 do, worst 1.4e-3): interpolating the "
+                        "table's coefficients near white; FACET_KNOWN_GAPS=1 runs it";
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.98f, 1.f);
     std::vector<Color3f> colors;
