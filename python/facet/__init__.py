@@ -552,7 +552,7 @@ def _entries(params):
 def chi2(kind, name=None, *, xml=None, theta=30.0, phi=0.0, wi=None, ref=(0.25, -0.5, 1.5),
          shape="rectangle", emission=False, component=None, mode="radiance", alpha=0.1,
          alpha_v=None, visible=True, res=32, samples=1000000, seed=0, tests=1, significance=0.01,
-         adaptive=True, ires=7, **params):
+         adaptive=True, ires=7, colour_mode=None, **params):
     """The chi-square test of ``facet chi2`` (facet::testing): draws ``samples`` directions from a
     plugin and compares their histogram over (phi, cos theta) with its pdf.
 
@@ -565,6 +565,8 @@ def chi2(kind, name=None, *, xml=None, theta=30.0, phi=0.0, wi=None, ref=(0.25, 
     emitters from ``ref`` (or their emitted rays with ``emission=True``); microfacet
     distributions ("beckmann" or "ggx" as ``name``) take ``alpha``, ``alpha_v`` and ``visible``.
     ``observed`` and ``expected`` are arrays of shape (res, 2 res), cos theta = -1 in row 0.
+    ``colour_mode`` builds the BSDF or emitter in that colour mode (``-m`` of ``facet chi2``; a
+    plastic's lobe weights come from its colours); ``mode`` is the transport mode.
     """
     opts = dict(res=int(res), samples=int(samples), seed=int(seed), tests=int(tests),
                 significance=float(significance), adaptive=bool(adaptive), ires=int(ires))
@@ -580,7 +582,8 @@ def chi2(kind, name=None, *, xml=None, theta=30.0, phi=0.0, wi=None, ref=(0.25, 
             if name is None:
                 raise ValueError("name the BSDF plugin to test (or give xml)")
             text = _facet.chi2_object_xml("bsdf", name, _entries(params))
-        return _facet.chi2_bsdf(text, direction, mode, -1 if component is None else int(component), opts)
+        return _facet.chi2_bsdf(text, direction, mode, -1 if component is None else int(component),
+                                opts, _mode(colour_mode))
     if kind == "emitter":
         if xml is not None:
             if params or name is not None:
@@ -590,7 +593,7 @@ def chi2(kind, name=None, *, xml=None, theta=30.0, phi=0.0, wi=None, ref=(0.25, 
             if name is None:
                 raise ValueError("name the emitter plugin to test (or give xml)")
             scene = _facet.chi2_emitter_scene_xml(name, _entries(params), shape)
-        return _facet.chi2_emitter(scene, list(ref), bool(emission), opts)
+        return _facet.chi2_emitter(scene, list(ref), bool(emission), opts, _mode(colour_mode))
     if kind == "microfacet":
         if name not in ("beckmann", "ggx"):
             raise ValueError(f"microfacet distribution {name!r}: expected 'beckmann' or 'ggx'")

@@ -760,30 +760,34 @@ PYBIND11_MODULE(_facet, m) {
         return chi2_object_xml(t, plugin, entries);
     });
     m.def("chi2_emitter_scene_xml", &EmitterAdapter::scene_xml);
-    m.def("chi2_bsdf", [](const std::string &xml, const std::vector<float> &wi,
-                          const std::string &mode, int component, const py::dict &o) {
-        BSDFContext ctx;
-        if (mode == "importance")
-            ctx.mode = TransportMode::Importance;
-        else if (mode != "radiance")
-            FACET_THROW("mode \"{}\": expected radiance or importance", mode);
-        if (component >= 0) ctx.component = uint32_t(component);
-        Chi2Options opts = chi2_options(o);
-        std::unique_ptr<BSDFAdapter> adapter;
-        {
-            py::gil_scoped_release release;
-            adapter = std::make_unique<BSDFAdapter>(xml, vec3(wi, "wi"), ctx);
-        }
-        return run_adapter(*adapter, opts);
-    });
+    m.def("chi2_bsdf",
+          [](const std::string &xml, const std::vector<float> &wi, const std::string &mode,
+             int component, const py::dict &o, const std::optional<std::string> &colour_mode) {
+              BSDFContext ctx;
+              if (mode == "importance")
+                  ctx.mode = TransportMode::Importance;
+              else if (mode != "radiance")
+                  FACET_THROW("mode \"{}\": expected radiance or importance", mode);
+              if (component >= 0) ctx.component = uint32_t(component);
+              Chi2Options opts = chi2_options(o);
+              const std::string colour = colour_mode ? resolve_mode(*colour_mode) : default_mode();
+              std::unique_ptr<BSDFAdapter> adapter;
+              {
+                  py::gil_scoped_release release;
+                  adapter = std::make_unique<BSDFAdapter>(xml, vec3(wi, "wi"), ctx, colour);
+              }
+              return run_adapter(*adapter, opts);
+          });
     m.def("chi2_emitter", [](const std::string &scene_xml, const std::vector<float> &ref,
-                             bool emission, const py::dict &o) {
+                             bool emission, const py::dict &o,
+                             const std::optional<std::string> &colour_mode) {
         Chi2Options opts = chi2_options(o);
+        const std::string colour = colour_mode ? resolve_mode(*colour_mode) : default_mode();
         if (emission) {
             std::unique_ptr<EmissionAdapter> adapter;
             {
                 py::gil_scoped_release release;
-                adapter = std::make_unique<EmissionAdapter>(scene_xml);
+                adapter = std::make_unique<EmissionAdapter>(scene_xml, 0, colour);
             }
             return run_adapter(*adapter, opts);
         }
@@ -791,7 +795,8 @@ PYBIND11_MODULE(_facet, m) {
         std::unique_ptr<EmitterAdapter> adapter;
         {
             py::gil_scoped_release release;
-            adapter = std::make_unique<EmitterAdapter>(scene_xml, Point3f(r.x, r.y, r.z));
+            adapter =
+                std::make_unique<EmitterAdapter>(scene_xml, Point3f(r.x, r.y, r.z), 0, colour);
         }
         return run_adapter(*adapter, opts);
     });

@@ -116,3 +116,17 @@ def test_every_loader_takes_the_mode(cornell):
         facet.load_file(cornell, mode="scalar_spectral")
     with pytest.raises(TypeError, match="mode=1"):
         facet.load_file(cornell, mode=1)
+
+
+def test_chi2_builds_the_plugin_in_a_colour_mode():
+    args = dict(diffuse_reflectance=(0.9, 0.1, 0.1), alpha=0.25, theta=40, samples=100000, res=16)
+    rgb = facet.chi2("bsdf", "roughplastic", **args)
+    mono = facet.chi2("bsdf", "roughplastic", colour_mode="scalar_mono", **args)
+    assert rgb.passed and mono.passed
+    # The lobe weights come from the colour: the luminance of (0.9, 0.1, 0.1) is not its mean,
+    # so the two draw different histograms from the same samples.
+    assert not np.array_equal(rgb.observed, mono.observed)
+    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono"):
+        facet.chi2("bsdf", "diffuse", colour_mode="scalar_spectral")
+    with pytest.raises(TypeError, match="mode=2"):
+        facet.chi2("emitter", "point", colour_mode=2)
