@@ -3,6 +3,8 @@
 // loaded with LoadOptions::mode = "scalar_mono", and stays as it is in scalar_rgb. (The images
 // are checked against the peer's mono renders in the compat suite.)
 
+#include "texture_lookup.h"
+
 #include <facet/image.h>
 #include <facet/mode.h>
 #include <facet/properties.h>
@@ -21,13 +23,6 @@ using namespace facet;
 namespace fs = std::filesystem;
 
 namespace {
-
-SurfaceInteraction at_uv(float u, float v) {
-    SurfaceInteraction si;
-    si.uv = Point2f(u, v);
-    si.wi = Vector3f(0.f, 0.f, 1.f);
-    return si;
-}
 
 std::shared_ptr<Texture> load_texture(const std::string &xml, const std::string &mode,
                                       const std::string &dir = "") {

@@ -3,6 +3,8 @@
 // itself, an edited file is read again, 8-bit files keep a byte per value with exactly the
 // values of the float path, and the texture memory budget refuses an image by its header, before
 // decoding it, with the scene location of the texture and the name of the file.
+#include "texture_lookup.h"
+
 #include <facet/emitter.h>
 #include <facet/image.h>
 #include <facet/plugin.h>
@@ -103,12 +105,6 @@ size_t resident_bytes() {
     size_t pages = 0, resident = 0;
     statm >> pages >> resident;
     return resident * size_t(sysconf(_SC_PAGESIZE));
-}
-
-SurfaceInteraction at_uv(float u, float v) {
-    SurfaceInteraction si;
-    si.uv = Point2f(u, v);
-    return si;
 }
 
 } // namespace

@@ -2,6 +2,8 @@
 // decoding of 8-bit files, raw data, linear EXR, the uv layout, nearest and bilinear lookups,
 // every wrap mode, to_uv, mean/max/eval_1, file resolution, errors, and use as a BSDF parameter.
 
+#include "texture_lookup.h"
+
 #include <facet/bsdf.h>
 #include <facet/image.h>
 #include <facet/plugin.h>
@@ -29,13 +31,6 @@ namespace {
 
 float srgb_decode(float v) {
     return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
-
-SurfaceInteraction at_uv(float u, float v) {
-    SurfaceInteraction si;
-    si.uv = Point2f(u, v);
-    si.wi = Vector3f(0.f, 0.f, 1.f);
-    return si;
 }
 
 class Bitmap : public ::testing::Test {

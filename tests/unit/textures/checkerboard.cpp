@@ -1,6 +1,8 @@
 // The checkerboard texture: the 2 × 2 pattern over the unit square and its repetition, defaults,
 // to_uv, nested textures, mean/max/eval_1, errors, and use as a BSDF parameter.
 
+#include "texture_lookup.h"
+
 #include <facet/bsdf.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -13,13 +15,6 @@
 using namespace facet;
 
 namespace {
-
-SurfaceInteraction at_uv(float u, float v) {
-    SurfaceInteraction si;
-    si.uv = Point2f(u, v);
-    si.wi = Vector3f(0.f, 0.f, 1.f);
-    return si;
-}
 
 std::shared_ptr<Texture> make_checkerboard(Properties &props) {
     props.set_plugin_name("checkerboard");

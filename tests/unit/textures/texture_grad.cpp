@@ -4,6 +4,7 @@
 // texture without one.
 
 #include "draws.h"
+#include "texture_lookup.h"
 
 #include <facet/image.h>
 #include <facet/plugin.h>
@@ -21,12 +22,6 @@ using namespace facet;
 namespace fs = std::filesystem;
 
 namespace {
-
-SurfaceInteraction at_uv(float u, float v) {
-    SurfaceInteraction si;
-    si.uv = Point2f(u, v);
-    return si;
-}
 
 class TextureGrad : public ::testing::Test {
 protected:
