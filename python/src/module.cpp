@@ -245,10 +245,13 @@ py::tuple render_py(const PyScene &s, std::optional<int> spp, uint64_t seed, int
     // The scene's objects were built for one mode (load_file's mode=); a render in another
     // would need them built again.
     const std::string render_mode = mode_name(s.scene->mode());
-    if (mode && resolve_mode(*mode) != render_mode)
-        FACET_THROW("mode=\"{}\": the scene was loaded in {}; load it with mode=\"{}\" to "
-                    "render it in that mode",
-                    *mode, render_mode, resolve_mode(*mode));
+    if (mode) {
+        const std::string asked = resolve_mode(*mode); // logs a vectorised name's note once
+        if (asked != render_mode)
+            FACET_THROW("mode=\"{}\": the scene was loaded in {}; load it with mode=\"{}\" to "
+                        "render it in that mode",
+                        *mode, render_mode, asked);
+    }
     const auto &sensors = s.scene->sensors();
     if (sensor_index < 0 || size_t(sensor_index) >= sensors.size())
         FACET_THROW("sensor {}: the scene has {} sensor{} (valid indices 0..{})", sensor_index,

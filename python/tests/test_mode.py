@@ -97,12 +97,16 @@ def test_the_cli_renders_the_same_mono_image(mono, cornell, facet_cli, cli_env, 
     assert np.array_equal(pixels[..., :3], image[..., :3].astype(np.float16).astype(np.float32))
 
 
-def test_rendering_in_another_mode_than_the_loaded_one_is_an_error(scene, mono):
+def test_rendering_in_another_mode_than_the_loaded_one_is_an_error(scene, mono, capfd):
     with pytest.raises(facet.Error, match='the scene was loaded in scalar_rgb; load it with '
                                           'mode="scalar_mono"'):
         facet.render(scene, progress=False, mode="scalar_mono")
-    with pytest.raises(facet.Error, match="loaded in scalar_mono"):
+    facet.set_log_level("info")
+    capfd.readouterr()
+    with pytest.raises(facet.Error, match='loaded in scalar_mono; load it with mode="scalar_rgb"'):
         facet.render(mono, progress=False, mode="cuda_rgb")
+    # The vectorised name's note, once.
+    assert capfd.readouterr().err.count("facet renders it as scalar_rgb") == 1
 
 
 def test_every_loader_takes_the_mode(cornell):
