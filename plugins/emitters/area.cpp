@@ -4,7 +4,8 @@ static const char *DOC = R"DOC(
 Turns the shape it is nested in into a light source that emits `radiance` from the front side of
 its surface (the side the shading normal points to; use `flip_normals` on the shape to turn it
 around). Direction sampling uses the shape's own strategy (uniform area, or the visible cone for
-spheres).
+spheres); a textured `radiance` on a rectangle samples its texture instead (a `bitmap` by the
+luminance of its texels), so a light of very uneven brightness is sampled where it is bright.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -45,9 +46,21 @@ public:
         if (m_radiance->is_spatially_varying()) m_flags = m_flags | EmitterFlags::SpatiallyVarying;
     }
 
+    /// A textured light on a shape whose uv spans it once (rectangle) samples its texture; any
+    /// other samples its shape.
+    void set_scene(const Scene &) override {
+        m_texture_sampling = false;
+        PositionSample ps;
+        float area_per_uv = 0.f;
+        if (m_shape && m_radiance->is_spatially_varying() &&
+            m_shape->eval_parameterization(Point2f(0.5f, 0.5f), ps, area_per_uv))
+            m_texture_sampling = m_radiance->prepare_position_sampling();
+    }
+
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
                                                          const Point2f &u) const override {
         const Shape &shape = require_shape();
+        if (m_texture_sampling) return sample_texture(ref, u);
         DirectionSample ds = shape.sample_direction(ref, u);
         ds.emitter = this;
         // Only the front side emits: the sampled point must face the reference point.
@@ -61,6 +74,12 @@ public:
     float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
         const Shape &shape = require_shape();
         if (dot(ds.n, ds.d) >= 0.f) return 0.f;
+        if (m_texture_sampling) {
+            PositionSample at;
+            float area_per_uv = 0.f;
+            if (!shape.eval_parameterization(ds.uv, at, area_per_uv)) return 0.f;
+            return m_radiance->pdf_position(ds.uv) / area_per_uv * solid_angle_factor(ds);
+        }
         return shape.pdf_direction(ref, ds);
     }
 
@@ -107,6 +126,37 @@ private:
         return *m_shape;
     }
 
+    /// dist² / cos θ at the emitter point: from a density over area to one over solid angle
+    /// (0 seen from behind).
+    static float solid_angle_factor(const DirectionSample &ds) {
+        const float cos_theta = -dot(ds.n, ds.d);
+        return cos_theta > 0.f ? ds.dist * ds.dist / cos_theta : 0.f;
+    }
+
+    /// A uv drawn by the texture, mapped onto the shape: its density over uv, over the surface
+    /// (÷ the area per unit uv), then over solid angle.
+    std::pair<DirectionSample, Color3f> sample_texture(const Interaction &ref,
+                                                       const Point2f &u) const {
+        DirectionSample ds;
+        ds.emitter = this;
+        const auto [uv, pdf_uv] = m_radiance->sample_position(u);
+        float area_per_uv = 0.f;
+        if (!(pdf_uv > 0.f) ||
+            !m_shape->eval_parameterization(uv, static_cast<PositionSample &>(ds), area_per_uv))
+            return {ds, Color3f(0.f)};
+        ds.d = ds.p - ref.p;
+        ds.dist = norm(ds.d);
+        if (!(ds.dist > 0.f)) return {ds, Color3f(0.f)};
+        ds.d /= ds.dist;
+        // Only the front side emits: the sampled point must face the reference point.
+        ds.pdf = pdf_uv / area_per_uv * solid_angle_factor(ds);
+        if (!(ds.pdf > 0.f) || !std::isfinite(ds.pdf)) {
+            ds.pdf = 0.f;
+            return {ds, Color3f(0.f)};
+        }
+        return {ds, radiance_at(ds) / ds.pdf};
+    }
+
     /// Radiance at a sampled point: textures are evaluated at the point's uv.
     Color3f radiance_at(const DirectionSample &ds) const {
         if (!m_radiance->is_spatially_varying()) return m_radiance->mean();
@@ -122,6 +172,7 @@ private:
     }
 
     std::shared_ptr<Texture> m_radiance;
+    bool m_texture_sampling = false; ///< set by set_scene(): sample_texture(), not the shape
 };
 
 } // namespace facet

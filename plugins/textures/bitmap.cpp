@@ -38,6 +38,7 @@ luminance too, unless `raw` is set (a normal map keeps its three channels).
 ```
 )DOC";
 
+#include <facet/distribution.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/resolver.h>
@@ -161,6 +162,59 @@ public:
     Color3f mean() const override { return m_mean; }
     float max() const override { return m_max; }
 
+    /// An area light's texture sampling: a texel (a cell of the nearest filter; of the bilinear
+    /// filter's texel grid) in proportion to its luminance, then a uniform point in it. With the
+    /// bilinear filter a cell's weight is the largest over the texel and its eight neighbours,
+    /// whose values reach into the cell, so the density is positive wherever the lookup is. Only
+    /// for the identity to_uv (the sampled uv is then the shape's).
+    bool prepare_position_sampling() override {
+        static const float identity[6] = {1, 0, 0, 0, 1, 0};
+        if (!std::equal(std::begin(m_uv_matrix), std::end(m_uv_matrix), identity)) return false;
+        if (m_position_sampling) return true;
+        const size_t w = size_t(m_width), h = size_t(m_height);
+        std::vector<float> texel(w * h);
+        for (size_t y = 0; y < h; ++y)
+            for (size_t x = 0; x < w; ++x) {
+                const int xi = int(x), yi = int(y);
+                const float v =
+                    m_channels == 1
+                        ? (m_bytes ? pixel<1, true>(xi, yi) : pixel<1, false>(xi, yi)).r
+                        : (m_bytes ? pixel<3, true>(xi, yi) : pixel<3, false>(xi, yi)).luminance();
+                texel[y * w + x] = v > 0.f && std::isfinite(v) ? v : 0.f;
+            }
+        std::vector<float> weight = texel;
+        if (m_filter == FilterType::Bilinear)
+            for (int y = 0; y < m_height; ++y)
+                for (int x = 0; x < m_width; ++x) {
+                    float m = 0.f;
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx)
+                            m = std::max(m, texel[size_t(wrap(y + dy, m_height)) * w +
+                                                  size_t(wrap(x + dx, m_width))]);
+                    weight[size_t(y) * w + size_t(x)] = m;
+                }
+        m_position_distribution.build(weight.data(), weight.size());
+        m_position_sampling = m_position_distribution.sum() > 0.0;
+        return m_position_sampling;
+    }
+
+    std::pair<Point2f, float> sample_position(const Point2f &u) const override {
+        float ux = u.x;
+        const size_t i = m_position_distribution.sample_reuse(ux);
+        const size_t x = i % size_t(m_width), y = i / size_t(m_width);
+        const Point2f uv(std::min((float(x) + ux) / float(m_width), OneMinusEpsilon),
+                         std::min((float(y) + u.y) / float(m_height), OneMinusEpsilon));
+        return {uv, pdf_position(uv)};
+    }
+
+    float pdf_position(const Point2f &uv) const override {
+        if (!(uv.x >= 0.f && uv.x <= 1.f && uv.y >= 0.f && uv.y <= 1.f)) return 0.f;
+        const size_t x = std::min(size_t(uv.x * float(m_width)), size_t(m_width) - 1);
+        const size_t y = std::min(size_t(uv.y * float(m_height)), size_t(m_height) - 1);
+        return m_position_distribution.pmf(y * size_t(m_width) + x) * float(m_width) *
+               float(m_height);
+    }
+
     int width() const { return m_width; }
     int height() const { return m_height; }
     Point2i resolution() const override { return {m_width, m_height}; }
@@ -275,6 +329,9 @@ private:
     const float *m_table = nullptr;             ///< its table
     Color3f m_mean;
     float m_max = 0.f;
+    /// The texel table of sample_position(), built by prepare_position_sampling() for emitters.
+    DiscreteDistribution m_position_distribution;
+    bool m_position_sampling = false;
 };
 
 } // namespace facet

@@ -60,6 +60,16 @@ public:
     virtual DirectionSample sample_direction(const Interaction &ref, const Point2f &u) const;
     virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const;
 
+    /// For shapes whose uv is a one-to-one map of [0, 1]² onto the whole surface (rectangle):
+    /// the point of texture coordinates `uv` (p, n, uv; pdf unset) and the area of surface per
+    /// unit of uv area there, |∂p/∂u × ∂p/∂v|. An area light samples its texture through it.
+    /// Other shapes return false (the default), and their area lights sample by area.
+    virtual bool eval_parameterization(const Point2f &uv, PositionSample &ps,
+                                       float &area_per_uv) const {
+        (void)uv, (void)ps, (void)area_per_uv;
+        return false;
+    }
+
     const BSDF *bsdf() const { return m_bsdf.get(); }
     const Emitter *emitter() const { return m_emitter.get(); }
     /// A nested sensor (see ShapeSensor), or nullptr.

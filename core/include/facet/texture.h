@@ -6,6 +6,7 @@
 #include <facet/spectrum.h>
 
 #include <memory>
+#include <utility>
 
 namespace facet {
 
@@ -32,6 +33,20 @@ public:
     /// Pixel resolution of a texture backed by an image ((1, 1) otherwise); the projector takes
     /// its aspect ratio from it, as in Mitsuba 3.
     virtual Point2i resolution() const { return {1, 1}; }
+
+    /// Importance sampling of the texture's domain, uv in [0, 1]², for an area light whose shape
+    /// maps [0, 1]² onto its surface (Shape::eval_parameterization). A texture that can sample
+    /// builds what it needs here and returns true; the call comes from the emitter before any
+    /// render, so textures that only reflect hold nothing for it. The default cannot.
+    virtual bool prepare_position_sampling() { return false; }
+    /// A uv in [0, 1]² drawn from `u`, with a density over [0, 1]² that is positive wherever
+    /// eval() is not zero, and that density (0: no sample). Only after prepare_position_sampling()
+    /// returned true.
+    virtual std::pair<Point2f, float> sample_position(const Point2f &u) const { return {u, 1.f}; }
+    /// The density sample_position() draws `uv` with (0 outside [0, 1]²).
+    virtual float pdf_position(const Point2f &uv) const {
+        return uv.x >= 0.f && uv.x <= 1.f && uv.y >= 0.f && uv.y <= 1.f ? 1.f : 0.f;
+    }
 };
 
 /// True for a texture that is present and varies over the surface (sets
