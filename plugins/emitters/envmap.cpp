@@ -60,6 +60,16 @@ float srgb_to_linear(float v) {
 /// Floor of sin θ in the density (Mitsuba's float epsilon), so the poles keep a finite pdf.
 constexpr float SinThetaFloor = 0x1p-24f;
 
+/// Starts loading the cache line of p. An asm statement rather than __builtin_prefetch: the
+/// compiler removes loops whose only statements are the builtin as having no effect.
+inline void prefetch(const void *p) {
+#if defined(__x86_64__) || defined(__i386__)
+    asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char *>(p)));
+#else
+    __builtin_prefetch(p);
+#endif
+}
+
 bool is_display_encoded(const std::string &path) {
     std::string ext = path.substr(path.find_last_of('.') + 1);
     std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -261,7 +271,10 @@ private:
 
     Point2f sample_uv(Point2f u) const {
         float uc = u.x;
-        size_t index = m_cells.sample_reuse(uc);
+        // While the distribution reads the block its cell comes from, the texels of that
+        // block's cells (the same rows: a block is a few cells of one row, or two) are fetched.
+        size_t index = m_cells.sample_reuse(
+            uc, [this](size_t first, size_t last) { prefetch_cells(first, last); });
         int i = int(index % size_t(m_width)), j = int(index / size_t(m_width));
         float a = table(i, j), b = table(i + 1, j), c = table(i, j + 1), d = table(i + 1, j + 1);
         // A cell next to a pole has a zero row (sin θ = 0): at t = 0 both ends of the s line
@@ -271,6 +284,21 @@ private:
         float uu = (float(i) + s + 0.5f) / float(m_width);
         uu -= std::floor(uu);
         return {std::min(uu, OneMinusEpsilon), (float(j) + t) / float(m_height - 1)};
+    }
+
+    /// Starts fetching the texel rows that sampling cells first..last reads.
+    void prefetch_cells(size_t first, size_t last) const {
+        const size_t W = size_t(m_width);
+        for (size_t j = first / W; j <= last / W; ++j) {
+            const size_t i0 = j == first / W ? first % W : 0;
+            const size_t i1 = j == last / W ? last % W + 1 : W;
+            for (size_t row = j; row <= j + 1; ++row) {
+                const char *begin = reinterpret_cast<const char *>(&texel(int(i0), int(row)));
+                const char *end = reinterpret_cast<const char *>(&texel(int(i1), int(row)) + 1);
+                for (const char *p = begin; p < end; p += 64) prefetch(p);
+                prefetch(end - 1);
+            }
+        }
     }
 
     /// Density of the local direction `local`, whose grid point is g.
