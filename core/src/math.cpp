@@ -30,11 +30,10 @@ float erfinv(float x) {
         p = 1.00167406f + p * w;
         p = 2.83297682f + p * w;
     }
-    double y = double(p) * double(x);
-    // One Newton step on erf(y) - x = 0 in double precision; d/dy erf(y) = 2/sqrt(pi) exp(-y²).
-    double err = std::erf(y) - double(x);
-    y -= err / (1.1283791670955126 * std::exp(-y * y));
-    return float(y);
+    // erf of the result is x to within 1.1e-7 over (-1, 1) (unit.math checks 2e-7): a float's
+    // precision, as sampling needs. A Newton step in double gave 2.6e-8, at 2.7x the cost; the
+    // Beckmann visible-normal sampler calls this five times per sample.
+    return p * x;
 }
 
 } // namespace facet
