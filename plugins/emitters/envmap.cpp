@@ -197,7 +197,7 @@ public:
 private:
     /// uv in [0,1]²: u = atan2(x, -z)/2π around +Y from -Z towards +X, v = θ/π from +Y.
     static Point2f direction_to_uv(const Vector3f &d) {
-        float u = std::atan2(d.x, -d.z) * InvTwoPi;
+        float u = fast_atan2(d.x, -d.z) * InvTwoPi;
         u -= std::floor(u);
         return {u, safe_acos(d.y) * InvPi};
     }

@@ -86,7 +86,7 @@ public:
         si.p = m_to_world.apply_point(Point3f(uv.x, uv.y, 0.f));
         si.n = m_normal;
         float r = std::sqrt(uv.x * uv.x + uv.y * uv.y);
-        float phi = r > 0.f ? std::atan2(uv.y, uv.x) : 0.f;
+        float phi = r > 0.f ? fast_atan2(uv.y, uv.x) : 0.f;
         if (phi < 0.f) phi += 2.f * Pi;
         si.uv = Point2f(r, phi * InvTwoPi);
         float cos_phi = std::cos(phi), sin_phi = std::sin(phi);
@@ -110,7 +110,7 @@ public:
         ps.p = m_to_world.apply_point(Point3f(q.x, q.y, 0.f));
         ps.n = m_normal;
         float r = norm(q);
-        float phi = r > 0.f ? std::atan2(q.y, q.x) : 0.f;
+        float phi = r > 0.f ? fast_atan2(q.y, q.x) : 0.f;
         if (phi < 0.f) phi += 2.f * Pi;
         ps.uv = Point2f(r, phi * InvTwoPi);
         ps.pdf = 1.f / m_area;

@@ -87,7 +87,7 @@ public:
         Vector3f q = object_direction(dir);
         float cos_theta = clamp(q.z, -1.f, 1.f);
         float sin_theta = safe_sqrt(1.f - cos_theta * cos_theta);
-        float phi = std::atan2(q.y, q.x);
+        float phi = fast_atan2(q.y, q.x);
         if (phi < 0.f) phi += 2.f * Pi;
         si.uv = Point2f(phi * InvTwoPi, safe_acos(cos_theta) * InvPi);
         float cos_phi = std::cos(phi), sin_phi = std::sin(phi);
@@ -205,7 +205,7 @@ private:
     }
 
     static Point2f spherical_uv(const Vector3f &q) {
-        float phi = std::atan2(q.y, q.x);
+        float phi = fast_atan2(q.y, q.x);
         if (phi < 0.f) phi += 2.f * Pi;
         return Point2f(phi * InvTwoPi, safe_acos(q.z) * InvPi);
     }

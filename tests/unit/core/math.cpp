@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <random>
 #include <vector>
 
 using namespace facet;
@@ -154,6 +155,32 @@ TEST(Math, ErfinvInvertsErf) {
     EXPECT_EQ(erfinv(0.f), 0.f);
     EXPECT_NEAR(erfinv(0.5f), 0.4769362762f, 1e-6f);
     EXPECT_NEAR(erfinv(-0.999999f), -3.4589107f, 2e-3f);
+}
+
+TEST(Math, FastAtan2IsWithinTwoAndAHalfUlpOfTheAngle) {
+    // Random points in every quadrant, at every scale ratio (down to 1e-6, where the angle is
+    // near an axis), against atan2 in double; then the signed zeros and the axes exactly.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uniform(-1.f, 1.f);
+    double worst = 0.0;
+    for (int i = 0; i < 1000000; ++i) {
+        float y = uniform(rng), x = uniform(rng);
+        if (i % 3 == 1) y *= std::pow(10.f, -float(i % 7));
+        if (i % 3 == 2) x *= std::pow(10.f, -float(i % 7));
+        const double want = std::atan2(double(y), double(x));
+        const float got = fast_atan2(y, x);
+        const float w = float(std::abs(want));
+        const double ulp = double(std::nextafter(w, Infinity) - w);
+        worst = std::max(worst, std::abs(double(got) - want) / ulp);
+        ASSERT_LE(std::abs(double(got) - want), 2.5 * ulp) << "atan2(" << y << ", " << x << ")";
+    }
+    EXPECT_GT(worst, 0.5); // the comparison itself is not vacuous
+    for (float y : {0.f, -0.f, 1.f, -1.f, 3e-30f})
+        for (float x : {0.f, -0.f, 1.f, -1.f, 2e-30f}) {
+            const float want = std::atan2(y, x), got = fast_atan2(y, x);
+            EXPECT_NEAR(got, want, 2.5e-7f) << "atan2(" << y << ", " << x << ")";
+            EXPECT_EQ(std::signbit(got), std::signbit(want)) << "atan2(" << y << ", " << x << ")";
+        }
 }
 
 // -- Warps -------------------------------------------------------------------------------------
