@@ -60,16 +60,6 @@ float srgb_to_linear(float v) {
 /// Floor of sin θ in the density (Mitsuba's float epsilon), so the poles keep a finite pdf.
 constexpr float SinThetaFloor = 0x1p-24f;
 
-/// Starts loading the cache line of p. An asm statement rather than __builtin_prefetch: the
-/// compiler removes loops whose only statements are the builtin as having no effect.
-inline void prefetch(const void *p) {
-#if defined(__x86_64__) || defined(__i386__)
-    asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char *>(p)));
-#else
-    __builtin_prefetch(p);
-#endif
-}
-
 bool is_display_encoded(const std::string &path) {
     std::string ext = path.substr(path.find_last_of('.') + 1);
     std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -295,8 +285,8 @@ private:
             for (size_t row = j; row <= j + 1; ++row) {
                 const char *begin = reinterpret_cast<const char *>(&texel(int(i0), int(row)));
                 const char *end = reinterpret_cast<const char *>(&texel(int(i1), int(row)) + 1);
-                for (const char *p = begin; p < end; p += 64) prefetch(p);
-                prefetch(end - 1);
+                for (const char *p = begin; p < end; p += 64) prefetch_line(p);
+                prefetch_line(end - 1);
             }
         }
     }
