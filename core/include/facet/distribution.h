@@ -31,7 +31,7 @@ class DiscreteDistribution {
 public:
     static constexpr size_t BlockSize = 12;
     /// Up to this many candidate blocks are compared directly rather than searched.
-    static constexpr size_t ShortRange = 4;
+    static constexpr size_t ShortRange = 8;
 
     DiscreteDistribution() = default;
     explicit DiscreteDistribution(const std::vector<float> &weights) {
@@ -149,16 +149,17 @@ private:
 
     /// The guide table of the cut-point method over the blocks: m_guide[k], k = 0..K, is the
     /// block sampled for u = k / K (the first whose CDF exceeds it, or the block count), with K
-    /// the largest power of two not above the count. The block of any u in [k/K, (k+1)/K) lies
-    /// between m_guide[k] and m_guide[k+1], so a search of the whole table (about log2 n
-    /// dependent loads across it) becomes one of a few entries. Empty for a single block or more
-    /// than 2^32.
+    /// the largest power of two not above a quarter of the count (at least 1). The block of any
+    /// u in [k/K, (k+1)/K) lies between m_guide[k] and m_guide[k+1], so a search of the whole
+    /// table (about log2 n dependent loads across it) becomes one of a few entries. A guide this
+    /// size stays in cache more often than one entry per block, which every sample would wait
+    /// for (the living room's sky: 3% of the render). Empty for a single block or more than 2^32.
     void build_guide() {
         m_guide.clear();
         const size_t n = m_blocks.size();
         if (n < 2 || n > size_t(UINT32_MAX)) return;
         size_t K = 1;
-        while (K <= n / 2) K *= 2;
+        while (K <= n / 8) K *= 2;
         m_guide.resize(K + 1);
         size_t i = 0; // a merge of the thresholds k / K into the CDF
         for (size_t k = 0; k <= K; ++k) {
