@@ -262,7 +262,7 @@ private:
     Point2f sample_uv(Point2f u) const {
         float uc = u.x;
         // While the distribution reads the block its cell comes from, the texels of that
-        // block's cells (the same rows: a block is a few cells of one row, or two) are fetched.
+        // block's cells (in one row or two, but for maps under 12 pixels wide) are fetched.
         size_t index = m_cells.sample_reuse(
             uc, [this](size_t first, size_t last) { prefetch_cells(first, last); });
         int i = int(index % size_t(m_width)), j = int(index / size_t(m_width));

@@ -107,7 +107,7 @@ public:
             if (hi - lo > 1 && hi - lo <= ShortRange) {
                 // A few candidates: their lines are loaded together, and the start of each
                 // next block (its CDF value) decides, so the pick waits for one miss, not two.
-                for (size_t c = lo; c <= std::min(hi, blocks - 1); ++c) prefetch_line(&m_blocks[c]);
+                for (size_t c = lo; c < hi; ++c) prefetch_line(&m_blocks[c]);
                 b = lo;
                 while (b + 1 < hi && b + 1 < blocks && !(m_blocks[b + 1].start > double(u))) ++b;
             } else if (hi - lo > 1) {
@@ -153,7 +153,8 @@ private:
     /// u in [k/K, (k+1)/K) lies between m_guide[k] and m_guide[k+1], so a search of the whole
     /// table (about log2 n dependent loads across it) becomes one of a few entries. A guide this
     /// size stays in cache more often than one entry per block, which every sample would wait
-    /// for (the living room's sky: 3% of the render). Empty for a single block or more than 2^32.
+    /// for (the living room's sky: 3% of the render). Empty for a single block or 2^32 blocks or
+    /// more.
     void build_guide() {
         m_guide.clear();
         const size_t n = m_blocks.size();

@@ -56,7 +56,7 @@ inline float fast_atan2(float y, float x) {
 }
 
 /// Inverse error function (Giles' single-precision approximation): erf of the result is x within
-/// 1.1e-7.
+/// 1.2e-7.
 float erfinv(float x);
 
 } // namespace facet
