@@ -109,7 +109,7 @@ public:
                 // next block (its CDF value) decides, so the pick waits for one miss, not two.
                 for (size_t c = lo; c < hi; ++c) prefetch_line(&m_blocks[c]);
                 b = lo;
-                while (b + 1 < hi && b + 1 < blocks && !(m_blocks[b + 1].start > double(u))) ++b;
+                while (b + 1 < hi && !(m_blocks[b + 1].start > double(u))) ++b; // hi <= blocks
             } else if (hi - lo > 1) {
                 auto it = std::upper_bound(m_block_cdf.begin() + 1 + lo,
                                            m_block_cdf.begin() + 1 + hi, double(u));
