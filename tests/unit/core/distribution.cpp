@@ -15,8 +15,9 @@ using namespace facet;
 
 namespace {
 
-/// The plain inversion: linear scans of the two-level CDF (a CDF over blocks of BlockSize
-/// entries, then each block's own CDF relative to it) accumulated as build() accumulates it.
+/// The plain inversion of the two-level CDF (a CDF over blocks of BlockSize entries, then each
+/// block's own CDF relative to it) accumulated as build() accumulates it: a search of the whole
+/// block CDF, without the guide or the candidate shortcut, then a scan of the block.
 struct Inversion {
     static constexpr size_t B = DiscreteDistribution::BlockSize;
     size_t n;
