@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include <facet/logger.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 
 #include <CLI/CLI.hpp>
@@ -46,7 +47,15 @@ ObjectType kind_from_word(std::string word) {
 
 struct Entry {
     std::string name, description, file; ///< file: set when not one of facet's own plugins
+    std::string modes;                   ///< the modes it renders in, when not all of them
 };
+
+/// plugin_modes(desc) when the plugin does not render in every mode, else "".
+std::string partial_modes(const PluginDescriptor &desc) {
+    for (const std::string &mode : modes())
+        if (!(desc.modes & mode_bit(colour_mode(mode)))) return plugin_modes(desc);
+    return "";
+}
 
 /// The library that serves `name` (the first on the search path) when it is not in facet's own
 /// plugin folder (the search path's last), with " (shadows the built-in)" when that has one too.
@@ -71,8 +80,8 @@ std::map<ObjectType, std::vector<Entry>> collect(std::vector<std::string> &broke
     for (const std::string &name : registry.available()) {
         try {
             const PluginDescriptor &desc = registry.descriptor(name);
-            by_kind[desc.kind].push_back(
-                {name, desc.description ? desc.description : "", user_file(name)});
+            by_kind[desc.kind].push_back({name, desc.description ? desc.description : "",
+                                          user_file(name), partial_modes(desc)});
         } catch (const std::exception &e) {
             broken.push_back(fmt::format("{}: {}", name, e.what()));
         }
@@ -85,7 +94,8 @@ void print_kind(ObjectType kind, const std::vector<Entry> &entries) {
     for (const Entry &e : entries) width = std::max(width, e.name.size());
     fmt::print("{} ({}):\n", object_type_folder(kind), object_type_name(kind));
     for (const Entry &e : entries)
-        fmt::print("  {:<{}}  {}{}\n", e.name, width, e.description,
+        fmt::print("  {:<{}}  {}{}{}\n", e.name, width, e.description,
+                   e.modes.empty() ? "" : " (only " + e.modes + ")",
                    e.file.empty() ? "" : " [" + e.file + "]");
 }
 
@@ -124,8 +134,8 @@ int plugins_main(int argc, char **argv) {
         doc.erase(0, doc.find_first_not_of("\n"));
         doc.erase(doc.find_last_not_of("\n") + 1);
         const std::string file = user_file(what);
-        fmt::print("{} ({}): {}\n{}\n{}\n", desc.name, object_type_name(desc.kind),
-                   desc.description ? desc.description : "",
+        fmt::print("{} ({}): {}\nmodes: {}\n{}\n{}\n", desc.name, object_type_name(desc.kind),
+                   desc.description ? desc.description : "", plugin_modes(desc),
                    file.empty() ? "" : fmt::format("from {}\n", file), doc);
         return 0;
     }

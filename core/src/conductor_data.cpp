@@ -52,8 +52,9 @@ std::vector<std::string> conductor_names() {
     return names;
 }
 
-std::pair<Color3f, Color3f> conductor_eta_k(const std::string &material) {
-    if (material == "none") return {Color3f(0.f), Color3f(1.f)};
+namespace {
+
+const ConductorEntry &find_conductor(const std::string &material) {
     const ConductorEntry *found = nullptr;
     for (const ConductorEntry &e : CONDUCTORS)
         if (material == e.name) found = &e;
@@ -67,8 +68,22 @@ std::pair<Color3f, Color3f> conductor_eta_k(const std::string &material) {
                     closest.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", closest),
                     fmt::join(names, ", "));
     }
-    return {spectrum_to_rgb(grid_spectrum(found->eta), SpectrumKind::Measured),
-            spectrum_to_rgb(grid_spectrum(found->k), SpectrumKind::Measured)};
+    return *found;
+}
+
+} // namespace
+
+std::pair<Color3f, Color3f> conductor_eta_k(const std::string &material) {
+    if (material == "none") return {Color3f(0.f), Color3f(1.f)};
+    const ConductorEntry &found = find_conductor(material);
+    return {spectrum_to_rgb(grid_spectrum(found.eta), SpectrumKind::Measured),
+            spectrum_to_rgb(grid_spectrum(found.k), SpectrumKind::Measured)};
+}
+
+std::pair<SpectrumData, SpectrumData> conductor_eta_k_spectra(const std::string &material) {
+    if (material == "none") return {SpectrumData::constant(0.0), SpectrumData::constant(1.0)};
+    const ConductorEntry &found = find_conductor(material);
+    return {grid_spectrum(found.eta), grid_spectrum(found.k)};
 }
 
 ConductorIOR read_conductor_ior(const Properties &props) {
@@ -90,8 +105,15 @@ ConductorIOR read_conductor_ior(const Properties &props) {
         } catch (const Error &e) {
             throw Error(props.location("material"), e.message());
         }
-        result.eta = std::make_shared<ConstantTexture>(in_mode(eta_k.first, props.mode()));
-        result.k = std::make_shared<ConstantTexture>(in_mode(eta_k.second, props.mode()));
+        if (props.mode() == ColourMode::Spectral) {
+            // The measured data per wavelength.
+            auto spectra = conductor_eta_k_spectra(result.material);
+            result.eta = data_spectrum_texture(spectra.first, SpectrumKind::Measured);
+            result.k = data_spectrum_texture(spectra.second, SpectrumKind::Measured);
+        } else {
+            result.eta = std::make_shared<ConstantTexture>(in_mode(eta_k.first, props.mode()));
+            result.k = std::make_shared<ConstantTexture>(in_mode(eta_k.second, props.mode()));
+        }
     }
     return result;
 }

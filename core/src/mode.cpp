@@ -41,7 +41,7 @@ bool has_mode(const std::string &name) {
 } // namespace
 
 const std::vector<std::string> &modes() {
-    static const std::vector<std::string> list = {"scalar_rgb", "scalar_mono"};
+    static const std::vector<std::string> list = {"scalar_rgb", "scalar_mono", "scalar_spectral"};
     return list;
 }
 
@@ -77,6 +77,7 @@ std::string resolve_mode(const std::string &name) {
 ColourMode colour_mode(const std::string &mode) {
     if (mode == "scalar_rgb") return ColourMode::RGB;
     if (mode == "scalar_mono") return ColourMode::Mono;
+    if (mode == "scalar_spectral") return ColourMode::Spectral;
     FACET_THROW("\"{}\" is no mode facet renders (expected one of: {})", mode,
                 fmt::join(modes(), ", "));
 }
@@ -85,6 +86,8 @@ const char *mode_name(ColourMode mode) {
     switch (mode) {
     case ColourMode::Mono:
         return "scalar_mono";
+    case ColourMode::Spectral:
+        return "scalar_spectral";
     case ColourMode::RGB:
         break;
     }

@@ -193,6 +193,10 @@ std::shared_ptr<Object> PluginRegistry::create(ObjectType expected, const Proper
         if (e.location().valid()) throw;
         throw Error(props.location(), e.message());
     }
+    if (!(desc->modes & mode_bit(props.mode())))
+        FACET_THROW_AT(props.location(),
+                       "the {} plugin \"{}\" does not render in the mode {} (it renders in: {})",
+                       kind_name(desc->kind), name, mode_name(props.mode()), plugin_modes(*desc));
     std::shared_ptr<Object> obj;
     try {
         obj = std::shared_ptr<Object>(desc->create(props));
@@ -213,6 +217,13 @@ std::shared_ptr<Object> PluginRegistry::create(ObjectType expected, const Proper
     if (!props.id().empty()) obj->set_id(props.id());
     check_unqueried(props, obj->type(), lenient);
     return obj;
+}
+
+std::string plugin_modes(const PluginDescriptor &desc) {
+    std::vector<std::string> names;
+    for (const std::string &mode : modes())
+        if (desc.modes & mode_bit(colour_mode(mode))) names.push_back(mode);
+    return names.empty() ? std::string("no mode") : fmt::format("{}", fmt::join(names, ", "));
 }
 
 std::vector<std::string> PluginRegistry::available(ObjectType kind) {

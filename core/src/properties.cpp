@@ -271,11 +271,51 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
     const Entry &e = require(name);
     if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) {
         // A spectrum plugin becomes the constant its use calls for (reflectance, emission, ...).
-        if (auto spectrum = std::dynamic_pointer_cast<SpectrumTexture>(*obj))
-            return std::make_shared<ConstantTexture>(
-                spectrum_value(*spectrum, name, e.location, kind));
+        if (auto spectrum = std::dynamic_pointer_cast<SpectrumTexture>(*obj)) {
+            if (m_mode != ColourMode::Spectral)
+                return std::make_shared<ConstantTexture>(
+                    spectrum_value(*spectrum, name, e.location, kind));
+            try {
+                return spectrum->spectral(kind);
+            } catch (const Error &err) {
+                if (err.location().valid()) throw;
+                FACET_THROW_AT(e.location.valid() ? e.location : m_location, "parameter \"{}\": {}",
+                               name, err.message());
+            }
+        }
         if (auto tex = std::dynamic_pointer_cast<Texture>(*obj)) return tex;
         type_error(name, "texture, rgb, spectrum or float");
+    }
+    if (m_mode == ColourMode::Spectral) {
+        // Numbers are flat spectra (an emitter's, like its rgb, has D65's colour); colours are
+        // upsampled, spectra evaluated per wavelength.
+        switch (Type(e.value.index())) {
+        case Type::Float:
+        case Type::Integer:
+            if (kind == SpectrumKind::Emission)
+                return rgb_spectrum_texture(get_color(name, kind), kind);
+            return std::make_shared<ConstantTexture>(get_color(name, kind));
+        case Type::Color: {
+            // A grey is a flat spectrum, but for an emitter.
+            const Color3f c = get_color(name, kind);
+            if (kind == SpectrumKind::Unbounded &&
+                !(std::min(c.r, std::min(c.g, c.b)) >= 0.f && c.max() <= 1.f)) {
+                const Location &loc = e.location.valid() ? e.location : m_location;
+                FACET_LOG(Warn,
+                          "{}{}parameter \"{}\" = [{}, {}, {}]: the spectral mode upsamples an "
+                          "rgb clamped to [0, 1], as Mitsuba does; give a spectrum for values "
+                          "outside it",
+                          loc.to_string(), loc.valid() ? ": " : "", name, c.r, c.g, c.b);
+            }
+            if (c.r == c.g && c.g == c.b && kind != SpectrumKind::Emission)
+                return std::make_shared<ConstantTexture>(c);
+            return rgb_spectrum_texture(c, kind);
+        }
+        case Type::Spectrum:
+            return data_spectrum_texture(std::get<SpectrumData>(e.value), kind);
+        default:
+            break;
+        }
     }
     switch (Type(e.value.index())) {
     case Type::Float:
@@ -290,13 +330,21 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
 
 std::shared_ptr<Texture> Properties::texture(const std::string &name, float def,
                                              SpectrumKind kind) const {
-    if (!has(name)) return std::make_shared<ConstantTexture>(Color3f(def));
+    if (!has(name))
+        return m_mode == ColourMode::Spectral && kind == SpectrumKind::Emission
+                   ? rgb_spectrum_texture(Color3f(def), kind)
+                   : std::make_shared<ConstantTexture>(Color3f(def));
     return texture(name, kind);
 }
 
 std::shared_ptr<Texture> Properties::texture(const std::string &name, const Color3f &def,
                                              SpectrumKind kind) const {
-    if (!has(name)) return std::make_shared<ConstantTexture>(in_mode(def, m_mode));
+    if (!has(name)) {
+        if (m_mode == ColourMode::Spectral &&
+            !(def.r == def.g && def.g == def.b && kind != SpectrumKind::Emission))
+            return rgb_spectrum_texture(def, kind);
+        return std::make_shared<ConstantTexture>(in_mode(def, m_mode));
+    }
     return texture(name, kind);
 }
 

@@ -11,11 +11,13 @@
 #include <facet/sampler.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
+#include <facet/spectrum.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <tuple>
 #include <utility>
 
 namespace facet {
@@ -344,6 +346,7 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     const int y0 = std::max(offset.y, grid.y0), y1 = std::min(offset.y + size.y, grid.y1);
     const ReconstructionFilter &filter = m_film.rfilter();
     const bool needs_aperture = m_sensor.needs_aperture_sample();
+    const bool spectral = m_scene.mode() == ColourMode::Spectral;
     const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
 
     uint64_t bad = 0, first_bad_pixel = UINT64_MAX;
@@ -365,9 +368,16 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                 const Point2f pos(float(x) + u.x, float(y) + u.y);
                 const Point2f aperture = needs_aperture ? sampler.draw_2d() : Point2f(0.5f, 0.5f);
                 auto [ray, weight] = m_sensor.sample_ray(0.f, pos * inv_film_size, aperture);
+                // The spectral mode's wavelengths come with the camera ray (the sample's next
+                // dimension); its radiance at them becomes the film's RGB through XYZ.
+                Color3f wavelength_weight;
+                if (spectral)
+                    std::tie(ray.wavelengths, wavelength_weight) =
+                        sample_wavelengths(sampler.draw_1d());
                 // Integrators need not write every AOV for every sample (e.g. on a miss).
                 if (aov_count > 0) std::fill_n(aovs.data(), aov_count, 0.f);
-                const Color3f L = integrator.sample(m_scene, sampler, ray, aovs.data()) * weight;
+                Color3f L = integrator.sample(m_scene, sampler, ray, aovs.data()) * weight;
+                if (spectral) L = spectral_to_srgb(L, ray.wavelengths, wavelength_weight);
                 bool valid = L.is_finite();
                 for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
                 if (!valid) {

@@ -499,6 +499,7 @@ uint64_t detail::SceneQueries::resend(const Scene &scene, const RayQuery *querie
 
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     g_intersect_calls.add();
+    si.wavelengths = ray.wavelengths;
     __m128 a, b;
     ray_words(ray, a, b);
     if (!embree_can_trace(a, b)) {

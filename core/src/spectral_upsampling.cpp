@@ -153,4 +153,38 @@ SigmoidPolynomial rgb_to_sigmoid(const Color3f &rgb_in) {
     return {c[0], c[1], c[2]};
 }
 
+RGBSpectrum RGBSpectrum::from_rgb(const Color3f &rgb, SpectrumKind kind) {
+    RGBSpectrum result;
+    if (kind == SpectrumKind::Reflectance || kind == SpectrumKind::Unbounded) {
+        // Mitsuba 3's spectral modes clamp an unbounded rgb (an eta or k) too: its peer
+        // references show it.
+        result.poly = rgb_to_sigmoid(rgb);
+        return result;
+    }
+    result = scaled(rgb);
+    result.illuminant = kind == SpectrumKind::Emission;
+    return result;
+}
+
+RGBSpectrum RGBSpectrum::scaled(const Color3f &rgb) {
+    RGBSpectrum result;
+    const float scale = 2.f * rgb.max();
+    if (!(scale > 0.f) || !std::isfinite(scale)) {
+        result.poly = rgb_to_sigmoid(Color3f(0.f));
+        result.scale = 0.f;
+        return result;
+    }
+    result.poly = rgb_to_sigmoid(rgb / scale);
+    result.scale = scale;
+    return result;
+}
+
+Color3f RGBSpectrum::eval(const Wavelengths &lambda) const {
+    Color3f v(poly(lambda.r), poly(lambda.g), poly(lambda.b));
+    v *= scale;
+    if (illuminant)
+        v *= Color3f(float(cie_d65(lambda.r)), float(cie_d65(lambda.g)), float(cie_d65(lambda.b)));
+    return v;
+}
+
 } // namespace facet

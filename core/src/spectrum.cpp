@@ -4,6 +4,7 @@
 #include <facet/spectrum.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -197,6 +198,45 @@ Color3f spectrum_to_rgb(const SpectrumData &s, SpectrumKind kind) {
     Color3f rgb = xyz_to_srgb(Color3f(float(x * w), float(y * w), float(z * w)));
     float hi = kind == SpectrumKind::Reflectance ? 1.f : Infinity;
     return {clamp(rgb.r, 0.f, hi), clamp(rgb.g, 0.f, hi), clamp(rgb.b, 0.f, hi)};
+}
+
+namespace {
+
+/// The wavelength density's shape 1 / cosh²(a (λ - c)) and its integral tanh(a (λ - c)) / a.
+constexpr double WavelengthA = 0.0072, WavelengthCentre = 538.0;
+const double TanhLo = std::tanh(WavelengthA * (SpectralMinNm - WavelengthCentre));
+const double TanhHi = std::tanh(WavelengthA * (SpectralMaxNm - WavelengthCentre));
+
+float sample_wavelength(float u) {
+    const double t = TanhLo + (TanhHi - TanhLo) * double(u);
+    const double lambda = WavelengthCentre + std::atanh(t) / WavelengthA;
+    return float(std::min<double>(std::max<double>(lambda, SpectralMinNm), SpectralMaxNm));
+}
+
+} // namespace
+
+float pdf_wavelength(float lambda) {
+    if (!(lambda >= SpectralMinNm && lambda <= SpectralMaxNm)) return 0.f;
+    const double c = std::cosh(WavelengthA * (double(lambda) - WavelengthCentre));
+    return float(WavelengthA / ((TanhHi - TanhLo) * c * c));
+}
+
+std::pair<Wavelengths, Color3f> sample_wavelengths(float u) {
+    Wavelengths lambda;
+    Color3f weight;
+    for (int i = 0; i < 3; ++i) {
+        float ui = u + float(i) * (1.f / 3.f);
+        if (ui >= 1.f) ui -= 1.f;
+        lambda[i] = sample_wavelength(ui);
+        weight[i] = 1.f / pdf_wavelength(lambda[i]);
+    }
+    return {lambda, weight};
+}
+
+Color3f spectral_to_srgb(const Color3f &L, const Wavelengths &lambda, const Color3f &weight) {
+    Color3f xyz(0.f);
+    for (int i = 0; i < 3; ++i) xyz += cie1931_xyz(lambda[i]) * (L[i] * weight[i]);
+    return xyz_to_srgb(xyz * float(1.0 / (3.0 * CieYIntegral)));
 }
 
 } // namespace facet

@@ -1,7 +1,10 @@
 #include <facet/logger.h>
+#include <facet/spectral_upsampling.h>
 #include <facet/texture.h>
 
 #include <fmt/format.h>
+
+#include <algorithm>
 
 namespace facet {
 
@@ -11,6 +14,57 @@ Vector2f Texture::eval_1_grad(const SurfaceInteraction &) const {
 
 std::string ConstantTexture::to_string() const {
     return fmt::format("ConstantTexture[value=[{}, {}, {}]]", m_value.r, m_value.g, m_value.b);
+}
+
+namespace {
+
+class RGBSpectrumTexture final : public SpectralTexture {
+public:
+    RGBSpectrumTexture(const Color3f &rgb, SpectrumKind kind)
+        : SpectralTexture(rgb), m_spectrum(RGBSpectrum::from_rgb(rgb, kind)) {}
+    Color3f eval_wavelengths(const Wavelengths &lambda) const override {
+        return m_spectrum.eval(lambda);
+    }
+    float max() const override { return m_spectrum.illuminant ? m_rgb.max() : m_spectrum.scale; }
+    std::string to_string() const override {
+        return fmt::format("RGBSpectrumTexture[rgb=[{}, {}, {}], scale={}, illuminant={}]", m_rgb.r,
+                           m_rgb.g, m_rgb.b, m_spectrum.scale, m_spectrum.illuminant);
+    }
+
+private:
+    RGBSpectrum m_spectrum;
+};
+
+class DataSpectrumTexture final : public SpectralTexture {
+public:
+    DataSpectrumTexture(SpectrumData data, SpectrumKind kind)
+        : SpectralTexture(spectrum_to_rgb(data, kind)), m_data(std::move(data)) {
+        m_max = 0.f;
+        for (double v : m_data.values) m_max = std::max(m_max, float(v));
+    }
+    Color3f eval_wavelengths(const Wavelengths &lambda) const override {
+        return {float(m_data.eval(lambda.r)), float(m_data.eval(lambda.g)),
+                float(m_data.eval(lambda.b))};
+    }
+    float max() const override { return m_max; }
+    std::string to_string() const override {
+        return fmt::format("DataSpectrumTexture[{}]", m_data.to_string());
+    }
+
+private:
+    SpectrumData m_data;
+    float m_max;
+};
+
+} // namespace
+
+std::shared_ptr<Texture> rgb_spectrum_texture(const Color3f &rgb, SpectrumKind kind) {
+    return std::make_shared<RGBSpectrumTexture>(rgb, kind);
+}
+
+std::shared_ptr<Texture> data_spectrum_texture(const SpectrumData &data, SpectrumKind kind) {
+    if (data.uniform) return std::make_shared<ConstantTexture>(Color3f(float(data.value)));
+    return std::make_shared<DataSpectrumTexture>(data, kind);
 }
 
 } // namespace facet

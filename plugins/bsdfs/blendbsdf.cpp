@@ -221,5 +221,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::BlendBSDF, BSDF, "blendbsdf",
-                    "Linear blend of two BSDFs with a constant or textured weight", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::BlendBSDF, BSDF, "blendbsdf",
+                          "Linear blend of two BSDFs with a constant or textured weight", DOC,
+                          ::facet::AllModes)

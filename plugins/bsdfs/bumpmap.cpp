@@ -100,5 +100,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::BumpMap, BSDF, "bumpmap",
-                    "Bump map (height gradient) around a nested BSDF", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::BumpMap, BSDF, "bumpmap",
+                          "Bump map (height gradient) around a nested BSDF", DOC, ::facet::AllModes)

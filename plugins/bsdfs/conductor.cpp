@@ -90,5 +90,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Conductor, BSDF, "conductor",
-                    "Smooth conductor with measured or given complex IOR", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Conductor, BSDF, "conductor",
+                          "Smooth conductor with measured or given complex IOR", DOC,
+                          ::facet::AllModes)

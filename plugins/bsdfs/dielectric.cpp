@@ -130,5 +130,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Dielectric, BSDF, "dielectric",
-                    "Smooth dielectric interface with Fresnel reflection and refraction", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Dielectric, BSDF, "dielectric",
+                          "Smooth dielectric interface with Fresnel reflection and refraction", DOC,
+                          ::facet::AllModes)

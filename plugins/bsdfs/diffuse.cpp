@@ -91,4 +91,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Diffuse, BSDF, "diffuse", "Smooth diffuse (Lambertian) reflection", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Diffuse, BSDF, "diffuse", "Smooth diffuse (Lambertian) reflection",
+                          DOC, ::facet::AllModes)

@@ -162,5 +162,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Mask, BSDF, "mask",
-                    "Opacity mask: a nested BSDF blended with a straight pass-through", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Mask, BSDF, "mask",
+                          "Opacity mask: a nested BSDF blended with a straight pass-through", DOC,
+                          ::facet::AllModes)

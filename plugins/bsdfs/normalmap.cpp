@@ -65,5 +65,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::NormalMap, BSDF, "normalmap",
-                    "Normal map (tangent-space RGB normals) around a nested BSDF", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::NormalMap, BSDF, "normalmap",
+                          "Normal map (tangent-space RGB normals) around a nested BSDF", DOC,
+                          ::facet::AllModes)

@@ -59,5 +59,6 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::NullBSDF, BSDF, "null",
-                    "Invisible surface: light passes straight through", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::NullBSDF, BSDF, "null",
+                          "Invisible surface: light passes straight through", DOC,
+                          ::facet::AllModes)

@@ -182,5 +182,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Plastic, BSDF, "plastic",
-                    "Smooth plastic: a diffuse base under a smooth dielectric coating", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Plastic, BSDF, "plastic",
+                          "Smooth plastic: a diffuse base under a smooth dielectric coating", DOC,
+                          ::facet::AllModes)

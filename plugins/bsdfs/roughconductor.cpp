@@ -136,5 +136,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::RoughConductor, BSDF, "roughconductor",
-                    "Rough conductor with a Beckmann or GGX microfacet distribution", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::RoughConductor, BSDF, "roughconductor",
+                          "Rough conductor with a Beckmann or GGX microfacet distribution", DOC,
+                          ::facet::AllModes)

@@ -203,6 +203,7 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::RoughDielectric, BSDF, "roughdielectric",
-                    "Rough dielectric interface with a Beckmann or GGX microfacet distribution",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(
+    facet::RoughDielectric, BSDF, "roughdielectric",
+    "Rough dielectric interface with a Beckmann or GGX microfacet distribution", DOC,
+    ::facet::AllModes)

@@ -348,5 +348,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::RoughPlastic, BSDF, "roughplastic",
-                    "Rough plastic: a diffuse base under a rough dielectric coating", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::RoughPlastic, BSDF, "roughplastic",
+                          "Rough plastic: a diffuse base under a rough dielectric coating", DOC,
+                          ::facet::AllModes)

@@ -124,5 +124,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::ThinDielectric, BSDF, "thindielectric",
-                    "Thin dielectric sheet: Fresnel reflection and unbent transmission", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::ThinDielectric, BSDF, "thindielectric",
+                          "Thin dielectric sheet: Fresnel reflection and unbent transmission", DOC,
+                          ::facet::AllModes)

@@ -177,5 +177,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::TwoSided, BSDF, "twosided",
-                    "Two-sided adapter: the same or a second BSDF on the back side", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::TwoSided, BSDF, "twosided",
+                          "Two-sided adapter: the same or a second BSDF on the back side", DOC,
+                          ::facet::AllModes)

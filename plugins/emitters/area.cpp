@@ -68,7 +68,7 @@ public:
             ds.pdf = 0.f;
             return {ds, Color3f(0.f)};
         }
-        return {ds, radiance_at(ds) / ds.pdf};
+        return {ds, radiance_at(ds, ref.wavelengths) / ds.pdf};
     }
 
     float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
@@ -97,7 +97,7 @@ public:
         origin.t = 0.f;
         DirectionSample at;
         static_cast<PositionSample &>(at) = ps;
-        return {origin.spawn_ray(d), radiance_at(at) * (Pi / ps.pdf)};
+        return {origin.spawn_ray(d), radiance_at(at, Wavelengths()) * (Pi / ps.pdf)};
     }
 
     std::optional<Color3f> constant_radiance() const override {
@@ -154,11 +154,12 @@ private:
             ds.pdf = 0.f;
             return {ds, Color3f(0.f)};
         }
-        return {ds, radiance_at(ds) / ds.pdf};
+        return {ds, radiance_at(ds, ref.wavelengths) / ds.pdf};
     }
 
-    /// Radiance at a sampled point: textures are evaluated at the point's uv.
-    Color3f radiance_at(const DirectionSample &ds) const {
+    /// Radiance at a sampled point: textures are evaluated at the point's uv and at the path's
+    /// wavelengths `lambda` (spectral mode).
+    Color3f radiance_at(const DirectionSample &ds, const Wavelengths &lambda) const {
         if (!m_radiance->is_spatially_varying()) return m_radiance->mean();
         SurfaceInteraction si;
         si.p = ds.p;
@@ -168,6 +169,7 @@ private:
         si.wi = Vector3f(0.f, 0.f, 1.f);
         si.t = ds.dist;
         si.shape = m_shape;
+        si.wavelengths = lambda;
         return m_radiance->eval(si);
     }
 
@@ -177,4 +179,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::AreaLight, Emitter, "area", "Area light attached to a shape", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::AreaLight, Emitter, "area", "Area light attached to a shape", DOC,
+                          ::facet::AllModes)

@@ -63,7 +63,7 @@ public:
         ds.pdf = InvFourPi;
         ds.delta = false;
         ds.emitter = this;
-        return {ds, radiance_along(ds.d) * (4.f * Pi)};
+        return {ds, radiance_along(ds.d, ref.wavelengths) * (4.f * Pi)};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override {
@@ -78,7 +78,7 @@ public:
         const Frame frame(w);
         const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y - w) * m_radius;
         const float area = Pi * m_radius * m_radius;
-        return {Ray(o, w), radiance_along(-w) * (4.f * Pi * area)};
+        return {Ray(o, w), radiance_along(-w, Wavelengths()) * (4.f * Pi * area)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override { return m_radiance->eval(si); }
@@ -89,11 +89,13 @@ public:
     }
 
 private:
-    /// Radiance arriving from direction d (a miss record, as Scene passes to eval()).
-    Color3f radiance_along(const Vector3f &d) const {
+    /// Radiance arriving from direction d (a miss record, as Scene passes to eval()) at the
+    /// path's wavelengths `lambda` (spectral mode).
+    Color3f radiance_along(const Vector3f &d, const Wavelengths &lambda) const {
         if (!m_radiance->is_spatially_varying()) return m_radiance->mean();
         SurfaceInteraction si;
         si.wi = -d;
+        si.wavelengths = lambda;
         return m_radiance->eval(si);
     }
 
@@ -104,4 +106,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::ConstantLight, Emitter, "constant", "Constant environment light", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::ConstantLight, Emitter, "constant", "Constant environment light",
+                          DOC, ::facet::AllModes)

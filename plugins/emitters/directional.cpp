@@ -22,6 +22,7 @@ unit area on a surface perpendicular to the direction.
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/scene.h>
+#include <facet/texture.h>
 #include <facet/warp.h>
 
 namespace facet {
@@ -29,7 +30,11 @@ namespace facet {
 class DirectionalEmitter final : public Emitter {
 public:
     explicit DirectionalEmitter(const Properties &props) {
-        m_irradiance = props.get_color("irradiance", Color3f(1.f), SpectrumKind::Emission);
+        try {
+            m_irradiance = SpectralValue(props.texture("irradiance", 1.f, SpectrumKind::Emission));
+        } catch (const Error &e) {
+            throw Error(props.location("irradiance"), e.message());
+        }
         bool has_dir = props.has("direction"), has_xf = props.has("to_world");
         if (has_dir && has_xf)
             FACET_THROW_AT(props.location(),
@@ -58,7 +63,7 @@ public:
         const Frame frame(m_direction);
         const Point2f p = warp::square_to_uniform_disk_concentric(u_pos) * m_radius;
         const Point3f o = m_center - m_direction * m_radius + frame.s * p.x + frame.t * p.y;
-        return {Ray(o, m_direction), m_irradiance * (Pi * m_radius * m_radius)};
+        return {Ray(o, m_direction), m_irradiance.mean() * (Pi * m_radius * m_radius)};
     }
 
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
@@ -71,7 +76,7 @@ public:
         ds.pdf = 1.f;
         ds.delta = true;
         ds.emitter = this;
-        return {ds, m_irradiance};
+        return {ds, m_irradiance.at(ref.wavelengths)};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
@@ -79,12 +84,12 @@ public:
 
     std::string to_string() const override {
         return fmt::format("DirectionalEmitter[direction=[{}, {}, {}], irradiance=[{}, {}, {}]]",
-                           m_direction.x, m_direction.y, m_direction.z, m_irradiance.r,
-                           m_irradiance.g, m_irradiance.b);
+                           m_direction.x, m_direction.y, m_direction.z, m_irradiance.mean().r,
+                           m_irradiance.mean().g, m_irradiance.mean().b);
     }
 
 private:
-    Color3f m_irradiance;
+    SpectralValue m_irradiance;
     Vector3f m_direction;
     float m_radius = 1.f;
     Point3f m_center{0.f, 0.f, 0.f};
@@ -92,5 +97,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::DirectionalEmitter, Emitter, "directional",
-                    "Distant light from a single direction (sun-like)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::DirectionalEmitter, Emitter, "directional",
+                          "Distant light from a single direction (sun-like)", DOC,
+                          ::facet::AllModes)

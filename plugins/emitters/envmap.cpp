@@ -44,6 +44,7 @@ scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba
 #include <facet/plugin.h>
 #include <facet/resolver.h>
 #include <facet/scene.h>
+#include <facet/spectral_upsampling.h>
 #include <facet/texture_image.h>
 #include <facet/transform.h>
 #include <facet/warp.h>
@@ -121,6 +122,16 @@ public:
                 texel(x, y).radiance = c;
                 if (x == 0) texel(m_width, y).radiance = c; // column W is column 0 again
             }
+        if (props.mode() == ColourMode::Spectral) {
+            // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
+            // and the scale 2 max c, blended separately between pixels; eval() multiplies by
+            // D65, the spectrum of an RGB white light.
+            m_spectral.resize(m_texels.size());
+            for (size_t i = 0; i < m_texels.size(); ++i) {
+                const RGBSpectrum rs = RGBSpectrum::scaled(m_texels[i].radiance);
+                m_spectral[i] = {rs.poly, rs.scale};
+            }
+        }
         build_distribution();
         m_flags = EmitterFlags::Infinite | EmitterFlags::SpatiallyVarying;
     }
@@ -146,7 +157,7 @@ public:
         const GridPoint g = grid_point(local); // one atan2 and acos for both
         ds.pdf = pdf_local(local, g);
         if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
-        return {ds, lookup(g) / ds.pdf};
+        return {ds, radiance(g, ref.wavelengths) / ds.pdf};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
@@ -176,7 +187,7 @@ public:
     Color3f eval(const SurfaceInteraction &si) const override {
         // si is the record of a ray that left the scene: wi points back along it (local frame).
         Vector3f local = normalize(m_to_world.inverse().apply_vector(-si.to_world(si.wi)));
-        return lookup(grid_point(local));
+        return radiance(grid_point(local), si.wavelengths);
     }
 
     std::string to_string() const override {
@@ -244,6 +255,32 @@ private:
         if (!m_bilinear) return pixel(s < 0.5f ? i : i + 1, t < 0.5f ? j : j + 1);
         return (pixel(i, j) * (1.f - s) + pixel(i + 1, j) * s) * (1.f - t) +
                (pixel(i, j + 1) * (1.f - s) + pixel(i + 1, j + 1) * s) * t;
+    }
+
+    /// The radiance at a grid point: lookup() in rgb and mono; in the spectral mode at the
+    /// path's wavelengths `lambda`.
+    Color3f radiance(const GridPoint &g, const Wavelengths &lambda) const {
+        if (m_spectral.empty()) return lookup(g);
+        Color3f curve(0.f);
+        float scale = 0.f;
+        auto add = [&](int x, int y, float w) {
+            const SpectralTexel &t = m_spectral[size_t(y) * size_t(m_width + 1) + size_t(x)];
+            curve += Color3f(t.poly(lambda.r), t.poly(lambda.g), t.poly(lambda.b)) * w;
+            scale += t.scale * w;
+        };
+        const int i = g.i, j = g.j;
+        const float s = g.s, t = g.t;
+        if (!m_bilinear) {
+            add(s < 0.5f ? i : i + 1, t < 0.5f ? j : j + 1, 1.f);
+        } else {
+            add(i, j, (1.f - s) * (1.f - t));
+            add(i + 1, j, s * (1.f - t));
+            add(i, j + 1, (1.f - s) * t);
+            add(i + 1, j + 1, s * t);
+        }
+        const Color3f d65(float(cie_d65(lambda.r)), float(cie_d65(lambda.g)),
+                          float(cie_d65(lambda.b)));
+        return curve * d65 * scale;
     }
 
     // -- Importance sampling ------------------------------------------------------------------
@@ -356,6 +393,12 @@ private:
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
     std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels and the sampling table
+    /// The spectral mode's pixels (empty in rgb and mono), laid out as m_texels.
+    struct SpectralTexel {
+        SigmoidPolynomial poly;
+        float scale = 0.f;
+    };
+    std::vector<SpectralTexel> m_spectral;
     DiscreteDistribution m_cells;
     double m_total = 0.0;
     float m_density_scale = 0.f;
@@ -365,5 +408,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::EnvironmentMap, Emitter, "envmap",
-                    "Latitude-longitude environment map with luminance importance sampling", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::EnvironmentMap, Emitter, "envmap",
+                          "Latitude-longitude environment map with luminance importance sampling",
+                          DOC, ::facet::AllModes)

@@ -21,6 +21,7 @@ angle θ with the direction to the light is `intensity`·cos θ/d². It cannot b
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
+#include <facet/texture.h>
 #include <facet/warp.h>
 
 #include <fmt/format.h>
@@ -37,7 +38,11 @@ public:
             m_position = props.get_vector("position");
         else
             m_position = props.get_transform("to_world", Transform()).apply_point(Point3f(0.f));
-        m_intensity = props.get_color("intensity", Color3f(1.f), SpectrumKind::Emission);
+        try {
+            m_intensity = SpectralValue(props.texture("intensity", 1.f, SpectrumKind::Emission));
+        } catch (const Error &e) {
+            throw Error(props.location("intensity"), e.message());
+        }
         if (!is_finite(m_position))
             FACET_THROW_AT(props.location(), "point emitter: the position must be finite");
         m_flags = EmitterFlags::DeltaPosition;
@@ -60,7 +65,7 @@ public:
             return {ds, Color3f(0.f)};
         }
         ds.d = d / ds.dist;
-        return {ds, m_intensity / dist2};
+        return {ds, m_intensity.at(ref.wavelengths) / dist2};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
@@ -70,7 +75,7 @@ public:
     /// direction density, 4π·intensity.
     std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
         Vector3f d = warp::square_to_uniform_sphere(u_dir);
-        return {Ray(m_position, d), m_intensity * (4.f * Pi)};
+        return {Ray(m_position, d), m_intensity.mean() * (4.f * Pi)};
     }
 
     float pdf_ray_direction(const Vector3f &d) const override {
@@ -79,15 +84,16 @@ public:
 
     std::string to_string() const override {
         return fmt::format("PointLight[position = ({}, {}, {}), intensity = ({}, {}, {})]",
-                           m_position.x, m_position.y, m_position.z, m_intensity.r, m_intensity.g,
-                           m_intensity.b);
+                           m_position.x, m_position.y, m_position.z, m_intensity.mean().r,
+                           m_intensity.mean().g, m_intensity.mean().b);
     }
 
 private:
     Point3f m_position;
-    Color3f m_intensity;
+    SpectralValue m_intensity;
 };
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::PointLight, Emitter, "point", "Isotropic point light", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::PointLight, Emitter, "point", "Isotropic point light", DOC,
+                          ::facet::AllModes)

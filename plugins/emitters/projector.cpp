@@ -98,7 +98,7 @@ public:
         // along the axis z = dist·cos θ this is π·E / (z²·cos θ).
         const float z = dot(-to_light, m_axis);
         const float cos_theta = z / ds.dist;
-        return {ds, eval_irradiance(uv) * (Pi * m_scale / (z * z * cos_theta))};
+        return {ds, eval_irradiance(uv, ref.wavelengths) * (Pi * m_scale / (z * z * cos_theta))};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
@@ -108,7 +108,7 @@ public:
     std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
         const Vector3f local((1.f - 2.f * u_dir.x) * m_tan_x, (1.f - 2.f * u_dir.y) * m_tan_y, 1.f);
         Ray ray(m_position, normalize(m_to_world.apply_vector(local)));
-        return {ray, eval_irradiance(u_dir) * (Pi * m_scale * m_plane_area)};
+        return {ray, eval_irradiance(u_dir, ray.wavelengths) * (Pi * m_scale * m_plane_area)};
     }
 
     /// Density per solid angle of sample_ray(): 1/area on the plane z = 1, i.e. 1/(area·cos³θ).
@@ -139,9 +139,11 @@ private:
         return uv.x >= 0.f && uv.x <= 1.f && uv.y >= 0.f && uv.y <= 1.f;
     }
 
-    Color3f eval_irradiance(const Point2f &uv) const {
+    /// The irradiance texture at `uv` and the path's wavelengths `lambda` (spectral mode).
+    Color3f eval_irradiance(const Point2f &uv, const Wavelengths &lambda) const {
         if (!m_irradiance->is_spatially_varying()) return m_irradiance->mean();
         SurfaceInteraction si;
+        si.wavelengths = lambda;
         si.uv = uv;
         si.p = m_position;
         return m_irradiance->eval(si);
@@ -157,5 +159,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Projector, Emitter, "projector",
-                    "Projection light: a texture projected through a pinhole", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Projector, Emitter, "projector",
+                          "Projection light: a texture projected through a pinhole", DOC,
+                          ::facet::AllModes)

@@ -36,7 +36,11 @@ namespace facet {
 class SpotEmitter final : public Emitter {
 public:
     explicit SpotEmitter(const Properties &props) {
-        m_intensity = props.get_color("intensity", Color3f(1.f), SpectrumKind::Emission);
+        try {
+            m_intensity = SpectralValue(props.texture("intensity", 1.f, SpectrumKind::Emission));
+        } catch (const Error &e) {
+            throw Error(props.location("intensity"), e.message());
+        }
         m_texture =
             props.has("texture") ? props.texture("texture", SpectrumKind::Emission) : nullptr;
         m_to_world = props.get_transform("to_world", Transform());
@@ -59,16 +63,18 @@ public:
             m_flags = m_flags | EmitterFlags::SpatiallyVarying;
     }
 
-    /// Intensity towards the local direction d (unit vector).
-    Color3f intensity(const Vector3f &d) const {
+    /// Intensity towards the local direction d (unit vector) at the path's wavelengths `lambda`
+    /// (spectral mode).
+    Color3f intensity(const Vector3f &d, const Wavelengths &lambda) const {
         float cos_theta = d.z;
         if (cos_theta <= m_cos_cutoff) return Color3f(0.f);
         float falloff = 1.f;
         if (cos_theta < m_cos_beam && m_cutoff > m_beam)
             falloff = (m_cutoff - safe_acos(cos_theta)) / (m_cutoff - m_beam);
-        Color3f result = m_intensity * falloff;
+        Color3f result = m_intensity.at(lambda) * falloff;
         if (m_texture) {
             SurfaceInteraction si;
+            si.wavelengths = lambda;
             si.uv = Point2f(0.5f + 0.5f * d.x / (d.z * m_uv_factor),
                             0.5f + 0.5f * d.y / (d.z * m_uv_factor));
             result *= m_texture->eval(si);
@@ -89,7 +95,7 @@ public:
         ds.delta = true;
         ds.emitter = this;
         Vector3f local = normalize(m_to_world.inverse().apply_vector(-ds.d));
-        return {ds, intensity(local) / dist2};
+        return {ds, intensity(local, ref.wavelengths) / dist2};
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
@@ -99,7 +105,7 @@ public:
         Vector3f local = warp::square_to_uniform_cone(u_dir, m_cos_cutoff);
         float pdf = warp::square_to_uniform_cone_pdf(local, m_cos_cutoff);
         Ray ray(m_position, normalize(m_to_world.apply_vector(local)));
-        return {ray, intensity(local) / pdf};
+        return {ray, intensity(local, ray.wavelengths) / pdf};
     }
 
     float pdf_ray_direction(const Vector3f &d) const override {
@@ -114,7 +120,7 @@ public:
     }
 
 private:
-    Color3f m_intensity;
+    SpectralValue m_intensity;
     std::shared_ptr<Texture> m_texture;
     Transform m_to_world;
     Point3f m_position;
@@ -123,5 +129,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::SpotEmitter, Emitter, "spot", "Spot light with a linear angular falloff",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::SpotEmitter, Emitter, "spot",
+                          "Spot light with a linear angular falloff", DOC, ::facet::AllModes)

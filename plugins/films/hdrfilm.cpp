@@ -166,5 +166,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::HDRFilm, Film, "hdrfilm",
-                    "High dynamic range film (OpenEXR and friends)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::HDRFilm, Film, "hdrfilm",
+                          "High dynamic range film (OpenEXR and friends)", DOC, ::facet::AllModes)

@@ -154,5 +154,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::DirectIntegrator, Integrator, "direct",
-                    "Direct illumination with emitter and BSDF sampling combined by MIS", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::DirectIntegrator, Integrator, "direct",
+                          "Direct illumination with emitter and BSDF sampling combined by MIS", DOC,
+                          ::facet::AllModes)

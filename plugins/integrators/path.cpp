@@ -168,5 +168,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::PathIntegrator, Integrator, "path",
-                    "Path tracer with next event estimation and multiple importance sampling", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::PathIntegrator, Integrator, "path",
+                          "Path tracer with next event estimation and multiple importance sampling",
+                          DOC, ::facet::AllModes)

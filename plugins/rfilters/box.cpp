@@ -33,4 +33,5 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::BoxFilter, ReconstructionFilter, "box", "Box pixel filter", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::BoxFilter, ReconstructionFilter, "box", "Box pixel filter", DOC,
+                          ::facet::AllModes)

@@ -46,5 +46,5 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::CatmullRomFilter, ReconstructionFilter, "catmullrom",
-                    "Catmull-Rom cubic pixel filter", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::CatmullRomFilter, ReconstructionFilter, "catmullrom",
+                          "Catmull-Rom cubic pixel filter", DOC, ::facet::AllModes)

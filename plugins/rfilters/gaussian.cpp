@@ -52,5 +52,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::GaussianFilter, ReconstructionFilter, "gaussian",
-                    "Windowed Gaussian pixel filter", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::GaussianFilter, ReconstructionFilter, "gaussian",
+                          "Windowed Gaussian pixel filter", DOC, ::facet::AllModes)

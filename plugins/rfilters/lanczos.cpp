@@ -58,5 +58,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::LanczosFilter, ReconstructionFilter, "lanczos",
-                    "Lanczos windowed-sinc pixel filter", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::LanczosFilter, ReconstructionFilter, "lanczos",
+                          "Lanczos windowed-sinc pixel filter", DOC, ::facet::AllModes)

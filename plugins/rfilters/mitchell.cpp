@@ -73,5 +73,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::MitchellFilter, ReconstructionFilter, "mitchell",
-                    "Mitchell-Netravali cubic pixel filter", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::MitchellFilter, ReconstructionFilter, "mitchell",
+                          "Mitchell-Netravali cubic pixel filter", DOC, ::facet::AllModes)

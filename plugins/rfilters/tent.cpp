@@ -46,5 +46,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::TentFilter, ReconstructionFilter, "tent", "Tent (triangle) pixel filter",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::TentFilter, ReconstructionFilter, "tent",
+                          "Tent (triangle) pixel filter", DOC, ::facet::AllModes)

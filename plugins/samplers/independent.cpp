@@ -83,5 +83,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Independent, Sampler, "independent",
-                    "Independent uniform random samples (PCG32)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Independent, Sampler, "independent",
+                          "Independent uniform random samples (PCG32)", DOC, ::facet::AllModes)

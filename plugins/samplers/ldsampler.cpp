@@ -91,5 +91,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::LowDiscrepancySampler, Sampler, "ldsampler",
-                    "Scrambled (0,2)-sequence low-discrepancy sampler", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::LowDiscrepancySampler, Sampler, "ldsampler",
+                          "Scrambled (0,2)-sequence low-discrepancy sampler", DOC,
+                          ::facet::AllModes)

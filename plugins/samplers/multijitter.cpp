@@ -99,5 +99,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::MultijitterSampler, Sampler, "multijitter",
-                    "Multi-jittered sampler (2D and 1D-projection stratification)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::MultijitterSampler, Sampler, "multijitter",
+                          "Multi-jittered sampler (2D and 1D-projection stratification)", DOC,
+                          ::facet::AllModes)

@@ -177,5 +177,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::OrthogonalSampler, Sampler, "orthogonal",
-                    "Orthogonal array sampler (Bose/Bush constructions, Jarosz et al. 2019)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::OrthogonalSampler, Sampler, "orthogonal",
+                          "Orthogonal array sampler (Bose/Bush constructions, Jarosz et al. 2019)",
+                          DOC, ::facet::AllModes)

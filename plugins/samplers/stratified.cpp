@@ -105,5 +105,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::StratifiedSampler, Sampler, "stratified",
-                    "Jittered stratified sampler with per-pixel random stratum order", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::StratifiedSampler, Sampler, "stratified",
+                          "Jittered stratified sampler with per-pixel random stratum order", DOC,
+                          ::facet::AllModes)

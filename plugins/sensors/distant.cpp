@@ -150,5 +150,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::DistantSensor, Sensor, "distant",
-                    "Distant radiance meter: radiance leaving the scene in one direction", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::DistantSensor, Sensor, "distant",
+                          "Distant radiance meter: radiance leaving the scene in one direction",
+                          DOC, ::facet::AllModes)

@@ -91,5 +91,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::IrradianceMeter, Sensor, "irradiancemeter",
-                    "Irradiance meter on the surface of its shape", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::IrradianceMeter, Sensor, "irradiancemeter",
+                          "Irradiance meter on the surface of its shape", DOC, ::facet::AllModes)

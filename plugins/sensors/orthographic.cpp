@@ -102,5 +102,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::OrthographicCamera, Sensor, "orthographic",
-                    "Orthographic (parallel) camera", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::OrthographicCamera, Sensor, "orthographic",
+                          "Orthographic (parallel) camera", DOC, ::facet::AllModes)

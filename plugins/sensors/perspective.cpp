@@ -152,5 +152,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::PerspectiveCamera, Sensor, "perspective", "Pinhole perspective camera",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::PerspectiveCamera, Sensor, "perspective",
+                          "Pinhole perspective camera", DOC, ::facet::AllModes)

@@ -101,5 +101,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::RadianceMeter, Sensor, "radiancemeter",
-                    "Radiance meter: the radiance along one ray", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::RadianceMeter, Sensor, "radiancemeter",
+                          "Radiance meter: the radiance along one ray", DOC, ::facet::AllModes)

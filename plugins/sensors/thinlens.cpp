@@ -168,5 +168,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::ThinLensCamera, Sensor, "thinlens",
-                    "Perspective camera with a thin lens (depth of field)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::ThinLensCamera, Sensor, "thinlens",
+                          "Perspective camera with a thin lens (depth of field)", DOC,
+                          ::facet::AllModes)

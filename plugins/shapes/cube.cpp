@@ -55,4 +55,5 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Cube, Shape, "cube", "Cube [-1, 1]³ as 12 triangles", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Cube, Shape, "cube", "Cube [-1, 1]³ as 12 triangles", DOC,
+                          ::facet::AllModes)

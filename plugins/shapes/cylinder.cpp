@@ -237,5 +237,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Cylinder, Shape, "cylinder",
-                    "Exact open cylinder (analytic intersection)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Cylinder, Shape, "cylinder",
+                          "Exact open cylinder (analytic intersection)", DOC, ::facet::AllModes)

@@ -155,4 +155,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Disk, Shape, "disk", "Exact disk (analytic intersection)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Disk, Shape, "disk", "Exact disk (analytic intersection)", DOC,
+                          ::facet::AllModes)

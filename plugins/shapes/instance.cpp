@@ -109,5 +109,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Instance, Shape, "instance",
-                    "Placed copy of a shapegroup (Embree instance)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Instance, Shape, "instance",
+                          "Placed copy of a shapegroup (Embree instance)", DOC, ::facet::AllModes)

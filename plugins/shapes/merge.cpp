@@ -150,5 +150,6 @@ public:
 } // namespace facet
 
 using facet::Merge;
-FACET_EXPORT_PLUGIN(Merge, Shape, "merge",
-                    "Merges nested meshes that share a BSDF into one mesh per group", DOC)
+FACET_EXPORT_PLUGIN_MODES(Merge, Shape, "merge",
+                          "Merges nested meshes that share a BSDF into one mesh per group", DOC,
+                          ::facet::AllModes)

@@ -228,4 +228,5 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Obj, Shape, "obj", "Triangle mesh from a Wavefront OBJ file", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Obj, Shape, "obj", "Triangle mesh from a Wavefront OBJ file", DOC,
+                          ::facet::AllModes)

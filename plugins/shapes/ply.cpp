@@ -844,4 +844,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Ply, Shape, "ply", "Triangle mesh from a PLY file", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Ply, Shape, "ply", "Triangle mesh from a PLY file", DOC,
+                          ::facet::AllModes)

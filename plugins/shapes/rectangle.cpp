@@ -59,4 +59,5 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Rectangle, Shape, "rectangle", "Square [-1, 1]² in the z = 0 plane", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Rectangle, Shape, "rectangle",
+                          "Square [-1, 1]² in the z = 0 plane", DOC, ::facet::AllModes)

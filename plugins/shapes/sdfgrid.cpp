@@ -647,6 +647,7 @@ private:
 } // namespace facet
 
 using facet::SDFGrid;
-FACET_EXPORT_PLUGIN(SDFGrid, Shape, "sdfgrid",
-                    "Signed distance grid (.vol), intersected exactly by its trilinear interpolant",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(
+    SDFGrid, Shape, "sdfgrid",
+    "Signed distance grid (.vol), intersected exactly by its trilinear interpolant", DOC,
+    ::facet::AllModes)

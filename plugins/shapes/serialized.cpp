@@ -261,5 +261,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::SerializedMesh, Shape, "serialized",
-                    "Triangle mesh from Mitsuba's compressed .serialized format", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::SerializedMesh, Shape, "serialized",
+                          "Triangle mesh from Mitsuba's compressed .serialized format", DOC,
+                          ::facet::AllModes)

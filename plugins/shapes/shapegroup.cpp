@@ -26,5 +26,5 @@ supported.
 
 // The class lives in libfacet (facet/shapegroup.h) so that `instance` can use it.
 
-FACET_EXPORT_PLUGIN(facet::ShapeGroup, Shape, "shapegroup", "Group of shapes placed by instances",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::ShapeGroup, Shape, "shapegroup",
+                          "Group of shapes placed by instances", DOC, ::facet::AllModes)

@@ -280,4 +280,5 @@ private:
 } // namespace facet
 
 using facet::Sphere;
-FACET_EXPORT_PLUGIN(Sphere, Shape, "sphere", "Exact sphere (analytic intersection)", DOC)
+FACET_EXPORT_PLUGIN_MODES(Sphere, Shape, "sphere", "Exact sphere (analytic intersection)", DOC,
+                          ::facet::AllModes)

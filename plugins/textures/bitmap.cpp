@@ -42,6 +42,7 @@ luminance too, unless `raw` is set (a normal map keeps its three channels).
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/resolver.h>
+#include <facet/spectral_upsampling.h>
 #include <facet/texture.h>
 #include <facet/texture_image.h>
 #include <facet/transform.h>
@@ -132,11 +133,22 @@ public:
         m_luminance = props.mode() == ColourMode::Mono && !m_raw && m_channels == 3;
         m_mean = m_luminance ? in_mode(t.mean, ColourMode::Mono) : t.mean;
         m_max = t.max; // in mono a bound: no luminance exceeds the largest channel
+        // The spectral mode upsamples each pixel of a colour image once, as a reflectance
+        // (clamped to [0, 1], as Mitsuba's spectral bitmaps are); lookups blend the pixels'
+        // spectra. Raw and grey images keep their values.
+        if (props.mode() == ColourMode::Spectral && !m_raw && m_channels == 3) {
+            m_curves.resize(size_t(m_width) * size_t(m_height));
+            for (int y = 0; y < m_height; ++y)
+                for (int x = 0; x < m_width; ++x)
+                    m_curves[size_t(y) * size_t(m_width) + size_t(x)] =
+                        rgb_to_sigmoid(m_bytes ? pixel<3, true>(x, y) : pixel<3, false>(x, y));
+        }
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
         if (m_luminance) return Color3f(eval_1(si));
         Point2f uv = to_uv(si.uv);
+        if (!m_curves.empty()) return lookup_spectral(uv, si.wavelengths);
         if (m_bytes) return m_channels == 1 ? Color3f(lookup<1, true>(uv).r) : lookup<3, true>(uv);
         return m_channels == 1 ? Color3f(lookup<1, false>(uv).r) : lookup<3, false>(uv);
     }
@@ -295,6 +307,28 @@ private:
                (pixel<C, Bytes>(xa, yb) * (1.f - fx) + pixel<C, Bytes>(xb, yb) * fx) * fy;
     }
 
+    /// The spectral mode's lookup: the pixels' spectra at `lambda`, blended as lookup() blends
+    /// their colours.
+    Color3f lookup_spectral(const Point2f &uv, const Wavelengths &lambda) const {
+        auto curve = [&](int px, int py) {
+            const SigmoidPolynomial &c = m_curves[size_t(py) * size_t(m_width) + size_t(px)];
+            return Color3f(c(lambda.r), c(lambda.g), c(lambda.b));
+        };
+        float x = uv.x * float(m_width), y = uv.y * float(m_height);
+        if (m_filter == FilterType::Nearest)
+            return curve(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
+        x -= 0.5f;
+        y -= 0.5f;
+        int x0 = floor_to_int(x), y0 = floor_to_int(y);
+        float fx = clamp(x - float(x0), 0.f, 1.f), fy = clamp(y - float(y0), 0.f, 1.f);
+        if (!std::isfinite(fx)) fx = 0.f;
+        if (!std::isfinite(fy)) fy = 0.f;
+        int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
+        int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
+        return (curve(xa, ya) * (1.f - fx) + curve(xb, ya) * fx) * (1.f - fy) +
+               (curve(xa, yb) * (1.f - fx) + curve(xb, yb) * fx) * fy;
+    }
+
     /// Gradient of the scalar (grey or luminance) bilinear lookup with respect to the transformed
     /// uv: the four pixels of lookup(), differentiated in x and y, times the resolution.
     template <int C, bool Bytes> Vector2f lookup_grad(const Point2f &uv) const {
@@ -327,6 +361,8 @@ private:
     const float *m_floats = nullptr;            ///< m_texels' floats, or
     const uint8_t *m_bytes = nullptr;           ///< its bytes, looked up in
     const float *m_table = nullptr;             ///< its table
+    /// The spectral mode's pixel spectra (a colour image that is not raw; else empty).
+    std::vector<SigmoidPolynomial> m_curves;
     Color3f m_mean;
     float m_max = 0.f;
     /// The texel table of sample_position(), built by prepare_position_sampling() for emitters.
@@ -336,4 +372,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Bitmap, Texture, "bitmap", "Image texture read with OpenImageIO", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Bitmap, Texture, "bitmap", "Image texture read with OpenImageIO",
+                          DOC, ::facet::AllModes)

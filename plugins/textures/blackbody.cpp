@@ -49,7 +49,7 @@ public:
                            "blackbody: lambda_min ({}) must be below lambda_max ({})", lo, hi);
         // Tabulated finely enough (at most 0.25 nm apart) that the linear interpolation of the
         // CIE integration cannot be told from the exact curve.
-        SpectrumData data;
+        SpectrumData &data = m_data;
         data.uniform = false;
         int n = std::max(2, int(std::ceil((hi - lo) / 0.25)) + 1);
         for (int i = 0; i < n; ++i) {
@@ -69,6 +69,11 @@ public:
     }
 
     Color3f value(SpectrumKind) const override { return m_rgb; }
+    /// Planck's law per wavelength (tabulated every 0.25 nm, linear between), 0 outside
+    /// [lambda_min, lambda_max].
+    std::shared_ptr<Texture> spectral(SpectrumKind) const override {
+        return data_spectrum_texture(m_data, SpectrumKind::Emission);
+    }
     std::string to_string() const override {
         return fmt::format("BlackBodySpectrum[temperature = {}, rgb = [{}, {}, {}]]", m_temperature,
                            m_rgb.r, m_rgb.g, m_rgb.b);
@@ -76,10 +81,12 @@ public:
 
 private:
     double m_temperature = 0.0;
+    SpectrumData m_data;
     Color3f m_rgb;
 };
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::BlackBodySpectrum, Texture, "blackbody",
-                    "Black body spectrum (Planck's law), converted to RGB at load time", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::BlackBodySpectrum, Texture, "blackbody",
+                          "Black body spectrum (Planck's law), converted to RGB at load time", DOC,
+                          ::facet::AllModes)

@@ -84,5 +84,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Checkerboard, Texture, "checkerboard",
-                    "Procedural two-colour checkerboard in texture space", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Checkerboard, Texture, "checkerboard",
+                          "Procedural two-colour checkerboard in texture space", DOC,
+                          ::facet::AllModes)

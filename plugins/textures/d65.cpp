@@ -39,6 +39,11 @@ public:
         m_value = color * scale;
     }
     Color3f value(SpectrumKind) const override { return m_value; }
+    /// D65 itself times the upsampled colour (an emitter's rgb as the spectral mode reads it),
+    /// whatever the parameter's kind.
+    std::shared_ptr<Texture> spectral(SpectrumKind) const override {
+        return rgb_spectrum_texture(m_value, SpectrumKind::Emission);
+    }
     std::string to_string() const override {
         return fmt::format("D65Spectrum[value = [{}, {}, {}]]", m_value.r, m_value.g, m_value.b);
     }
@@ -49,5 +54,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::D65Spectrum, Texture, "d65", "CIE D65 illuminant (RGB: a plain value)",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::D65Spectrum, Texture, "d65",
+                          "CIE D65 illuminant (RGB: a plain value)", DOC, ::facet::AllModes)

@@ -55,6 +55,9 @@ public:
         m_data.uniform = false;
     }
     Color3f value(SpectrumKind kind) const override { return spectrum_to_rgb(m_data, kind); }
+    std::shared_ptr<Texture> spectral(SpectrumKind kind) const override {
+        return data_spectrum_texture(m_data, kind);
+    }
     std::string to_string() const override {
         return fmt::format("IrregularSpectrum[{}]", m_data.to_string());
     }
@@ -65,5 +68,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::IrregularSpectrum, Texture, "irregular",
-                    "Spectrum sampled at given wavelengths", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::IrregularSpectrum, Texture, "irregular",
+                          "Spectrum sampled at given wavelengths", DOC, ::facet::AllModes)

@@ -33,6 +33,7 @@ listing the attributes it has (shapes other than PLY and serialized meshes have 
 #include <facet/mesh.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
+#include <facet/spectral_upsampling.h>
 #include <facet/texture.h>
 
 #include <fmt/format.h>
@@ -67,6 +68,12 @@ public:
         mesh->eval_attribute(*a, si, v);
         if (a->channels == 1) return Color3f(v[0] * m_scale);
         if (a->channels != 3) throw_channels(*mesh, *a, "a colour query needs 1 or 3");
+        if (m_mode == ColourMode::Spectral) {
+            // The interpolated colour's spectrum (as a reflectance: clamped to [0, 1]).
+            const SigmoidPolynomial c = rgb_to_sigmoid(Color3f(v[0], v[1], v[2]));
+            const Wavelengths &l = si.wavelengths;
+            return Color3f(c(l.r), c(l.g), c(l.b)) * m_scale;
+        }
         return in_mode(Color3f(v[0], v[1], v[2]) * m_scale, m_mode);
     }
 
@@ -112,5 +119,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::MeshAttribute, Texture, "mesh_attribute",
-                    "Named vertex or face attribute of the mesh being shaded", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::MeshAttribute, Texture, "mesh_attribute",
+                          "Named vertex or face attribute of the mesh being shaded", DOC,
+                          ::facet::AllModes)

@@ -64,5 +64,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::RawConstant, Texture, "rawconstant",
-                    "Constant used as stored (no colour conversion)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::RawConstant, Texture, "rawconstant",
+                          "Constant used as stored (no colour conversion)", DOC, ::facet::AllModes)

@@ -55,4 +55,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::SRGBSpectrum, Texture, "srgb", "Constant linear sRGB colour", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::SRGBSpectrum, Texture, "srgb", "Constant linear sRGB colour", DOC,
+                          ::facet::AllModes)

@@ -47,6 +47,9 @@ public:
                            hi);
     }
     Color3f value(SpectrumKind) const override { return Color3f(m_value); }
+    std::shared_ptr<Texture> spectral(SpectrumKind) const override {
+        return std::make_shared<ConstantTexture>(Color3f(m_value));
+    }
     std::string to_string() const override {
         return fmt::format("UniformSpectrum[value = {}]", m_value);
     }
@@ -57,4 +60,5 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::UniformSpectrum, Texture, "uniform", "Constant spectrum", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::UniformSpectrum, Texture, "uniform", "Constant spectrum", DOC,
+                          ::facet::AllModes)

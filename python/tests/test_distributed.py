@@ -55,8 +55,8 @@ def test_a_mono_render_is_bit_identical_to_one_process(client, cornell):
     assert image.metadata["facet:mode"] == "scalar_mono"
     assert np.array_equal(image.pixels, single.pixels)
     assert np.array_equal(image.pixels[..., 0], image.pixels[..., 1])
-    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono"):
-        facet.distributed.render(cornell, client, params=PARAMS, mode="scalar_spectral")
+    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono, scalar_spectral"):
+        facet.distributed.render(cornell, client, params=PARAMS, mode="scalar_spectral_polarized")
 
 
 def test_passes_are_bit_identical_to_one_process(client, cornell):

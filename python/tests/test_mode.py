@@ -17,7 +17,7 @@ def scene(cornell):
 
 
 def test_modes_lists_the_default_first():
-    assert facet.modes() == ["scalar_rgb", "scalar_mono"]
+    assert facet.modes() == ["scalar_rgb", "scalar_mono", "scalar_spectral"]
 
 
 def test_scalar_rgb_is_the_default(scene):
@@ -43,7 +43,8 @@ def test_vectorised_name_renders_as_scalar_rgb_with_one_note(scene, capfd):
     assert image.metadata["facet:mode"] == "scalar_rgb"
 
 
-@pytest.mark.parametrize("mode", ["scalar_spectral", "cuda_mono_polarized", "foo", "scalar_rbg"])
+@pytest.mark.parametrize("mode", ["scalar_spectral_polarized", "cuda_mono_polarized", "foo",
+                                  "scalar_rbg"])
 def test_errors_are_those_of_the_cli(scene, cornell, facet_cli, cli_env, mode):
     with pytest.raises(facet.Error) as raised:
         facet.render(scene, progress=False, mode=mode)
@@ -116,8 +117,8 @@ def test_every_loader_takes_the_mode(cornell):
     assert facet.load_dict(d, mode="scalar_mono").mode == "scalar_mono"
     assert facet.load_dict(d).mode == "scalar_rgb"
     assert facet.scene_info(cornell, mode="llvm_mono")["mode"] == "scalar_mono"
-    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono"):
-        facet.load_file(cornell, mode="scalar_spectral")
+    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono, scalar_spectral"):
+        facet.load_file(cornell, mode="scalar_spectral_polarized")
     with pytest.raises(TypeError, match="mode=1"):
         facet.load_file(cornell, mode=1)
 
@@ -130,7 +131,7 @@ def test_chi2_builds_the_plugin_in_a_colour_mode():
     # The lobe weights come from the colour: the luminance of (0.9, 0.1, 0.1) is not its mean,
     # so the two draw different histograms from the same samples.
     assert not np.array_equal(rgb.observed, mono.observed)
-    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono"):
-        facet.chi2("bsdf", "diffuse", colour_mode="scalar_spectral")
+    with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono, scalar_spectral"):
+        facet.chi2("bsdf", "diffuse", colour_mode="scalar_spectral_polarized")
     with pytest.raises(TypeError, match="mode=2"):
         facet.chi2("emitter", "point", colour_mode=2)

@@ -273,6 +273,13 @@ TEST_F(CliTest, PluginsListsEveryKind) {
     ASSERT_EQ(bsdfs.code, 0) << bsdfs.err;
     EXPECT_NE(bsdfs.out.find("diffuse"), std::string::npos);
     EXPECT_EQ(bsdfs.out.find("perspective"), std::string::npos) << bsdfs.out;
+    // A plugin that does not render in every mode says which it renders in.
+    EXPECT_TRUE(std::regex_search(
+        bsdfs.out, std::regex(R"(\n\s+principled\s[^\n]*\(only scalar_rgb, scalar_mono\)\n)")))
+        << bsdfs.out;
+    EXPECT_TRUE(std::regex_search(
+        bsdfs.out, std::regex(R"(\n\s+diffuse\s+Smooth diffuse \(Lambertian\) reflection\n)")))
+        << bsdfs.out;
 }
 
 TEST_F(CliTest, PluginsPrintsOnePluginsTable) {
@@ -281,6 +288,8 @@ TEST_F(CliTest, PluginsPrintsOnePluginsTable) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*Parameter\s*\|\s*Type\s*\|)")))
         << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*reflectance\s*\|)"))) << r.out;
+    EXPECT_NE(r.out.find("\nmodes: scalar_rgb, scalar_mono, scalar_spectral\n"), std::string::npos)
+        << r.out;
 
     std::string line = expect_one_line_error("plugins difuse");
     EXPECT_NE(line.find("diffuse"), std::string::npos) << line; // the suggestion
@@ -430,9 +439,9 @@ TEST_F(CliTest, ModeLlvmRgbRendersAsScalarRgbWithOneNote) {
 
 TEST_F(CliTest, ModeFacetDoesNotRenderIsRefusedBeforeTheSceneLoads) {
     // The scene file does not exist: the mode is refused first.
-    std::string line = expect_one_line_error("render missing.xml -m scalar_spectral");
-    EXPECT_EQ(line, "facet: error: facet does not render the mode \"scalar_spectral\"; the "
-                    "modes it renders: scalar_rgb, scalar_mono");
+    std::string line = expect_one_line_error("render missing.xml -m scalar_rgb_polarized");
+    EXPECT_EQ(line, "facet: error: facet does not render the mode \"scalar_rgb_polarized\"; the "
+                    "modes it renders: scalar_rgb, scalar_mono, scalar_spectral");
     line = expect_one_line_error("render scene.xml more.xml --mode llvm_ad_spectral_polarized");
     EXPECT_NE(line.find("(nor scalar_spectral_polarized, its scalar form)"), std::string::npos)
         << line;
@@ -443,7 +452,8 @@ TEST_F(CliTest, UnknownModeListsTheModes) {
     std::string line = expect_one_line_error("render scene.xml -m foo");
     EXPECT_EQ(
         line,
-        "facet: error: unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono");
+        "facet: error: unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono, "
+        "scalar_spectral");
     line = expect_one_line_error("render scene.xml -m scalar_rbg");
     EXPECT_NE(line.find("did you mean \"scalar_rgb\"?"), std::string::npos) << line;
     EXPECT_EQ(files(), std::set<std::string>{"scene.xml"});
@@ -467,8 +477,12 @@ TEST_F(CliTest, InfoPrintsTheResolvedMode) {
     r = run("info scene.xml -m cuda_mono");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("\nmode: scalar_mono\n"), std::string::npos) << r.out;
-    const std::string line = expect_one_line_error("info scene.xml -m scalar_spectral");
-    EXPECT_NE(line.find("facet does not render the mode \"scalar_spectral\""), std::string::npos)
+    r = run("info scene.xml -m llvm_spectral");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("\nmode: scalar_spectral\n"), std::string::npos) << r.out;
+    const std::string line = expect_one_line_error("info scene.xml -m scalar_spectral_polarized");
+    EXPECT_NE(line.find("facet does not render the mode \"scalar_spectral_polarized\""),
+              std::string::npos)
         << line;
 }
 

@@ -63,6 +63,10 @@ struct Color3f {
 
 constexpr Color3f operator*(float s, const Color3f &c) { return c * s; }
 
+/// The wavelengths (nm) a value of the spectral modes holds its channels at: channel i of every
+/// colour along a path is the quantity at wavelength i (see ColourMode::Spectral).
+using Wavelengths = Color3f;
+
 inline std::ostream &operator<<(std::ostream &os, const Color3f &c) {
     return os << "[" << c.r << ", " << c.g << ", " << c.b << "]";
 }

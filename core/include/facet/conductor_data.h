@@ -22,6 +22,10 @@ std::vector<std::string> conductor_names();
 /// the valid names and the closest one.
 std::pair<Color3f, Color3f> conductor_eta_k(const std::string &material);
 
+/// The measured η and k of a material per wavelength (the spectral mode's form; "none" gives the
+/// uniform 0 and 1). Names as conductor_eta_k().
+std::pair<SpectrumData, SpectrumData> conductor_eta_k_spectra(const std::string &material);
+
 /// The conductor parameters of a BSDF: `material` (default "none") or `eta` and `k` (numbers,
 /// rgb, spectra or textures; defaults 0 and 1). Giving a material together with eta or k throws.
 struct ConductorIOR {

@@ -15,22 +15,32 @@ struct Interaction {
     Point3f p;
     Normal3f n; ///< geometric normal; zero for points in space
     float t = Infinity;
+    /// The path's wavelengths (Ray::wavelengths): spectral textures and emitters evaluate at them.
+    Wavelengths wavelengths;
 
     bool is_valid() const { return t != Infinity; }
 
     /// Ray leaving p in direction d, offset along n to avoid self-intersection. The offset grows
     /// with the magnitude of p so it stays above float rounding at large coordinates. (Inline:
     /// it runs once or twice per path vertex.)
-    Ray spawn_ray(const Vector3f &d) const { return Ray(offset_origin(p, n, d), d, 0.f, Infinity); }
+    Ray spawn_ray(const Vector3f &d) const {
+        Ray ray(offset_origin(p, n, d), d, 0.f, Infinity);
+        ray.wavelengths = wavelengths;
+        return ray;
+    }
     /// Ray from p towards `target`, ending just before it (shadow rays): it stops short by the
     /// fraction ShadowEpsilon of its length, since the target usually lies on a surface too.
     Ray spawn_ray_to(const Point3f &target) const {
         Point3f o = offset_origin(p, n, target - p);
         Vector3f d = target - o;
         float dist = norm(d);
-        if (!(dist > 0.f)) return Ray(o, Vector3f(0.f, 0.f, 1.f), 0.f, 0.f);
-        d /= dist;
-        return Ray(o, d, 0.f, dist * (1.f - ShadowEpsilon));
+        Ray ray(o, Vector3f(0.f, 0.f, 1.f), 0.f, 0.f);
+        if (dist > 0.f) {
+            ray.d = d / dist;
+            ray.maxt = dist * (1.f - ShadowEpsilon);
+        }
+        ray.wavelengths = wavelengths;
+        return ray;
     }
 
     /// Distance by which spawned rays leave a surface: (1 + max |p_i|) · RayEpsilon, Mitsuba 3's

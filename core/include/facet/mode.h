@@ -10,8 +10,9 @@
 /// the one place a name a user typed (`facet render -m`, Python's `mode=`) becomes a mode.
 namespace facet {
 
-/// The modes facet renders in, the default first: {"scalar_rgb", "scalar_mono"}. The one list: a
-/// mode added here is accepted by every resolve_mode() caller, with its vectorised names.
+/// The modes facet renders in, the default first: {"scalar_rgb", "scalar_mono", "scalar_spectral"}.
+/// The one list: a mode added here is accepted by every resolve_mode() caller, with its vectorised
+/// names.
 const std::vector<std::string> &modes();
 
 /// The mode of a render that names none: modes().front().
@@ -36,17 +37,31 @@ std::string resolve_mode(const std::string &name);
  *   colour a scene gives (rgb, spectrum, image texel, vertex colour) becomes its luminance
  *   (Rec.709 Y, which is CIE Y) when it is read, so every channel of every value along a path is
  *   the same and the image's R = G = B is the mono image.
+ * - `Spectral`: each channel of a value along a path is the quantity at one of the path's three
+ *   wavelengths (Interaction::wavelengths, sampled with the camera ray); the render loop turns
+ *   the path's radiance into CIE XYZ and then the film's RGB. Colours a scene gives become
+ *   spectra (RGB by the sigmoid-polynomial model, spectra and measured data per wavelength), which
+ *   textures evaluate at the interaction's wavelengths (see Properties::texture()).
  */
-enum class ColourMode : uint8_t { RGB, Mono };
+enum class ColourMode : uint8_t { RGB, Mono, Spectral };
+
+/// The bit of `mode` in PluginDescriptor::modes.
+constexpr uint32_t mode_bit(ColourMode mode) { return 1u << uint32_t(mode); }
+/// The modes of a plugin that reads its colours through Properties and never looks at
+/// wavelengths: rgb and mono.
+constexpr uint32_t RGBAndMono = mode_bit(ColourMode::RGB) | mode_bit(ColourMode::Mono);
+/// Every mode: a plugin without colours (a shape, a sensor, a filter, a sampler), or one that
+/// evaluates its colours at Interaction::wavelengths in the spectral mode.
+constexpr uint32_t AllModes = RGBAndMono | mode_bit(ColourMode::Spectral);
 
 /// The ColourMode of one of modes() (a name resolve_mode() returned); throws facet::Error for any
 /// other name.
 ColourMode colour_mode(const std::string &mode);
-/// The name of a ColourMode in modes(): "scalar_rgb", "scalar_mono".
+/// The name of a ColourMode in modes(): "scalar_rgb", "scalar_mono", "scalar_spectral".
 const char *mode_name(ColourMode mode);
 
-/// A colour a scene gives (linear Rec.709) as `mode` renders it: in Mono its luminance in every
-/// channel, otherwise unchanged.
+/// A colour a scene gives (linear Rec.709) as `mode` renders it at load: in Mono its luminance in
+/// every channel, otherwise unchanged (the spectral mode upsamples it where it is evaluated).
 inline Color3f in_mode(const Color3f &c, ColourMode mode) {
     return mode == ColourMode::Mono ? Color3f(c.luminance()) : c;
 }

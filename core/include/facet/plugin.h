@@ -13,7 +13,7 @@ namespace facet {
 
 /// Version of the binary interface between libfacet and plugins. Bump it whenever a public class
 /// layout, a virtual table or PluginDescriptor changes; the registry refuses other versions.
-constexpr uint32_t FACET_ABI_VERSION = 6;
+constexpr uint32_t FACET_ABI_VERSION = 7;
 
 /// What every plugin library exports through `facet_plugin_descriptor()`.
 /// `abi_version` stays the first member in every future version, so it can always be checked.
@@ -24,7 +24,16 @@ struct PluginDescriptor {
     const char *description; ///< one line
     const char *doc;         ///< Markdown parameter table and an XML example
     Object *(*create)(const Properties &props);
+    /// The colour modes the plugin renders in: mode_bit() of each. A scene loaded in any other
+    /// mode is refused with the plugin's name and its modes. FACET_EXPORT_PLUGIN declares rgb
+    /// and mono (mono reaches a plugin as three equal channels); a plugin that evaluates its
+    /// colours at the path's wavelengths (Interaction::wavelengths) adds the spectral mode with
+    /// FACET_EXPORT_PLUGIN_MODES.
+    uint32_t modes = RGBAndMono;
 };
+
+/// The modes of `desc` by name, in modes()'s order ("scalar_rgb, scalar_mono").
+std::string plugin_modes(const PluginDescriptor &desc);
 
 using PluginDescriptorFn = const PluginDescriptor *(*)();
 
@@ -86,6 +95,11 @@ std::string closest_name(const std::string &name, const std::vector<std::string>
 /// Exports a plugin. Use once at the end of the plugin's .cpp file:
 ///   FACET_EXPORT_PLUGIN(Diffuse, BSDF, "diffuse", "Smooth diffuse (Lambertian) reflection", DOC)
 #define FACET_EXPORT_PLUGIN(Class, Kind, Name, Description, Doc)                                   \
+    FACET_EXPORT_PLUGIN_MODES(Class, Kind, Name, Description, Doc, ::facet::RGBAndMono)
+
+/// FACET_EXPORT_PLUGIN for the modes `Modes` (mode_bit()s or'ed, or ::facet::AllModes):
+///   FACET_EXPORT_PLUGIN_MODES(Diffuse, BSDF, "diffuse", "...", DOC, ::facet::AllModes)
+#define FACET_EXPORT_PLUGIN_MODES(Class, Kind, Name, Description, Doc, Modes)                      \
     extern "C" __attribute__((visibility("default"))) const ::facet::PluginDescriptor *            \
     facet_plugin_descriptor() {                                                                    \
         static const ::facet::PluginDescriptor desc{                                               \
@@ -96,6 +110,7 @@ std::string closest_name(const std::string &name, const std::vector<std::string>
             Doc,                                                                                   \
             [](const ::facet::Properties &props) -> ::facet::Object * {                            \
                 return new Class(props);                                                           \
-            }};                                                                                    \
+            },                                                                                     \
+            Modes};                                                                                \
         return &desc;                                                                              \
     }

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/color.h>
 #include <facet/vector.h>
 
 namespace facet {
@@ -11,6 +12,10 @@ struct Ray {
     float mint = 0.f;
     float maxt = Infinity;
     float time = 0.f;
+    /// The path's wavelengths in nm, one per channel, in the spectral modes (sampled with the
+    /// camera ray, carried to every interaction and every ray spawned from one); zero and unused
+    /// in rgb and mono.
+    Wavelengths wavelengths;
 
     Ray() = default;
     Ray(const Point3f &o_, const Vector3f &d_, float mint_ = 0.f, float maxt_ = Infinity)

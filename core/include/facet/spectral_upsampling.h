@@ -1,6 +1,7 @@
 #pragma once
 
 #include <facet/color.h>
+#include <facet/spectrum.h>
 
 #include <string>
 
@@ -40,6 +41,28 @@ struct SigmoidPolynomial {
 /// (the paper's lookup). Black and white are exact: {0, 0, -inf} and {0, 0, +inf}. Throws
 /// facet::Error if the table cannot be read (the first call reads it; later calls only look up).
 SigmoidPolynomial rgb_to_sigmoid(const Color3f &rgb);
+
+/**
+ * A colour a scene gives as RGB, as the spectral mode renders it: scale · s(λ), times D65(λ)
+ * (cie_d65) for an emitter's colour. By kind, as Mitsuba 3's spectral modes read colours:
+ * - Reflectance and Unbounded (an eta or k given as rgb): s of the colour clamped to [0, 1],
+ *   scale 1 (Properties warns when an unbounded colour is clamped);
+ * - Emission and Measured: s of rgb / (2 max(rgb)), scale 2 max(rgb) (0 for a black or negative
+ *   colour), so that the curve stays inside the table's range whatever the magnitude; Emission
+ *   is also multiplied by D65, the spectrum of an RGB white light.
+ */
+struct RGBSpectrum {
+    SigmoidPolynomial poly;
+    float scale = 1.f;
+    bool illuminant = false;
+
+    static RGBSpectrum from_rgb(const Color3f &rgb, SpectrumKind kind);
+    /// The scaled form of any colour, without D65: s of rgb / (2 max(rgb)), scale 2 max(rgb)
+    /// (an environment map's pixels, which the map multiplies by D65 itself).
+    static RGBSpectrum scaled(const Color3f &rgb);
+    /// The spectrum at each of `lambda`'s wavelengths (nm).
+    Color3f eval(const Wavelengths &lambda) const;
+};
 
 /// The path of the coefficient table rgb_to_sigmoid reads.
 std::string spectral_upsampling_table_path();

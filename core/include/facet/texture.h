@@ -2,6 +2,7 @@
 
 #include <facet/color.h>
 #include <facet/interaction.h>
+#include <facet/logger.h>
 #include <facet/object.h>
 #include <facet/spectrum.h>
 
@@ -96,6 +97,64 @@ private:
 };
 
 /**
+ * A constant of the spectral mode: a value that does not vary over the surface but with the
+ * wavelength (an rgb or a spectrum a scene gives, upsampled or tabulated). eval() gives it at the
+ * interaction's wavelengths. mean() is the colour the rgb mode would use, for heuristics that
+ * want one colour (sampling weights, power estimates). is_spatially_varying() is true: eval()
+ * depends on the interaction, so BSDFs and emitters must call it.
+ */
+class SpectralTexture : public Texture {
+public:
+    explicit SpectralTexture(const Color3f &rgb) : m_rgb(rgb) {}
+    /// The value at each of `lambda`'s wavelengths (nm).
+    virtual Color3f eval_wavelengths(const Wavelengths &lambda) const = 0;
+    Color3f eval(const SurfaceInteraction &si) const final {
+        return eval_wavelengths(si.wavelengths);
+    }
+    Vector2f eval_1_grad(const SurfaceInteraction &) const override { return Vector2f(0.f); }
+    Color3f mean() const override { return m_rgb; }
+    bool is_spatially_varying() const override { return true; }
+
+protected:
+    Color3f m_rgb;
+};
+
+/**
+ * A parameter that may vary with the wavelength but not over a surface (a point light's
+ * intensity), read once from its texture: at(lambda) is a load in rgb and mono, and the value
+ * at the path's wavelengths in the spectral mode. Throws facet::Error for a texture that varies
+ * over the surface.
+ */
+class SpectralValue {
+public:
+    SpectralValue() = default;
+    explicit SpectralValue(std::shared_ptr<Texture> texture) {
+        m_spectral = std::dynamic_pointer_cast<SpectralTexture>(texture);
+        if (!m_spectral && texture->is_spatially_varying())
+            FACET_THROW("{} varies over the surface; a constant or a spectrum is needed here",
+                        texture->to_string());
+        m_value = texture->mean();
+    }
+    Color3f at(const Wavelengths &lambda) const {
+        return m_spectral ? m_spectral->eval_wavelengths(lambda) : m_value;
+    }
+    /// The rgb mode's colour (exact in rgb and mono).
+    const Color3f &mean() const { return m_value; }
+
+private:
+    std::shared_ptr<SpectralTexture> m_spectral;
+    Color3f m_value;
+};
+
+/// The spectral mode's form of an rgb a scene gives for a parameter of kind `kind`
+/// (RGBSpectrum::from_rgb).
+std::shared_ptr<Texture> rgb_spectrum_texture(const Color3f &rgb, SpectrumKind kind);
+/// The spectral mode's form of a spectrum written in a scene: its values per wavelength (linear
+/// between the pairs, 0 outside them); a uniform spectrum is a ConstantTexture. `kind` only
+/// chooses mean()'s colour.
+std::shared_ptr<Texture> data_spectrum_texture(const SpectrumData &data, SpectrumKind kind);
+
+/**
  * A spectrum plugin (`<spectrum type="d65">`, uniform, regular, irregular, srgb, blackbody): a
  * constant whose RGB value depends on what it describes, as in Mitsuba's RGB variants (a
  * reflectance is D65-weighted and clamped to [0, 1], an emission only clamped at 0). The
@@ -107,6 +166,12 @@ public:
     /// The RGB value for a parameter of kind `kind`; throws facet::Error when the spectrum
     /// cannot describe such a quantity (an srgb reflectance outside [0, 1]).
     virtual Color3f value(SpectrumKind kind) const = 0;
+    /// The spectral mode's form for a parameter of kind `kind` (Properties::texture() asks for
+    /// it): by default the upsampled value(kind) (rgb_spectrum_texture). Spectra defined per
+    /// wavelength (d65, blackbody, regular, ...) return their values at the wavelengths.
+    virtual std::shared_ptr<Texture> spectral(SpectrumKind kind) const {
+        return rgb_spectrum_texture(value(kind), kind);
+    }
     /// Used only where no parameter kind is known: the reflectance conversion.
     Color3f eval(const SurfaceInteraction &) const override {
         return value(SpectrumKind::Reflectance);

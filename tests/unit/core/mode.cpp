@@ -49,7 +49,7 @@ TEST(Mode, EveryListedModeResolvesToItselfSilently) {
 }
 
 TEST(Mode, VectorisedNamesRenderAsTheScalarModeWithOneNote) {
-    for (const char *colour : {"rgb", "mono"})
+    for (const char *colour : {"rgb", "mono", "spectral"})
         for (const char *prefix : {"llvm_", "cuda_", "llvm_ad_", "cuda_ad_"}) {
             const std::string name = std::string(prefix) + colour;
             const Resolved r = resolve(name);
@@ -64,6 +64,7 @@ TEST(Mode, VectorisedNamesRenderAsTheScalarModeWithOneNote) {
 TEST(Mode, EveryModeHasItsColourMode) {
     EXPECT_EQ(colour_mode("scalar_rgb"), ColourMode::RGB);
     EXPECT_EQ(colour_mode("scalar_mono"), ColourMode::Mono);
+    EXPECT_EQ(colour_mode("scalar_spectral"), ColourMode::Spectral);
     for (const std::string &mode : modes()) EXPECT_EQ(mode_name(colour_mode(mode)), mode);
     try {
         colour_mode("llvm_mono");
@@ -91,13 +92,12 @@ TEST(Mode, TheNoteFollowsTheLogLevel) {
 
 TEST(Mode, MitsubaModesFacetLacksAreRefusedByName) {
     for (const char *name :
-         {"scalar_spectral", "scalar_spectral_polarized", "scalar_mono_polarized",
-          "scalar_rgb_polarized", "scalar_spectral_double", "scalar_rgb_double",
-          "scalar_mono_polarized_double"}) {
+         {"scalar_spectral_polarized", "scalar_mono_polarized", "scalar_rgb_polarized",
+          "scalar_spectral_double", "scalar_rgb_double", "scalar_mono_polarized_double"}) {
         const Resolved r = resolve(name);
         EXPECT_EQ(r.mode, "") << name;
         EXPECT_EQ(r.error, fmt::format("facet does not render the mode \"{}\"; the modes it "
-                                       "renders: scalar_rgb, scalar_mono",
+                                       "renders: scalar_rgb, scalar_mono, scalar_spectral",
                                        name));
         EXPECT_EQ(r.log, "") << name;
     }
@@ -105,7 +105,6 @@ TEST(Mode, MitsubaModesFacetLacksAreRefusedByName) {
 
 TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
     const std::vector<std::pair<const char *, const char *>> cases = {
-        {"llvm_spectral", "scalar_spectral"},
         {"cuda_ad_spectral_polarized", "scalar_spectral_polarized"},
         {"cuda_rgb_polarized", "scalar_rgb_polarized"},
         {"llvm_ad_rgb_double", "scalar_rgb_double"},
@@ -113,7 +112,8 @@ TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
     for (const auto &[name, scalar] : cases) {
         const Resolved r = resolve(name);
         EXPECT_EQ(r.error, fmt::format("facet does not render the mode \"{}\" (nor {}, its scalar "
-                                       "form); the modes it renders: scalar_rgb, scalar_mono",
+                                       "form); the modes it renders: scalar_rgb, scalar_mono, "
+                                       "scalar_spectral",
                                        name, scalar));
         EXPECT_EQ(r.log, "") << name;
     }
@@ -121,12 +121,14 @@ TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
 
 TEST(Mode, UnknownNamesListTheModesWithTheNearestName) {
     EXPECT_EQ(resolve("foo").error,
-              "unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono");
+              "unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono, "
+              "scalar_spectral");
     EXPECT_EQ(resolve("").error,
-              "unknown mode \"\"; the modes facet renders: scalar_rgb, scalar_mono");
+              "unknown mode \"\"; the modes facet renders: scalar_rgb, scalar_mono, "
+              "scalar_spectral");
     EXPECT_EQ(resolve("scalar_rbg").error, "unknown mode \"scalar_rbg\" (did you mean "
                                            "\"scalar_rgb\"?); the modes facet renders: scalar_rgb, "
-                                           "scalar_mono");
+                                           "scalar_mono, scalar_spectral");
     EXPECT_CONTAINS(resolve("llvm_rg").error, "(did you mean \"llvm_rgb\"?)");
     EXPECT_CONTAINS(resolve("SCALAR_RGB").error, "(did you mean \"scalar_rgb\"?)");
     // Not Mitsuba's names: scalar has no _ad_ form, and rgb comes before _polarized.

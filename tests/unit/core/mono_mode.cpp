@@ -120,6 +120,9 @@ TEST(MonoMode, TheSceneAndItsPropertiesKnowTheMode) {
     opts.mode = "scalar_mono";
     EXPECT_EQ(std::dynamic_pointer_cast<Scene>(load_string(xml, opts))->mode(), ColourMode::Mono);
     opts.mode = "scalar_spectral";
+    EXPECT_EQ(std::dynamic_pointer_cast<Scene>(load_string(xml, opts))->mode(),
+              ColourMode::Spectral);
+    opts.mode = "scalar_spectral_polarized";
     EXPECT_THROW(load_string(xml, opts), Error);
 
     // A colour read straight from Properties follows the mode; so do defaults.
