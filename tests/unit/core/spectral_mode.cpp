@@ -119,7 +119,8 @@ std::string furnace(const std::string &emitter, const std::string &content) {
 TEST(SpectralMode, TheWavelengthDensityIsNormalisedOnTheVisibleRange) {
     // The trapezoid rule over 1 nm steps.
     double sum = 0.0;
-    for (int l = 360; l < 830; ++l) sum += 0.5 * (pdf_wavelength(float(l)) + pdf_wavelength(l + 1.f));
+    for (int l = 360; l < 830; ++l)
+        sum += 0.5 * (pdf_wavelength(float(l)) + pdf_wavelength(l + 1.f));
     EXPECT_NEAR(sum, 1.0, 1e-4);
     EXPECT_EQ(pdf_wavelength(359.f), 0.f);
     EXPECT_EQ(pdf_wavelength(831.f), 0.f);
@@ -180,8 +181,8 @@ TEST(SpectralMode, ColoursComeBackThroughTheirSpectra) {
         expect_near(develop([&](const Wavelengths &l) { return s.eval(l) * d65(l); }), c, 4e-3f,
                     fmt::format("reflectance ({}, {}, {})", c.r, c.g, c.b));
     }
-    for (const Color3f c : {Color3f(6.f, 5.5f, 5.f), Color3f(0.35f, 0.4f, 0.5f),
-                            Color3f(25.f, 2.f, 0.5f)}) {
+    for (const Color3f c :
+         {Color3f(6.f, 5.5f, 5.f), Color3f(0.35f, 0.4f, 0.5f), Color3f(25.f, 2.f, 0.5f)}) {
         const RGBSpectrum s = RGBSpectrum::from_rgb(c, SpectrumKind::Emission);
         EXPECT_TRUE(s.illuminant);
         EXPECT_FLOAT_EQ(s.scale, 2.f * c.max());
@@ -192,8 +193,7 @@ TEST(SpectralMode, ColoursComeBackThroughTheirSpectra) {
     // Black is black in every form.
     const Wavelengths l(450.f, 550.f, 650.f);
     EXPECT_EQ(RGBSpectrum::from_rgb(Color3f(0.f), SpectrumKind::Emission).eval(l), Color3f(0.f));
-    EXPECT_EQ(RGBSpectrum::from_rgb(Color3f(0.f), SpectrumKind::Reflectance).eval(l),
-              Color3f(0.f));
+    EXPECT_EQ(RGBSpectrum::from_rgb(Color3f(0.f), SpectrumKind::Reflectance).eval(l), Color3f(0.f));
 }
 
 TEST(SpectralMode, SceneColoursBecomeSpectraEvaluatedAtTheWavelengths) {
@@ -221,7 +221,8 @@ TEST(SpectralMode, SceneColoursBecomeSpectraEvaluatedAtTheWavelengths) {
         color0_of("<spectrum name=\"color0\" type=\"blackbody\"><float name=\"temperature\" "
                   "value=\"3000\"/></spectrum>");
     const double lm = 530e-9, h = 6.62607015e-34, cl = 2.99792458e8, k = 1.380649e-23;
-    const double expected = 1e-9 * 2 * h * cl * cl / (std::pow(lm, 5) * std::expm1(h * cl / (lm * k * 3000)));
+    const double expected =
+        1e-9 * 2 * h * cl * cl / (std::pow(lm, 5) * std::expm1(h * cl / (lm * k * 3000)));
     EXPECT_NEAR(eval_at(*planck, l).g / expected, 1.0, 1e-4);
 }
 
