@@ -203,22 +203,26 @@ Color3f spectrum_to_rgb(const SpectrumData &s, SpectrumKind kind) {
 namespace {
 
 /// The wavelength density's shape 1 / cosh²(a (λ - c)) and its integral tanh(a (λ - c)) / a.
-constexpr double WavelengthA = 0.0072, WavelengthCentre = 538.0;
-const double TanhLo = std::tanh(WavelengthA * (SpectralMinNm - WavelengthCentre));
-const double TanhHi = std::tanh(WavelengthA * (SpectralMaxNm - WavelengthCentre));
+/// Float arithmetic: every camera ray draws three (a wavelength is good to 1e-4 nm).
+constexpr float WavelengthA = 0.0072f, WavelengthCentre = 538.f;
+const float TanhLo = std::tanh(WavelengthA * (SpectralMinNm - WavelengthCentre));
+const float TanhHi = std::tanh(WavelengthA * (SpectralMaxNm - WavelengthCentre));
+const float PdfScale = WavelengthA / (TanhHi - TanhLo);
 
 float sample_wavelength(float u) {
-    const double t = TanhLo + (TanhHi - TanhLo) * double(u);
-    const double lambda = WavelengthCentre + std::atanh(t) / WavelengthA;
-    return float(std::min<double>(std::max<double>(lambda, SpectralMinNm), SpectralMaxNm));
+    const float t = TanhLo + (TanhHi - TanhLo) * u;
+    // atanh(t) = ½ log((1 + t) / (1 - t)); |t| < 0.98 on the range.
+    const float lambda = WavelengthCentre + 0.5f * std::log((1.f + t) / (1.f - t)) / WavelengthA;
+    return std::min(std::max(lambda, SpectralMinNm), SpectralMaxNm);
 }
 
 } // namespace
 
 float pdf_wavelength(float lambda) {
     if (!(lambda >= SpectralMinNm && lambda <= SpectralMaxNm)) return 0.f;
-    const double c = std::cosh(WavelengthA * (double(lambda) - WavelengthCentre));
-    return float(WavelengthA / ((TanhHi - TanhLo) * c * c));
+    // 1 / cosh²(x) = 4 e^{-2|x|} / (1 + e^{-2|x|})².
+    const float e = std::exp(-2.f * std::abs(WavelengthA * (lambda - WavelengthCentre)));
+    return PdfScale * 4.f * e / ((1.f + e) * (1.f + e));
 }
 
 std::pair<Wavelengths, Color3f> sample_wavelengths(float u) {

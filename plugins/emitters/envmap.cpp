@@ -122,17 +122,21 @@ public:
                 texel(x, y).radiance = c;
                 if (x == 0) texel(m_width, y).radiance = c; // column W is column 0 again
             }
+        build_distribution();
         if (props.mode() == ColourMode::Spectral) {
             // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
-            // and the scale 2 max c, blended separately between pixels; eval() multiplies by
-            // D65, the spectrum of an RGB white light.
-            m_spectral.resize(m_texels.size());
+            // and the scale 2 max c, blended separately between pixels; radiance() multiplies
+            // by D65, the spectrum of an RGB white light. The curve's coefficients replace the
+            // texel's colour (the sampling table below is built from the colours first), so a
+            // lookup reads the lines the density reads; the scales are a dense array beside.
+            m_spectral = true;
+            m_scales.resize(m_texels.size());
             for (size_t i = 0; i < m_texels.size(); ++i) {
                 const RGBSpectrum rs = RGBSpectrum::scaled(m_texels[i].radiance);
-                m_spectral[i] = {rs.poly, rs.scale};
+                m_scales[i] = rs.scale;
+                m_texels[i].curve = rs.poly;
             }
         }
-        build_distribution();
         m_flags = EmitterFlags::Infinite | EmitterFlags::SpatiallyVarying;
     }
 
@@ -238,7 +242,10 @@ private:
     // sample_direction()) read the same cache lines: in a map larger than the cache each
     // texel row read is a miss, and separate arrays took twice as many.
     struct Texel {
-        Color3f radiance;   ///< the pixel, times `scale`
+        union {
+            Color3f radiance = Color3f(); ///< the pixel, times `scale`
+            SigmoidPolynomial curve;      ///< the spectral mode: the pixel's curve
+        };
         float weight = 0.f; ///< the sampling table's value (see build_distribution())
     };
     Texel &texel(int x, int y) { return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
@@ -260,13 +267,14 @@ private:
     /// The radiance at a grid point: lookup() in rgb and mono; in the spectral mode at the
     /// path's wavelengths `lambda`.
     Color3f radiance(const GridPoint &g, const Wavelengths &lambda) const {
-        if (m_spectral.empty()) return lookup(g);
+        if (!m_spectral) return lookup(g);
         Color3f curve(0.f);
         float scale = 0.f;
         auto add = [&](int x, int y, float w) {
-            const SpectralTexel &t = m_spectral[size_t(y) * size_t(m_width + 1) + size_t(x)];
-            curve += Color3f(t.poly(lambda.r), t.poly(lambda.g), t.poly(lambda.b)) * w;
-            scale += t.scale * w;
+            const size_t i = size_t(y) * size_t(m_width + 1) + size_t(x);
+            const SigmoidPolynomial &c = m_texels[i].curve;
+            curve += Color3f(c(lambda.r), c(lambda.g), c(lambda.b)) * w;
+            scale += m_scales[i] * w;
         };
         const int i = g.i, j = g.j;
         const float s = g.s, t = g.t;
@@ -324,6 +332,11 @@ private:
                 const char *end = reinterpret_cast<const char *>(&texel(int(i1), int(row)) + 1);
                 for (const char *p = begin; p < end; p += 64) prefetch_line(p);
                 prefetch_line(end - 1);
+                if (m_spectral) {
+                    const size_t k = row * (W + 1);
+                    prefetch_line(&m_scales[k + i0]);
+                    prefetch_line(&m_scales[k + i1]);
+                }
             }
         }
     }
@@ -393,12 +406,8 @@ private:
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
     std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels and the sampling table
-    /// The spectral mode's pixels (empty in rgb and mono), laid out as m_texels.
-    struct SpectralTexel {
-        SigmoidPolynomial poly;
-        float scale = 0.f;
-    };
-    std::vector<SpectralTexel> m_spectral;
+    bool m_spectral = false;     ///< the texels hold curves (the spectral mode)
+    std::vector<float> m_scales; ///< the spectral mode's pixel scales, laid out as m_texels
     DiscreteDistribution m_cells;
     double m_total = 0.0;
     float m_density_scale = 0.f;
