@@ -25,6 +25,9 @@ namespace facet {
 
 namespace {
 
+/// The wavelengths (nm) the adapters evaluate spectral-mode plugins at.
+const Wavelengths ChiSquareWavelengths(450.f, 550.f, 650.f);
+
 std::string xml_escape(const std::string &s) {
     std::string out;
     for (char c : s) {
@@ -180,6 +183,9 @@ void BSDFAdapter::init() {
     m_si.uv = Point2f(0.5f, 0.5f);
     m_si.dp_du = Vector3f(1.f, 0.f, 0.f);
     m_si.dp_dv = Vector3f(0.f, 1.f, 0.f);
+    // Wavelengths of a spectral-mode path (the other modes ignore them): three distinct ones,
+    // so that the weight check sees spectral values that differ by channel.
+    m_si.wavelengths = ChiSquareWavelengths;
     if (m_ctx.component != uint32_t(-1) && m_ctx.component >= m_bsdf->component_count())
         FACET_THROW("BSDFAdapter: component {} requested but the BSDF has {}", m_ctx.component,
                     m_bsdf->component_count());
@@ -256,6 +262,7 @@ EmitterAdapter::~EmitterAdapter() = default;
 
 void EmitterAdapter::init() {
     if (!m_scene || !m_emitter) FACET_THROW("EmitterAdapter: no scene or no emitter");
+    m_ref.wavelengths = ChiSquareWavelengths;
     if (has_flag(m_emitter->flags(), EmitterFlags::Delta))
         FACET_THROW("{}: a delta emitter (point-like or one direction) has no direction density "
                     "to test",
