@@ -174,7 +174,11 @@ private:
 } // namespace facet
 
 // Name = the XML type = the library's file name (@NAME@.so).
-FACET_EXPORT_PLUGIN(facet::@CLASS@, BSDF, "@NAME@", "A BSDF plugin (so far a Lambertian reflector)", DOC)
+// Every mode: the reflectance comes from Properties::texture() and is evaluated at the
+// interaction (in scalar_spectral at its wavelengths). A plugin that reads its own colours
+// declares ::facet::RGBAndMono (or uses FACET_EXPORT_PLUGIN) until it evaluates them there.
+FACET_EXPORT_PLUGIN_MODES(facet::@CLASS@, BSDF, "@NAME@",
+                          "A BSDF plugin (so far a Lambertian reflector)", DOC, ::facet::AllModes)
 )CPP";
 
 const char *EMITTER_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
@@ -536,7 +540,10 @@ public:
 } // namespace facet
 
 // Name = the XML type = the library's file name (@NAME@.so).
-FACET_EXPORT_PLUGIN(facet::@CLASS@, ReconstructionFilter, "@NAME@", "A reconstruction filter plugin (so far a Hann window)", DOC)
+// Every mode: a filter has no colours.
+FACET_EXPORT_PLUGIN_MODES(facet::@CLASS@, ReconstructionFilter, "@NAME@",
+                          "A reconstruction filter plugin (so far a Hann window)", DOC,
+                          ::facet::AllModes)
 )CPP";
 
 const char *SAMPLER_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
@@ -618,7 +625,10 @@ private:
 } // namespace facet
 
 // Name = the XML type = the library's file name (@NAME@.so).
-FACET_EXPORT_PLUGIN(facet::@CLASS@, Sampler, "@NAME@", "A sampler plugin (so far independent random numbers)", DOC)
+// Every mode: a sampler has no colours.
+FACET_EXPORT_PLUGIN_MODES(facet::@CLASS@, Sampler, "@NAME@",
+                          "A sampler plugin (so far independent random numbers)", DOC,
+                          ::facet::AllModes)
 )CPP";
 
 const char *FILM_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
@@ -840,7 +850,9 @@ public:
 } // namespace facet
 
 // Name = the XML type = the library's file name (@NAME@.so).
-FACET_EXPORT_PLUGIN(facet::@CLASS@, Shape, "@NAME@", "A shape plugin (so far a square pyramid)", DOC)
+// Every mode: a shape has no colours.
+FACET_EXPORT_PLUGIN_MODES(facet::@CLASS@, Shape, "@NAME@",
+                          "A shape plugin (so far a square pyramid)", DOC, ::facet::AllModes)
 )CPP";
 
 /// One kind of plugin `facet new-plugin` can write.
