@@ -298,7 +298,7 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
         case Type::Color: {
             // A grey is a flat spectrum, but for an emitter.
             const Color3f c = get_color(name, kind);
-            if (kind == SpectrumKind::Unbounded &&
+            if ((kind == SpectrumKind::Unbounded || kind == SpectrumKind::Reflectance) &&
                 !(std::min(c.r, std::min(c.g, c.b)) >= 0.f && c.max() <= 1.f)) {
                 const Location &loc = e.location.valid() ? e.location : m_location;
                 FACET_LOG(Warn,
@@ -307,8 +307,10 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
                           "outside it",
                           loc.to_string(), loc.valid() ? ": " : "", name, c.r, c.g, c.b);
             }
+            // (Reflectances and unbounded values clamped to [0, 1], as their curves are.)
             if (c.r == c.g && c.g == c.b && kind != SpectrumKind::Emission)
-                return std::make_shared<ConstantTexture>(c);
+                return std::make_shared<ConstantTexture>(
+                    kind == SpectrumKind::Measured ? c : Color3f(clamp(c.r, 0.f, 1.f)));
             return rgb_spectrum_texture(c, kind);
         }
         case Type::Spectrum:

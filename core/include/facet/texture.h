@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/assert.h>
 #include <facet/color.h>
 #include <facet/interaction.h>
 #include <facet/logger.h>
@@ -109,8 +110,13 @@ public:
     /// The value at each of `lambda`'s wavelengths (nm).
     virtual Color3f eval_wavelengths(const Wavelengths &lambda) const = 0;
     Color3f eval(const SurfaceInteraction &si) const final {
+        // Wavelengths outside the visible range are ones a caller lost (zero).
+        FACET_ASSERT(si.wavelengths.r >= 360.f && si.wavelengths.b <= 830.f);
         return eval_wavelengths(si.wavelengths);
     }
+    /// A scalar parameter given as a colour or spectrum (a weight, an opacity, a roughness)
+    /// stays one number: the rgb mode's mean, whatever the path's wavelengths.
+    float eval_1(const SurfaceInteraction &) const override { return m_rgb.mean(); }
     Vector2f eval_1_grad(const SurfaceInteraction &) const override { return Vector2f(0.f); }
     Color3f mean() const override { return m_rgb; }
     bool is_spatially_varying() const override { return true; }

@@ -21,6 +21,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -300,4 +301,50 @@ TEST(SpectralMode, AColoredPlaneUnderAWhiteEnvironmentMapIsItsColour) {
     expect_near(render_mean(xml, "scalar_rgb", dir), rho, 2e-3f, "rgb");
     expect_near(render_mean(xml, "scalar_spectral", dir), rho, 8e-3f, "spectral");
     fs::remove_all(dir);
+}
+
+TEST(SpectralMode, ColoursAreClampedAlikeAndScalarsStayScalars) {
+    const Wavelengths l(420.f, 530.f, 640.f);
+    // An unbounded rgb is clamped to [0, 1], grey or not (as Mitsuba's spectral modes clamp it);
+    // a number is not.
+    Properties props("test");
+    props.set_mode(ColourMode::Spectral);
+    props.set_color("grey", Color3f(1.5f));
+    props.set_color("colour", Color3f(1.5f, 1.5f, 1.4f));
+    props.set_float("number", 1.5);
+    EXPECT_EQ(eval_at(*props.texture("grey", SpectrumKind::Unbounded), l), Color3f(1.f));
+    const Color3f colour = eval_at(*props.texture("colour", SpectrumKind::Unbounded), l);
+    EXPECT_LE(colour.max(), 1.f);
+    EXPECT_GT(std::min(colour.r, std::min(colour.g, colour.b)), 0.9f);
+    EXPECT_EQ(eval_at(*props.texture("number", SpectrumKind::Unbounded), l), Color3f(1.5f));
+    // A scalar parameter given as a colour (a blend weight, an opacity) is one number for every
+    // path, the rgb mode's mean, not the mean of the path's three wavelengths.
+    props.set_color("weight", Color3f(0.9f, 0.2f, 0.1f));
+    const auto weight = props.texture("weight");
+    SurfaceInteraction a, b;
+    a.uv = b.uv = Point2f(0.1f, 0.1f);
+    a.wavelengths = Wavelengths(400.f, 410.f, 420.f);
+    b.wavelengths = Wavelengths(650.f, 660.f, 670.f);
+    EXPECT_FLOAT_EQ(weight->eval_1(a), 0.4f);
+    EXPECT_FLOAT_EQ(weight->eval_1(b), 0.4f);
+}
+
+TEST(SpectralMode, ALightsIntensityMustNotVaryOverASurface) {
+    const std::string xml = R"(<scene version="3.0.0">
+        <emitter type="point">
+            <texture type="checkerboard" name="intensity"/>
+        </emitter>
+    </scene>)";
+    for (const char *mode : {"scalar_rgb", "scalar_spectral"}) {
+        LoadOptions opts;
+        opts.mode = mode;
+        try {
+            load_string(xml, opts);
+            ADD_FAILURE() << "a checkerboard intensity was accepted in " << mode;
+        } catch (const Error &e) {
+            EXPECT_NE(std::string(e.what()).find("varies over the surface"), std::string::npos)
+                << e.what();
+            EXPECT_TRUE(e.location().valid()) << e.what();
+        }
+    }
 }
