@@ -185,7 +185,9 @@ public:
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
         const Frame frame(from);
         const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y + from) * radius;
-        return {Ray(o, -from), lookup(g) * (Pi * radius * radius / pdf)};
+        // (The light tracer does not render the spectral mode yet: sample_ray has no wavelengths
+        // to give radiance(), which then reads the curves, not the colours, and gives zero.)
+        return {Ray(o, -from), radiance(g, Wavelengths()) * (Pi * radius * radius / pdf)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {
