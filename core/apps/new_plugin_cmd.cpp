@@ -708,7 +708,9 @@ private:
 } // namespace facet
 
 // Name = the XML type = the library's file name (@NAME@.so).
-FACET_EXPORT_PLUGIN(facet::@CLASS@, Film, "@NAME@", "A film plugin (so far an exposure control)", DOC)
+// Every mode: a film has no colours (the render loop develops spectra before the film).
+FACET_EXPORT_PLUGIN_MODES(facet::@CLASS@, Film, "@NAME@",
+                          "A film plugin (so far an exposure control)", DOC, ::facet::AllModes)
 )CPP";
 
 const char *SENSOR_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
@@ -789,7 +791,9 @@ private:
 } // namespace facet
 
 // Name = the XML type = the library's file name (@NAME@.so).
-FACET_EXPORT_PLUGIN(facet::@CLASS@, Sensor, "@NAME@", "A sensor plugin (so far a pinhole camera)", DOC)
+// Every mode: a sensor has no colours (the render loop develops spectra before the film).
+FACET_EXPORT_PLUGIN_MODES(facet::@CLASS@, Sensor, "@NAME@",
+                          "A sensor plugin (so far a pinhole camera)", DOC, ::facet::AllModes)
 )CPP";
 
 const char *SHAPE_TEMPLATE = R"CPP(static const char *DOC = R"DOC(
