@@ -290,9 +290,23 @@ private:
     }
 
     template <int C, bool Bytes> Color3f lookup(const Point2f &uv) const {
+        return filtered(uv, [&](int px, int py) { return pixel<C, Bytes>(px, py); });
+    }
+
+    /// The spectral mode's lookup: the pixels' spectra at `lambda`, blended as lookup() blends
+    /// their colours.
+    Color3f lookup_spectral(const Point2f &uv, const Wavelengths &lambda) const {
+        return filtered(uv, [&](int px, int py) {
+            const SigmoidPolynomial &c = m_curves[size_t(py) * size_t(m_width) + size_t(px)];
+            return Color3f(c(lambda.r), c(lambda.g), c(lambda.b));
+        });
+    }
+
+    /// The filter's blend of the values value(x, y) of the pixels around uv (transformed).
+    template <typename Value> Color3f filtered(const Point2f &uv, Value value) const {
         float x = uv.x * float(m_width), y = uv.y * float(m_height);
         if (m_filter == FilterType::Nearest)
-            return pixel<C, Bytes>(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
+            return value(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
 
         // Bilinear between the four pixel centres around (x, y); centres sit at half-integers.
         x -= 0.5f;
@@ -303,30 +317,8 @@ private:
         if (!std::isfinite(fy)) fy = 0.f;
         int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
         int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
-        return (pixel<C, Bytes>(xa, ya) * (1.f - fx) + pixel<C, Bytes>(xb, ya) * fx) * (1.f - fy) +
-               (pixel<C, Bytes>(xa, yb) * (1.f - fx) + pixel<C, Bytes>(xb, yb) * fx) * fy;
-    }
-
-    /// The spectral mode's lookup: the pixels' spectra at `lambda`, blended as lookup() blends
-    /// their colours.
-    Color3f lookup_spectral(const Point2f &uv, const Wavelengths &lambda) const {
-        auto curve = [&](int px, int py) {
-            const SigmoidPolynomial &c = m_curves[size_t(py) * size_t(m_width) + size_t(px)];
-            return Color3f(c(lambda.r), c(lambda.g), c(lambda.b));
-        };
-        float x = uv.x * float(m_width), y = uv.y * float(m_height);
-        if (m_filter == FilterType::Nearest)
-            return curve(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
-        x -= 0.5f;
-        y -= 0.5f;
-        int x0 = floor_to_int(x), y0 = floor_to_int(y);
-        float fx = clamp(x - float(x0), 0.f, 1.f), fy = clamp(y - float(y0), 0.f, 1.f);
-        if (!std::isfinite(fx)) fx = 0.f;
-        if (!std::isfinite(fy)) fy = 0.f;
-        int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
-        int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
-        return (curve(xa, ya) * (1.f - fx) + curve(xb, ya) * fx) * (1.f - fy) +
-               (curve(xa, yb) * (1.f - fx) + curve(xb, yb) * fx) * fy;
+        return (value(xa, ya) * (1.f - fx) + value(xb, ya) * fx) * (1.f - fy) +
+               (value(xa, yb) * (1.f - fx) + value(xb, yb) * fx) * fy;
     }
 
     /// Gradient of the scalar (grey or luminance) bilinear lookup with respect to the transformed
