@@ -4,8 +4,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-
 namespace facet {
 
 Vector2f Texture::eval_1_grad(const SurfaceInteraction &) const {
@@ -25,7 +23,6 @@ public:
     Color3f eval_wavelengths(const Wavelengths &lambda) const override {
         return m_spectrum.eval(lambda);
     }
-    float max() const override { return m_spectrum.illuminant ? m_rgb.max() : m_spectrum.scale; }
     std::string to_string() const override {
         return fmt::format("RGBSpectrumTexture[rgb=[{}, {}, {}], scale={}, illuminant={}]", m_rgb.r,
                            m_rgb.g, m_rgb.b, m_spectrum.scale, m_spectrum.illuminant);
@@ -38,22 +35,17 @@ private:
 class DataSpectrumTexture final : public SpectralTexture {
 public:
     DataSpectrumTexture(SpectrumData data, SpectrumKind kind)
-        : SpectralTexture(spectrum_to_rgb(data, kind)), m_data(std::move(data)) {
-        m_max = 0.f;
-        for (double v : m_data.values) m_max = std::max(m_max, float(v));
-    }
+        : SpectralTexture(spectrum_to_rgb(data, kind)), m_data(std::move(data)) {}
     Color3f eval_wavelengths(const Wavelengths &lambda) const override {
         return {float(m_data.eval(lambda.r)), float(m_data.eval(lambda.g)),
                 float(m_data.eval(lambda.b))};
     }
-    float max() const override { return m_max; }
     std::string to_string() const override {
         return fmt::format("DataSpectrumTexture[{}]", m_data.to_string());
     }
 
 private:
     SpectrumData m_data;
-    float m_max;
 };
 
 } // namespace
