@@ -324,20 +324,23 @@ private:
     }
 
     /// Starts fetching the texel rows that sampling cells first..last reads.
+    /// Starts fetching every cache line of [begin, end).
+    static void prefetch_range(const void *begin, const void *end) {
+        const char *b = static_cast<const char *>(begin), *e = static_cast<const char *>(end);
+        for (const char *p = b; p < e; p += 64) prefetch_line(p);
+        prefetch_line(e - 1);
+    }
+
     void prefetch_cells(size_t first, size_t last) const {
         const size_t W = size_t(m_width);
         for (size_t j = first / W; j <= last / W; ++j) {
             const size_t i0 = j == first / W ? first % W : 0;
             const size_t i1 = j == last / W ? last % W + 1 : W;
             for (size_t row = j; row <= j + 1; ++row) {
-                const char *begin = reinterpret_cast<const char *>(&texel(int(i0), int(row)));
-                const char *end = reinterpret_cast<const char *>(&texel(int(i1), int(row)) + 1);
-                for (const char *p = begin; p < end; p += 64) prefetch_line(p);
-                prefetch_line(end - 1);
+                prefetch_range(&texel(int(i0), int(row)), &texel(int(i1), int(row)) + 1);
                 if (m_spectral) {
-                    const size_t k = row * (W + 1);
-                    prefetch_line(&m_scales[k + i0]);
-                    prefetch_line(&m_scales[k + i1]);
+                    const float *scales = m_scales.data() + row * (W + 1);
+                    prefetch_range(scales + i0, scales + i1 + 1);
                 }
             }
         }
