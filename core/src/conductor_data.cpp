@@ -105,7 +105,7 @@ ConductorIOR read_conductor_ior(const Properties &props) {
         } catch (const Error &e) {
             throw Error(props.location("material"), e.message());
         }
-        if (props.mode() == ColourMode::Spectral) {
+        if (is_spectral(props.mode())) {
             // The measured data per wavelength.
             auto spectra = conductor_eta_k_spectra(result.material);
             result.eta = data_spectrum_texture(spectra.first, SpectrumKind::Measured);

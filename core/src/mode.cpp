@@ -41,7 +41,8 @@ bool has_mode(const std::string &name) {
 } // namespace
 
 const std::vector<std::string> &modes() {
-    static const std::vector<std::string> list = {"scalar_rgb", "scalar_mono", "scalar_spectral"};
+    static const std::vector<std::string> list = {"scalar_rgb", "scalar_mono", "scalar_spectral",
+                                                  "scalar_spectral_polarized"};
     return list;
 }
 
@@ -78,6 +79,7 @@ ColourMode colour_mode(const std::string &mode) {
     if (mode == "scalar_rgb") return ColourMode::RGB;
     if (mode == "scalar_mono") return ColourMode::Mono;
     if (mode == "scalar_spectral") return ColourMode::Spectral;
+    if (mode == "scalar_spectral_polarized") return ColourMode::SpectralPolarized;
     FACET_THROW("\"{}\" is no mode facet renders (expected one of: {})", mode,
                 fmt::join(modes(), ", "));
 }
@@ -88,6 +90,8 @@ const char *mode_name(ColourMode mode) {
         return "scalar_mono";
     case ColourMode::Spectral:
         return "scalar_spectral";
+    case ColourMode::SpectralPolarized:
+        return "scalar_spectral_polarized";
     case ColourMode::RGB:
         break;
     }

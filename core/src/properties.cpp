@@ -272,7 +272,7 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
     if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) {
         // A spectrum plugin becomes the constant its use calls for (reflectance, emission, ...).
         if (auto spectrum = std::dynamic_pointer_cast<SpectrumTexture>(*obj)) {
-            if (m_mode != ColourMode::Spectral)
+            if (!is_spectral(m_mode))
                 return std::make_shared<ConstantTexture>(
                     spectrum_value(*spectrum, name, e.location, kind));
             try {
@@ -286,7 +286,7 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
         if (auto tex = std::dynamic_pointer_cast<Texture>(*obj)) return tex;
         type_error(name, "texture, rgb, spectrum or float");
     }
-    if (m_mode == ColourMode::Spectral) {
+    if (is_spectral(m_mode)) {
         // Numbers are flat spectra (an emitter's, like its rgb, has D65's colour); colours are
         // upsampled, spectra evaluated per wavelength.
         switch (Type(e.value.index())) {
@@ -333,7 +333,7 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKi
 std::shared_ptr<Texture> Properties::texture(const std::string &name, float def,
                                              SpectrumKind kind) const {
     if (!has(name))
-        return m_mode == ColourMode::Spectral && kind == SpectrumKind::Emission
+        return is_spectral(m_mode) && kind == SpectrumKind::Emission
                    ? rgb_spectrum_texture(Color3f(def), kind)
                    : std::make_shared<ConstantTexture>(Color3f(def));
     return texture(name, kind);
@@ -342,7 +342,7 @@ std::shared_ptr<Texture> Properties::texture(const std::string &name, float def,
 std::shared_ptr<Texture> Properties::texture(const std::string &name, const Color3f &def,
                                              SpectrumKind kind) const {
     if (!has(name)) {
-        if (m_mode == ColourMode::Spectral &&
+        if (is_spectral(m_mode) &&
             !(def.r == def.g && def.g == def.b && kind != SpectrumKind::Emission))
             return rgb_spectrum_texture(def, kind);
         return std::make_shared<ConstantTexture>(in_mode(def, m_mode));

@@ -123,7 +123,7 @@ public:
                 if (x == 0) texel(m_width, y).radiance = c; // column W is column 0 again
             }
         build_distribution();
-        if (props.mode() == ColourMode::Spectral) {
+        if (is_spectral(props.mode())) {
             // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
             // and the scale 2 max c, blended separately between pixels; radiance() multiplies
             // by D65, the spectrum of an RGB white light. The curve's coefficients replace the

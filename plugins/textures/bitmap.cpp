@@ -136,7 +136,7 @@ public:
         // The spectral mode upsamples each pixel of a colour image once, as a reflectance
         // (clamped to [0, 1], as Mitsuba's spectral bitmaps are); lookups blend the pixels'
         // spectra. Raw and grey images keep their values.
-        if (props.mode() == ColourMode::Spectral && !m_raw && m_channels == 3) {
+        if (is_spectral(props.mode()) && !m_raw && m_channels == 3) {
             m_curves.resize(size_t(m_width) * size_t(m_height));
             for (int y = 0; y < m_height; ++y)
                 for (int x = 0; x < m_width; ++x)

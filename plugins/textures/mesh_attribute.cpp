@@ -68,7 +68,7 @@ public:
         mesh->eval_attribute(*a, si, v);
         if (a->channels == 1) return Color3f(v[0] * m_scale);
         if (a->channels != 3) throw_channels(*mesh, *a, "a colour query needs 1 or 3");
-        if (m_mode == ColourMode::Spectral) {
+        if (is_spectral(m_mode)) {
             // The interpolated colour's spectrum (as a reflectance: clamped to [0, 1]).
             const SigmoidPolynomial c = rgb_to_sigmoid(Color3f(v[0], v[1], v[2]));
             const Wavelengths &l = si.wavelengths;

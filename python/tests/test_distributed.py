@@ -56,7 +56,7 @@ def test_a_mono_render_is_bit_identical_to_one_process(client, cornell):
     assert np.array_equal(image.pixels, single.pixels)
     assert np.array_equal(image.pixels[..., 0], image.pixels[..., 1])
     with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono, scalar_spectral"):
-        facet.distributed.render(cornell, client, params=PARAMS, mode="scalar_spectral_polarized")
+        facet.distributed.render(cornell, client, params=PARAMS, mode="scalar_rgb_polarized")
 
 
 def test_passes_are_bit_identical_to_one_process(client, cornell):

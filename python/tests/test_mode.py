@@ -17,7 +17,8 @@ def scene(cornell):
 
 
 def test_modes_lists_the_default_first():
-    assert facet.modes() == ["scalar_rgb", "scalar_mono", "scalar_spectral"]
+    assert facet.modes() == [
+        "scalar_rgb", "scalar_mono", "scalar_spectral", "scalar_spectral_polarized"]
 
 
 def test_scalar_rgb_is_the_default(scene):
@@ -43,7 +44,7 @@ def test_vectorised_name_renders_as_scalar_rgb_with_one_note(scene, capfd):
     assert image.metadata["facet:mode"] == "scalar_rgb"
 
 
-@pytest.mark.parametrize("mode", ["scalar_spectral_polarized", "cuda_mono_polarized", "foo",
+@pytest.mark.parametrize("mode", ["scalar_rgb_polarized", "cuda_mono_polarized", "foo",
                                   "scalar_rbg"])
 def test_errors_are_those_of_the_cli(scene, cornell, facet_cli, cli_env, mode):
     with pytest.raises(facet.Error) as raised:
@@ -118,7 +119,7 @@ def test_every_loader_takes_the_mode(cornell):
     assert facet.load_dict(d).mode == "scalar_rgb"
     assert facet.scene_info(cornell, mode="llvm_mono")["mode"] == "scalar_mono"
     with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono, scalar_spectral"):
-        facet.load_file(cornell, mode="scalar_spectral_polarized")
+        facet.load_file(cornell, mode="scalar_rgb_polarized")
     with pytest.raises(TypeError, match="mode=1"):
         facet.load_file(cornell, mode=1)
 
@@ -132,6 +133,6 @@ def test_chi2_builds_the_plugin_in_a_colour_mode():
     # so the two draw different histograms from the same samples.
     assert not np.array_equal(rgb.observed, mono.observed)
     with pytest.raises(facet.Error, match="scalar_rgb, scalar_mono, scalar_spectral"):
-        facet.chi2("bsdf", "diffuse", colour_mode="scalar_spectral_polarized")
+        facet.chi2("bsdf", "diffuse", colour_mode="scalar_rgb_polarized")
     with pytest.raises(TypeError, match="mode=2"):
         facet.chi2("emitter", "point", colour_mode=2)

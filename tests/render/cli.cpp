@@ -288,7 +288,9 @@ TEST_F(CliTest, PluginsPrintsOnePluginsTable) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*Parameter\s*\|\s*Type\s*\|)")))
         << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(\|\s*reflectance\s*\|)"))) << r.out;
-    EXPECT_NE(r.out.find("\nmodes: scalar_rgb, scalar_mono, scalar_spectral\n"), std::string::npos)
+    EXPECT_NE(r.out.find("\nmodes: scalar_rgb, scalar_mono, scalar_spectral, "
+                         "scalar_spectral_polarized\n"),
+              std::string::npos)
         << r.out;
 
     std::string line = expect_one_line_error("plugins difuse");
@@ -441,10 +443,10 @@ TEST_F(CliTest, ModeFacetDoesNotRenderIsRefusedBeforeTheSceneLoads) {
     // The scene file does not exist: the mode is refused first.
     std::string line = expect_one_line_error("render missing.xml -m scalar_rgb_polarized");
     EXPECT_EQ(line, "facet: error: facet does not render the mode \"scalar_rgb_polarized\"; the "
-                    "modes it renders: scalar_rgb, scalar_mono, scalar_spectral");
-    line = expect_one_line_error("render scene.xml more.xml --mode llvm_ad_spectral_polarized");
-    EXPECT_NE(line.find("(nor scalar_spectral_polarized, its scalar form)"), std::string::npos)
-        << line;
+                    "modes it renders: scalar_rgb, scalar_mono, scalar_spectral, "
+                    "scalar_spectral_polarized");
+    line = expect_one_line_error("render scene.xml more.xml --mode llvm_ad_mono_polarized");
+    EXPECT_NE(line.find("(nor scalar_mono_polarized, its scalar form)"), std::string::npos) << line;
     EXPECT_EQ(files(), std::set<std::string>{"scene.xml"});
 }
 
@@ -480,8 +482,11 @@ TEST_F(CliTest, InfoPrintsTheResolvedMode) {
     r = run("info scene.xml -m llvm_spectral");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.out.find("\nmode: scalar_spectral\n"), std::string::npos) << r.out;
-    const std::string line = expect_one_line_error("info scene.xml -m scalar_spectral_polarized");
-    EXPECT_NE(line.find("facet does not render the mode \"scalar_spectral_polarized\""),
+    r = run("info scene.xml -m scalar_spectral_polarized");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("\nmode: scalar_spectral_polarized\n"), std::string::npos) << r.out;
+    const std::string line = expect_one_line_error("info scene.xml -m scalar_rgb_polarized");
+    EXPECT_NE(line.find("facet does not render the mode \"scalar_rgb_polarized\""),
               std::string::npos)
         << line;
 }

@@ -10,7 +10,8 @@
 /// the one place a name a user typed (`facet render -m`, Python's `mode=`) becomes a mode.
 namespace facet {
 
-/// The modes facet renders in, the default first: {"scalar_rgb", "scalar_mono", "scalar_spectral"}.
+/// The modes facet renders in, the default first: {"scalar_rgb", "scalar_mono", "scalar_spectral",
+/// "scalar_spectral_polarized"}.
 /// The one list: a mode added here is accepted by every resolve_mode() caller, with its vectorised
 /// names.
 const std::vector<std::string> &modes();
@@ -42,22 +43,42 @@ std::string resolve_mode(const std::string &name);
  *   the path's radiance into CIE XYZ and then the film's RGB. Colours a scene gives become
  *   spectra (RGB by the sigmoid-polynomial model, spectra and measured data per wavelength), which
  *   textures evaluate at the interaction's wavelengths (see Properties::texture()).
+ * - `SpectralPolarized`: the spectral mode whose light carries its polarisation: a path's
+ *   radiance is a Stokes vector and a BSDF's value a Mueller matrix at each wavelength
+ *   (facet/mueller.h gives the conventions). Colours are read as in `Spectral`; BSDFs that do not
+ *   polarise depolarise (BSDF::sample_polarized()), emitters are unpolarised, and the film
+ *   records the intensity S0 (the `stokes` integrator records all four components).
  */
-enum class ColourMode : uint8_t { RGB, Mono, Spectral };
+enum class ColourMode : uint8_t { RGB, Mono, Spectral, SpectralPolarized };
+
+/// True in the modes whose values hold the quantity at the path's wavelengths.
+constexpr bool is_spectral(ColourMode mode) {
+    return mode == ColourMode::Spectral || mode == ColourMode::SpectralPolarized;
+}
+/// True in the mode whose light carries its polarisation.
+constexpr bool is_polarized(ColourMode mode) { return mode == ColourMode::SpectralPolarized; }
 
 /// The bit of `mode` in PluginDescriptor::modes.
 constexpr uint32_t mode_bit(ColourMode mode) { return 1u << uint32_t(mode); }
 /// The modes of a plugin that reads its colours through Properties and never looks at
 /// wavelengths: rgb and mono.
 constexpr uint32_t RGBAndMono = mode_bit(ColourMode::RGB) | mode_bit(ColourMode::Mono);
+/// The modes without polarisation: a plugin that evaluates its colours at
+/// Interaction::wavelengths in the spectral mode but would be wrong where light is polarised (a
+/// BSDF that polarises without BSDF::sample_polarized() and its siblings; an integrator that
+/// chains BSDF values as colours).
+constexpr uint32_t UnpolarizedModes = RGBAndMono | mode_bit(ColourMode::Spectral);
 /// Every mode: a plugin without colours (a shape, a sensor, a filter, a sampler), or one that
-/// evaluates its colours at Interaction::wavelengths in the spectral mode.
-constexpr uint32_t AllModes = RGBAndMono | mode_bit(ColourMode::Spectral);
+/// evaluates its colours at Interaction::wavelengths in the spectral modes, and in the polarized
+/// mode is unpolarised (an emitter), depolarises (a BSDF through the default
+/// BSDF::sample_polarized()) or carries the polarisation (the path integrator).
+constexpr uint32_t AllModes = UnpolarizedModes | mode_bit(ColourMode::SpectralPolarized);
 
 /// The ColourMode of one of modes() (a name resolve_mode() returned); throws facet::Error for any
 /// other name.
 ColourMode colour_mode(const std::string &mode);
-/// The name of a ColourMode in modes(): "scalar_rgb", "scalar_mono", "scalar_spectral".
+/// The name of a ColourMode in modes(): "scalar_rgb", "scalar_mono", "scalar_spectral",
+/// "scalar_spectral_polarized".
 const char *mode_name(ColourMode mode);
 
 /// A colour a scene gives (linear Rec.709) as `mode` renders it at load: in Mono its luminance in

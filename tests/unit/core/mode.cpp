@@ -92,12 +92,13 @@ TEST(Mode, TheNoteFollowsTheLogLevel) {
 
 TEST(Mode, MitsubaModesFacetLacksAreRefusedByName) {
     for (const char *name :
-         {"scalar_spectral_polarized", "scalar_mono_polarized", "scalar_rgb_polarized",
+         {"scalar_mono_polarized", "scalar_rgb_polarized", "scalar_spectral_polarized_double",
           "scalar_spectral_double", "scalar_rgb_double", "scalar_mono_polarized_double"}) {
         const Resolved r = resolve(name);
         EXPECT_EQ(r.mode, "") << name;
         EXPECT_EQ(r.error, fmt::format("facet does not render the mode \"{}\"; the modes it "
-                                       "renders: scalar_rgb, scalar_mono, scalar_spectral",
+                                       "renders: scalar_rgb, scalar_mono, scalar_spectral, "
+                                       "scalar_spectral_polarized",
                                        name));
         EXPECT_EQ(r.log, "") << name;
     }
@@ -105,7 +106,7 @@ TEST(Mode, MitsubaModesFacetLacksAreRefusedByName) {
 
 TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
     const std::vector<std::pair<const char *, const char *>> cases = {
-        {"cuda_ad_spectral_polarized", "scalar_spectral_polarized"},
+        {"cuda_ad_mono_polarized", "scalar_mono_polarized"},
         {"cuda_rgb_polarized", "scalar_rgb_polarized"},
         {"llvm_ad_rgb_double", "scalar_rgb_double"},
     };
@@ -113,7 +114,7 @@ TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
         const Resolved r = resolve(name);
         EXPECT_EQ(r.error, fmt::format("facet does not render the mode \"{}\" (nor {}, its scalar "
                                        "form); the modes it renders: scalar_rgb, scalar_mono, "
-                                       "scalar_spectral",
+                                       "scalar_spectral, scalar_spectral_polarized",
                                        name, scalar));
         EXPECT_EQ(r.log, "") << name;
     }
@@ -122,13 +123,14 @@ TEST(Mode, VectorisedNamesOfModesFacetLacksNameTheirScalarForm) {
 TEST(Mode, UnknownNamesListTheModesWithTheNearestName) {
     EXPECT_EQ(resolve("foo").error,
               "unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono, "
-              "scalar_spectral");
+              "scalar_spectral, scalar_spectral_polarized");
     EXPECT_EQ(resolve("").error,
               "unknown mode \"\"; the modes facet renders: scalar_rgb, scalar_mono, "
-              "scalar_spectral");
-    EXPECT_EQ(resolve("scalar_rbg").error, "unknown mode \"scalar_rbg\" (did you mean "
-                                           "\"scalar_rgb\"?); the modes facet renders: scalar_rgb, "
-                                           "scalar_mono, scalar_spectral");
+              "scalar_spectral, scalar_spectral_polarized");
+    EXPECT_EQ(resolve("scalar_rbg").error,
+              "unknown mode \"scalar_rbg\" (did you mean "
+              "\"scalar_rgb\"?); the modes facet renders: scalar_rgb, "
+              "scalar_mono, scalar_spectral, scalar_spectral_polarized");
     EXPECT_CONTAINS(resolve("llvm_rg").error, "(did you mean \"llvm_rgb\"?)");
     EXPECT_CONTAINS(resolve("SCALAR_RGB").error, "(did you mean \"scalar_rgb\"?)");
     // Not Mitsuba's names: scalar has no _ad_ form, and rgb comes before _polarized.
