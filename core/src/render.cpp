@@ -286,6 +286,7 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     uint32_t cap = 1;
     while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
     plan(integrator, cap, "samples");
+    integrator.begin_render(m_sensor);
     const std::vector<std::string> aov_names = integrator.aov_names();
     m_buffer = std::make_unique<FilmBuffer>(m_window.offset, m_window.size, aov_names);
 
@@ -346,7 +347,7 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     const int y0 = std::max(offset.y, grid.y0), y1 = std::min(offset.y + size.y, grid.y1);
     const ReconstructionFilter &filter = m_film.rfilter();
     const bool needs_aperture = m_sensor.needs_aperture_sample();
-    const bool spectral = m_scene.mode() == ColourMode::Spectral;
+    const bool spectral = is_spectral(m_scene.mode());
     const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
 
     uint64_t bad = 0, first_bad_pixel = UINT64_MAX;

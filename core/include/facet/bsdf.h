@@ -3,8 +3,10 @@
 #include <facet/color.h>
 #include <facet/interaction.h>
 #include <facet/logger.h>
+#include <facet/mueller.h>
 #include <facet/object.h>
 
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -19,6 +21,13 @@
  *   delta lobes have pdf 0 in `pdf` and their discrete probability in BSDFSample::pdf.
  * - Each method first checks that a lobe is enabled in the context and that wi is on a supported
  *   side. Two-sidedness belongs to the `twosided` adapter.
+ * - In the polarized mode the path integrator asks a BSDF flagged `Polarizing` for Mueller
+ *   matrices (sample_polarized(), eval_pdf_polarized()): the same quantities with every colour
+ *   value replaced by the matrix that maps the Stokes vector of the light arriving along −wo_hat
+ *   to that of the light leaving along wi_hat, in the implicit frames (mueller::stokes_basis()) of
+ *   those local directions. Light travels from wo to wi in radiance mode (wo_hat = wo,
+ *   wi_hat = si.wi) and from wi to wo in importance mode (wo_hat = si.wi, wi_hat = wo). Entry
+ *   (0, 0) of the matrix is the colour value the unpolarised methods return.
  */
 namespace facet {
 
@@ -41,6 +50,9 @@ enum class BSDFFlags : uint32_t {
     FrontSide = 0x8000,
     BackSide = 0x10000,
     NeedsDifferentials = 0x20000,
+    /// The BSDF's value depends on the polarisation of light, or changes it: the polarized mode
+    /// asks it for Mueller matrices. Others depolarise (mueller::depolarizer()).
+    Polarizing = 0x40000,
 
     Reflection = DiffuseReflection | DeltaReflection | Delta1DReflection | GlossyReflection,
     Transmission =
@@ -112,6 +124,26 @@ public:
                                                const Vector3f &wo) const {
         return {eval(ctx, si, wo), pdf(ctx, si, wo)};
     }
+    /**
+     * sample() in the polarized mode: the weight is a Mueller matrix (see the conventions above).
+     * The default, for BSDFs that do not polarise: light passed by a Null lobe keeps its
+     * polarisation (the identity times the weight), any other is depolarised.
+     */
+    virtual std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                            const SurfaceInteraction &si,
+                                                            float sample1,
+                                                            const Point2f &sample2) const {
+        auto [bs, weight] = sample(ctx, si, sample1, sample2);
+        return {bs, has_flag(bs.sampled_type, BSDFFlags::Null) ? Mueller::identity(weight)
+                                                               : mueller::depolarizer(weight)};
+    }
+    /// eval_pdf() in the polarized mode; the default depolarises.
+    virtual std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
+                                                         const SurfaceInteraction &si,
+                                                         const Vector3f &wo) const {
+        auto [value, pdf] = eval_pdf(ctx, si, wo);
+        return {mueller::depolarizer(value), pdf};
+    }
     /// Fraction of light passed straight through (wo = -wi) by Null lobes.
     virtual Color3f eval_null_transmission(const SurfaceInteraction &si) const {
         return Color3f(0.f);
@@ -141,5 +173,34 @@ protected:
     BSDFFlags m_flags = BSDFFlags::Empty;
     std::vector<BSDFFlags> m_components;
 };
+
+/**
+ * For BSDFs written once for both value types (adapters that combine nested BSDFs): `V` =
+ * Color3f calls sample()/eval_pdf(), `V` = Mueller the polarized mode's sample_polarized()/
+ * eval_pdf_polarized().
+ */
+template <typename V> std::pair<BSDFSample, V> sample_as(const BSDF &bsdf, const BSDFContext &ctx,
+                                                         const SurfaceInteraction &si,
+                                                         float sample1, const Point2f &sample2) {
+    if constexpr (std::is_same_v<V, Mueller>)
+        return bsdf.sample_polarized(ctx, si, sample1, sample2);
+    else
+        return bsdf.sample(ctx, si, sample1, sample2);
+}
+template <typename V> std::pair<V, float> eval_pdf_as(const BSDF &bsdf, const BSDFContext &ctx,
+                                                      const SurfaceInteraction &si,
+                                                      const Vector3f &wo) {
+    if constexpr (std::is_same_v<V, Mueller>)
+        return bsdf.eval_pdf_polarized(ctx, si, wo);
+    else
+        return bsdf.eval_pdf(ctx, si, wo);
+}
+/// A Null lobe's weight `w` as a V: the colour, or the matrix that passes the light unchanged.
+template <typename V> V null_weight(const Color3f &w) {
+    if constexpr (std::is_same_v<V, Mueller>)
+        return Mueller::identity(w);
+    else
+        return w;
+}
 
 } // namespace facet

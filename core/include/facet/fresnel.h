@@ -3,6 +3,8 @@
 #include <facet/color.h>
 #include <facet/vector.h>
 
+#include <complex>
+
 /// Fresnel equations and the reflection/refraction directions shared by the specular and
 /// microfacet BSDFs. All directions live in the local shading frame (normal = +Z) and point away
 /// from the surface.
@@ -66,6 +68,55 @@ inline float fresnel_conductor(float cos_i, float eta, float k) {
 inline Color3f fresnel_conductor(float cos_i, const Color3f &eta, const Color3f &k) {
     return {fresnel_conductor(cos_i, eta.r, k.r), fresnel_conductor(cos_i, eta.g, k.g),
             fresnel_conductor(cos_i, eta.b, k.b)};
+}
+
+/// Result of fresnel_polarized(): the complex amplitude reflection coefficients and the
+/// refraction's geometry.
+struct FresnelPolarized {
+    std::complex<float> a_s;    ///< amplitude of s-polarised light (perpendicular to the plane)
+    std::complex<float> a_p;    ///< amplitude of p-polarised light (in the plane of incidence)
+    float cos_t;                ///< as FresnelResult::cos_t (0 under total internal reflection)
+    std::complex<float> eta_it; ///< relative IOR η_t/η_i along the direction of travel
+    std::complex<float> eta_ti; ///< its reciprocal
+};
+
+/**
+ * The Fresnel equations with their phases, for light arriving with cosine `cos_i` at an
+ * interface of relative IOR `eta` = η_inside/η_outside, real (a dielectric) or n + ik (a
+ * conductor; either sign of k means the same absorbing metal). cos_i < 0: the light arrives
+ * from the inside.
+ *
+ * The signs are Verdet's (Mitsuba 3's): with θt the angle of refraction and η = η_it,
+ *   a_s = (cos θi − η cos θt) / (cos θi + η cos θt),
+ *   a_p = (η cos θi − cos θt) / (η cos θi + cos θt),
+ * so at normal incidence a_p = −a_s (for η > 1: a_s < 0 < a_p), and |a_s|² and |a_p|² are the
+ * reflectances the unpolarised fresnel_dielectric() averages. cos θt is the root of
+ * 1 − η_ti²·sin²θi with the sign that keeps refracted waves decaying: under total internal
+ * reflection it is −i·√|…|, which gives |a_s| = |a_p| = 1 and the phases of the evanescent wave.
+ * An index-matched interface (η = 1) reflects nothing. (The result is written to `out`: a
+ * structure of complex numbers returned by value draws an ABI note from GCC.)
+ */
+inline void fresnel_polarized(float cos_i, const std::complex<float> &eta_in,
+                              FresnelPolarized &out) {
+    using C = std::complex<float>;
+    C eta = eta_in;
+    // The formulas take the conductor's index as n − ik.
+    if (eta.imag() > 0.f) eta = std::conj(eta);
+    const bool outside = cos_i >= 0.f;
+    const C eta_it = outside ? eta : C(1.f) / eta, eta_ti = C(1.f) / eta_it;
+    C cos_t_2 = C(1.f) - eta_ti * eta_ti * (1.f - cos_i * cos_i);
+    // (+0: a negative zero imaginary part would flip std::sqrt's branch.)
+    cos_t_2 = C(cos_t_2.real(), cos_t_2.imag() + 0.f);
+    const float sign_t = cos_t_2.real() >= 0.f ? 1.f : -1.f;
+    const C ct = std::sqrt(cos_t_2) * sign_t;
+    const float ci = std::abs(cos_i);
+
+    C a_s = (ci - eta_it * ct) / (ci + eta_it * ct);
+    C a_p = (eta_it * ci - ct) / (eta_it * ci + ct);
+    const bool matched = std::norm(eta) == 1.f && eta.imag() == 0.f;
+    if (matched || eta == C(0.f)) a_s = a_p = C(0.f);
+    const float cos_t = cos_t_2.real() >= 0.f ? (outside ? -ct.real() : ct.real()) : 0.f;
+    out = {a_s, a_p, cos_t, eta_it, eta_ti};
 }
 
 /// Mirror direction about the shading normal: (−x, −y, z).

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <facet/color.h>
+#include <facet/mueller.h>
 #include <facet/object.h>
 #include <facet/ray.h>
 #include <facet/render.h>
@@ -55,6 +56,22 @@ public:
     /// on entry. A long loop inside one sample asks render_should_stop(iteration) (render.h).
     virtual Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray,
                            float *aovs) const = 0;
+    /**
+     * The polarized mode's whole answer: the Stokes vector of the light arriving along `ray`, in
+     * the implicit frame of its direction of travel (mueller::stokes_basis(-ray.d)); S0 is what
+     * sample() returns. Only integrators whose has_stokes() is true give more than that (the
+     * `stokes` integrator refuses the others); the default is sample()'s unpolarised light.
+     */
+    virtual Stokes sample_stokes(const Scene &scene, Sampler &sampler, const Ray &ray,
+                                 float *aovs) const {
+        return Stokes::unpolarized(sample(scene, sampler, ray, aovs));
+    }
+    /// True when sample_stokes() follows the polarisation of light in the polarized mode.
+    virtual bool has_stokes() const { return false; }
+    /// Called by the render loop before the first sample of a render from `sensor`, on one
+    /// thread: an integrator that needs the sensor (the `stokes` integrator's reference frame)
+    /// records it. One integrator renders from one sensor at a time.
+    virtual void begin_render(const Sensor & /*sensor*/) const {}
     /// Extra channels this integrator writes (e.g. "albedo.R"); none by default.
     virtual std::vector<std::string> aov_names() const { return {}; }
 
