@@ -43,7 +43,7 @@ public:
         m_eta = ior.eta;
         m_k = ior.k;
         m_specular_reflectance = props.texture("specular_reflectance", 1.f);
-        BSDFFlags flags = BSDFFlags::DeltaReflection | BSDFFlags::FrontSide;
+        BSDFFlags flags = BSDFFlags::DeltaReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
         if (varies(m_eta) || varies(m_k) || varies(m_specular_reflectance))
             flags |= BSDFFlags::SpatiallyVarying;
         set_components({flags});
@@ -63,6 +63,27 @@ public:
         bs.sampled_type = BSDFFlags::DeltaReflection;
         bs.sampled_component = 0;
         Color3f F = fresnel_conductor(cos_i, m_eta->eval(si), m_k->eval(si));
+        return {bs, F * m_specular_reflectance->eval(si)};
+    }
+
+    /// The polarized mode: the metal's Fresnel reflection with its phases.
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float /*sample1*/,
+                                                    const Point2f & /*sample2*/) const override {
+        BSDFSample bs;
+        if (!ctx.is_enabled(BSDFFlags::DeltaReflection, 0) || Frame::cos_theta(si.wi) <= 0.f)
+            return {bs, Mueller{}};
+        bs.wo = facet::reflect(si.wi);
+        bs.pdf = 1.f;
+        bs.eta = 1.f;
+        bs.sampled_type = BSDFFlags::DeltaReflection;
+        bs.sampled_component = 0;
+        // Light travels from wo_hat to wi_hat (BSDF's conventions).
+        const bool radiance = ctx.mode == TransportMode::Radiance;
+        const Vector3f wo_hat = radiance ? bs.wo : si.wi, wi_hat = radiance ? si.wi : bs.wo;
+        Mueller F =
+            mueller::specular_reflection(Frame::cos_theta(wo_hat), m_eta->eval(si), m_k->eval(si));
+        F = mueller::reflection_to_implicit(F, Vector3f(0.f, 0.f, 1.f), wo_hat, wi_hat);
         return {bs, F * m_specular_reflectance->eval(si)};
     }
 

@@ -49,6 +49,7 @@ public:
         BSDFFlags sides = BSDFFlags::FrontSide | BSDFFlags::BackSide;
         if (varies(m_specular_reflectance) || varies(m_specular_transmittance))
             sides |= BSDFFlags::SpatiallyVarying;
+        sides |= BSDFFlags::Polarizing;
         set_components({BSDFFlags::DeltaReflection | sides,
                         BSDFFlags::DeltaTransmission | sides | BSDFFlags::NonSymmetric});
     }
@@ -98,6 +99,32 @@ public:
         }
         if (!(bs.pdf > 0.f)) return {bs, Color3f(0.f)};
         return {bs, result};
+    }
+
+    /// The polarized mode: the same lobes and choice, the Fresnel matrices of the interface in
+    /// place of F and 1 − F.
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float sample1,
+                                                    const Point2f &sample2) const override {
+        auto [bs, weight] = sample(ctx, si, sample1, sample2);
+        if (weight.is_black()) return {bs, Mueller{}};
+        const bool reflected = bs.sampled_type == BSDFFlags::DeltaReflection;
+        // With one lobe enabled it is taken with probability 1 and carries its Fresnel term.
+        const bool both = ctx.is_enabled(BSDFFlags::DeltaReflection, 0) &&
+                          ctx.is_enabled(BSDFFlags::DeltaTransmission, 1);
+        const bool radiance = ctx.mode == TransportMode::Radiance;
+        const Vector3f wo_hat = radiance ? bs.wo : si.wi, wi_hat = radiance ? si.wi : bs.wo;
+        const float cos_hat = Frame::cos_theta(wo_hat);
+        Mueller M = reflected ? mueller::specular_reflection(cos_hat, m_eta)
+                              : mueller::specular_transmission(cos_hat, m_eta);
+        M = mueller::reflection_to_implicit(M, Vector3f(0.f, 0.f, 1.f), wo_hat, wi_hat);
+        float scale = both ? 1.f / bs.pdf : 1.f;
+        if (!reflected && radiance) scale /= bs.eta * bs.eta; // η_ti², as sample() does
+        Color3f tint(scale);
+        const Texture *t =
+            reflected ? m_specular_reflectance.get() : m_specular_transmittance.get();
+        if (t) tint *= t->eval(si);
+        return {bs, M * tint};
     }
 
     /// Delta lobes only: no density with respect to solid angle.

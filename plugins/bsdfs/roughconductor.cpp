@@ -52,7 +52,8 @@ public:
         m_k = ior.k;
         m_specular_reflectance = props.texture("specular_reflectance", 1.f);
 
-        BSDFFlags flags = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide;
+        BSDFFlags flags =
+            BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
         if (m_microfacet.is_anisotropic()) flags |= BSDFFlags::Anisotropic;
         if (m_microfacet.is_spatially_varying() || varies(m_eta) || varies(m_k) ||
             varies(m_specular_reflectance))
@@ -64,21 +65,7 @@ public:
                                           float /*sample1*/,
                                           const Point2f &sample2) const override {
         BSDFSample bs;
-        float cos_i = Frame::cos_theta(si.wi);
-        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f)
-            return {bs, Color3f(0.f)};
-
-        MicrofacetDistribution distr = m_microfacet.at(si);
-        auto [m, pdf_m] = distr.sample(si.wi, sample2);
-        float wi_dot_m = dot(si.wi, m);
-        if (!(pdf_m > 0.f) || wi_dot_m <= 0.f) return {bs, Color3f(0.f)};
-
-        bs.wo = facet::reflect(si.wi, m);
-        bs.eta = 1.f;
-        bs.sampled_type = BSDFFlags::GlossyReflection;
-        bs.sampled_component = 0;
-        if (Frame::cos_theta(bs.wo) <= 0.f) return {bs, Color3f(0.f)};
-
+        if (!sample_direction(ctx, si, sample2, bs)) return {bs, Color3f(0.f)};
         // The weight F·G1(wo, m) (visible normals) or F·G·(wi·m)/(cos θi·cos θm) (all normals)
         // is evaluated as eval/pdf at wo: near grazing back-scattering, recovering m from
         // (wi, wo) is ill-conditioned in float, and this way bs.pdf is exactly what pdf() and
@@ -87,6 +74,17 @@ public:
         if (!(pdf > 0.f) || value.is_black()) return {bs, Color3f(0.f)};
         bs.pdf = pdf;
         return {bs, value / pdf};
+    }
+
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float /*sample1*/,
+                                                    const Point2f &sample2) const override {
+        BSDFSample bs;
+        if (!sample_direction(ctx, si, sample2, bs)) return {bs, Mueller{}};
+        auto [value, pdf] = eval_pdf_polarized(ctx, si, bs.wo);
+        if (!(pdf > 0.f) || value.unpolarized().is_black()) return {bs, Mueller{}};
+        bs.pdf = pdf;
+        return {bs, value * Color3f(1.f / pdf)};
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
@@ -121,6 +119,27 @@ public:
         return {F * m_specular_reflectance->eval(si) * value, pdf};
     }
 
+    /// The polarized mode: each microfacet reflects as the smooth conductor does, in the frames
+    /// of its own plane of incidence.
+    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
+                                                 const SurfaceInteraction &si,
+                                                 const Vector3f &wo) const override {
+        float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f || cos_o <= 0.f)
+            return {Mueller{}, 0.f};
+        MicrofacetDistribution distr = m_microfacet.at(si);
+        Vector3f h = normalize(si.wi + wo);
+        float D = distr.eval(h);
+        if (D == 0.f) return {Mueller{}, 0.f};
+        float value = D * distr.G(si.wi, wo, h) / (4.f * cos_i);
+        const bool radiance = ctx.mode == TransportMode::Radiance;
+        const Vector3f wo_hat = radiance ? wo : si.wi, wi_hat = radiance ? si.wi : wo;
+        Mueller F = mueller::specular_reflection(dot(wo_hat, h), m_eta->eval(si), m_k->eval(si));
+        F = mueller::reflection_to_implicit(F, h, wo_hat, wi_hat);
+        float pdf = distr.pdf(si.wi, h) / (4.f * dot(wo, h));
+        return {F * (m_specular_reflectance->eval(si) * value), pdf};
+    }
+
     std::string to_string() const override {
         return fmt::format("RoughConductor[{}, material = {}, eta = {}, k = {}, "
                            "specular_reflectance = {}]",
@@ -129,6 +148,22 @@ public:
     }
 
 private:
+    /// Draws a microfacet normal and reflects wi about it into bs (all but the pdf); false when
+    /// the sample fails.
+    bool sample_direction(const BSDFContext &ctx, const SurfaceInteraction &si,
+                          const Point2f &sample2, BSDFSample &bs) const {
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || Frame::cos_theta(si.wi) <= 0.f)
+            return false;
+        MicrofacetDistribution distr = m_microfacet.at(si);
+        auto [m, pdf_m] = distr.sample(si.wi, sample2);
+        if (!(pdf_m > 0.f) || dot(si.wi, m) <= 0.f) return false;
+        bs.wo = facet::reflect(si.wi, m);
+        bs.eta = 1.f;
+        bs.sampled_type = BSDFFlags::GlossyReflection;
+        bs.sampled_component = 0;
+        return Frame::cos_theta(bs.wo) > 0.f;
+    }
+
     MicrofacetParameters m_microfacet;
     std::string m_material;
     std::shared_ptr<Texture> m_eta, m_k, m_specular_reflectance;
