@@ -84,46 +84,18 @@ public:
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
                                           float sample1, const Point2f &sample2) const override {
-        float w = weight(si);
-        if (ctx.component != uint32_t(-1)) {
-            // One component: only its BSDF is sampled, and carries its blend factor.
-            BSDFContext sub;
-            int which = route(ctx, sub);
-            auto [bs, value] = m_nested[which]->sample(sub, si, sample1, sample2);
-            if (which == 1 && bs.sampled_component != uint32_t(-1))
-                bs.sampled_component += m_first_count;
-            return {bs, value * (which == 0 ? 1.f - w : w)};
-        }
-
-        // Pick the second BSDF with probability w and rescale sample1 for its own lobe choice.
-        int which;
-        float u;
-        if (sample1 < w) {
-            which = 1;
-            u = sample1 / w;
-        } else {
-            which = 0;
-            u = (sample1 - w) / (1.f - w);
-        }
-        u = clamp(u, 0.f, OneMinusEpsilon);
-        float p_which = which == 1 ? w : 1.f - w;
-        auto [bs, value] = m_nested[which]->sample(ctx, si, u, sample2);
-        if (which == 1 && bs.sampled_component != uint32_t(-1))
-            bs.sampled_component += m_first_count;
-        if (value.is_black() || !(p_which > 0.f)) return {bs, Color3f(0.f)};
-
-        // As in Mitsuba 3, the sample is weighted by the blend on the sampled direction: the
-        // picked BSDF contributes its own value and density (for a delta lobe, its discrete
-        // weight and probability, treated like a value and a density), the other BSDF its eval
-        // and pdf there. A delta sample thus picks up the other BSDF's smooth value too.
-        float pdf_picked = bs.pdf;
-        Color3f f_picked = value * pdf_picked;
-        auto [f_other, pdf_other] = m_nested[1 - which]->eval_pdf(ctx, si, bs.wo);
-        float blend_pdf = p_which * pdf_picked + (1.f - p_which) * pdf_other;
-        Color3f blend_value = f_picked * p_which + f_other * (1.f - p_which);
-        if (!(blend_pdf > 0.f) || blend_value.is_black()) return {bs, Color3f(0.f)};
-        bs.pdf = blend_pdf;
-        return {bs, blend_value / blend_pdf};
+        return sample_impl<Color3f>(ctx, si, sample1, sample2);
+    }
+    /// The polarized mode: the same blend of the nested BSDFs' matrices.
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float sample1,
+                                                    const Point2f &sample2) const override {
+        return sample_impl<Mueller>(ctx, si, sample1, sample2);
+    }
+    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
+                                                 const SurfaceInteraction &si,
+                                                 const Vector3f &wo) const override {
+        return eval_pdf_impl<Mueller>(ctx, si, wo);
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
@@ -156,26 +128,7 @@ public:
 
     std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
                                        const Vector3f &wo) const override {
-        float w = weight(si);
-        if (ctx.component != uint32_t(-1)) {
-            BSDFContext sub;
-            int which = route(ctx, sub);
-            auto [value, pdf] = m_nested[which]->eval_pdf(sub, si, wo);
-            return {value * (which == 0 ? 1.f - w : w), pdf};
-        }
-        Color3f value(0.f);
-        float pdf = 0.f;
-        if (w < 1.f) {
-            auto [v0, p0] = m_nested[0]->eval_pdf(ctx, si, wo);
-            value += v0 * (1.f - w);
-            pdf += p0 * (1.f - w);
-        }
-        if (w > 0.f) {
-            auto [v1, p1] = m_nested[1]->eval_pdf(ctx, si, wo);
-            value += v1 * w;
-            pdf += p1 * w;
-        }
-        return {value, pdf};
+        return eval_pdf_impl<Color3f>(ctx, si, wo);
     }
 
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {
@@ -201,6 +154,75 @@ public:
     }
 
 private:
+    template <typename V>
+    std::pair<BSDFSample, V> sample_impl(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                         float sample1, const Point2f &sample2) const {
+        float w = weight(si);
+        if (ctx.component != uint32_t(-1)) {
+            // One component: only its BSDF is sampled, and carries its blend factor.
+            BSDFContext sub;
+            int which = route(ctx, sub);
+            auto [bs, value] = sample_as<V>(*m_nested[which], sub, si, sample1, sample2);
+            if (which == 1 && bs.sampled_component != uint32_t(-1))
+                bs.sampled_component += m_first_count;
+            return {bs, value * (which == 0 ? 1.f - w : w)};
+        }
+
+        // Pick the second BSDF with probability w and rescale sample1 for its own lobe choice.
+        int which;
+        float u;
+        if (sample1 < w) {
+            which = 1;
+            u = sample1 / w;
+        } else {
+            which = 0;
+            u = (sample1 - w) / (1.f - w);
+        }
+        u = clamp(u, 0.f, OneMinusEpsilon);
+        float p_which = which == 1 ? w : 1.f - w;
+        auto [bs, value] = sample_as<V>(*m_nested[which], ctx, si, u, sample2);
+        if (which == 1 && bs.sampled_component != uint32_t(-1))
+            bs.sampled_component += m_first_count;
+        if (value.is_black() || !(p_which > 0.f)) return {bs, V{}};
+
+        // As in Mitsuba 3, the sample is weighted by the blend on the sampled direction: the
+        // picked BSDF contributes its own value and density (for a delta lobe, its discrete
+        // weight and probability, treated like a value and a density), the other BSDF its eval
+        // and pdf there. A delta sample thus picks up the other BSDF's smooth value too.
+        float pdf_picked = bs.pdf;
+        V f_picked = value * pdf_picked;
+        auto [f_other, pdf_other] = eval_pdf_as<V>(*m_nested[1 - which], ctx, si, bs.wo);
+        float blend_pdf = p_which * pdf_picked + (1.f - p_which) * pdf_other;
+        V blend_value = f_picked * p_which + f_other * (1.f - p_which);
+        if (!(blend_pdf > 0.f) || blend_value.is_black()) return {bs, V{}};
+        bs.pdf = blend_pdf;
+        return {bs, blend_value / blend_pdf};
+    }
+
+    template <typename V> std::pair<V, float>
+    eval_pdf_impl(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const {
+        float w = weight(si);
+        if (ctx.component != uint32_t(-1)) {
+            BSDFContext sub;
+            int which = route(ctx, sub);
+            auto [value, pdf] = eval_pdf_as<V>(*m_nested[which], sub, si, wo);
+            return {value * (which == 0 ? 1.f - w : w), pdf};
+        }
+        V value{};
+        float pdf = 0.f;
+        if (w < 1.f) {
+            auto [v0, p0] = eval_pdf_as<V>(*m_nested[0], ctx, si, wo);
+            value += v0 * (1.f - w);
+            pdf += p0 * (1.f - w);
+        }
+        if (w > 0.f) {
+            auto [v1, p1] = eval_pdf_as<V>(*m_nested[1], ctx, si, wo);
+            value += v1 * w;
+            pdf += p1 * w;
+        }
+        return {value, pdf};
+    }
+
     float weight(const SurfaceInteraction &si) const {
         return clamp(m_weight->eval_1(si), 0.f, 1.f);
     }

@@ -72,31 +72,19 @@ public:
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
                                           float sample1, const Point2f &sample2) const override {
-        bool has_null = ctx.is_enabled(BSDFFlags::Null, m_null_index);
-        bool has_nested = nested_enabled(ctx);
-        BSDFSample bs;
-        if (!has_null && !has_nested) return {bs, Color3f(0.f)};
-
-        float alpha = opacity(si);
-        // With one part disabled the other is always taken and carries its share in the weight.
-        float p_nested = selection_opacity(alpha, has_null, has_nested);
-        if (sample1 < p_nested) {
-            // Reuse sample1 for the nested BSDF's own lobe choice.
-            auto [nested_bs, weight] =
-                m_nested->sample(ctx, si, std::min(sample1 / p_nested, OneMinusEpsilon), sample2);
-            // Value and density scale by alpha and p_nested: alpha·f / (p_nested·pdf).
-            nested_bs.pdf *= p_nested;
-            if (p_nested != alpha) weight *= alpha / p_nested;
-            return {nested_bs, weight};
-        }
-        bs.wo = -si.wi;
-        bs.pdf = 1.f - p_nested;
-        bs.eta = 1.f;
-        bs.sampled_type = BSDFFlags::Null;
-        bs.sampled_component = m_null_index;
-        // Value (1 − opacity) over its probability (1 − opacity, or 1 when alone).
-        if (!(bs.pdf > 0.f) || alpha >= 1.f) return {bs, Color3f(0.f)};
-        return {bs, Color3f((1.f - alpha) / bs.pdf)};
+        return sample_impl<Color3f>(ctx, si, sample1, sample2);
+    }
+    /// The polarized mode: the nested BSDF's matrices; the light passed through keeps its
+    /// polarisation.
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float sample1,
+                                                    const Point2f &sample2) const override {
+        return sample_impl<Mueller>(ctx, si, sample1, sample2);
+    }
+    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
+                                                 const SurfaceInteraction &si,
+                                                 const Vector3f &wo) const override {
+        return eval_pdf_impl<Mueller>(ctx, si, wo);
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
@@ -115,12 +103,7 @@ public:
 
     std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
                                        const Vector3f &wo) const override {
-        bool has_null = ctx.is_enabled(BSDFFlags::Null, m_null_index);
-        bool has_nested = nested_enabled(ctx);
-        if (!has_nested) return {Color3f(0.f), 0.f};
-        auto [value, pdf] = m_nested->eval_pdf(ctx, si, wo);
-        float alpha = opacity(si);
-        return {value * alpha, pdf * selection_opacity(alpha, has_null, has_nested)};
+        return eval_pdf_impl<Color3f>(ctx, si, wo);
     }
 
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {
@@ -139,6 +122,46 @@ public:
     }
 
 private:
+    template <typename V>
+    std::pair<BSDFSample, V> sample_impl(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                         float sample1, const Point2f &sample2) const {
+        bool has_null = ctx.is_enabled(BSDFFlags::Null, m_null_index);
+        bool has_nested = nested_enabled(ctx);
+        BSDFSample bs;
+        if (!has_null && !has_nested) return {bs, V{}};
+
+        float alpha = opacity(si);
+        // With one part disabled the other is always taken and carries its share in the weight.
+        float p_nested = selection_opacity(alpha, has_null, has_nested);
+        if (sample1 < p_nested) {
+            // Reuse sample1 for the nested BSDF's own lobe choice.
+            auto [nested_bs, weight] = sample_as<V>(
+                *m_nested, ctx, si, std::min(sample1 / p_nested, OneMinusEpsilon), sample2);
+            // Value and density scale by alpha and p_nested: alpha·f / (p_nested·pdf).
+            nested_bs.pdf *= p_nested;
+            if (p_nested != alpha) weight = weight * (alpha / p_nested);
+            return {nested_bs, weight};
+        }
+        bs.wo = -si.wi;
+        bs.pdf = 1.f - p_nested;
+        bs.eta = 1.f;
+        bs.sampled_type = BSDFFlags::Null;
+        bs.sampled_component = m_null_index;
+        // Value (1 − opacity) over its probability (1 − opacity, or 1 when alone).
+        if (!(bs.pdf > 0.f) || alpha >= 1.f) return {bs, V{}};
+        return {bs, null_weight<V>(Color3f((1.f - alpha) / bs.pdf))};
+    }
+
+    template <typename V> std::pair<V, float>
+    eval_pdf_impl(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const {
+        bool has_null = ctx.is_enabled(BSDFFlags::Null, m_null_index);
+        bool has_nested = nested_enabled(ctx);
+        if (!has_nested) return {V{}, 0.f};
+        auto [value, pdf] = eval_pdf_as<V>(*m_nested, ctx, si, wo);
+        float alpha = opacity(si);
+        return {value * alpha, pdf * selection_opacity(alpha, has_null, has_nested)};
+    }
+
     float opacity(const SurfaceInteraction &si) const {
         return clamp(m_opacity->eval_1(si), 0.f, 1.f);
     }

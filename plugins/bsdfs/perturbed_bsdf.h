@@ -75,12 +75,52 @@ public:
         return {value, pdf};
     }
 
+    /// The polarized mode: the nested BSDF's matrix, turned from the implicit frames of the
+    /// perturbed frame's directions into those of the unperturbed frame's.
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float sample1,
+                                                    const Point2f &sample2) const override {
+        Frame local;
+        SurfaceInteraction psi = perturb(si, local);
+        auto [bs, weight] = m_nested->sample_polarized(ctx, psi, sample1, sample2);
+        if (weight.is_black()) return {bs, Mueller{}};
+        Vector3f wo = local.to_world(bs.wo);
+        if (!(Frame::cos_theta(bs.wo) * Frame::cos_theta(wo) > 0.f)) {
+            bs.pdf = 0.f;
+            return {bs, Mueller{}};
+        }
+        weight = to_unperturbed(ctx, local, weight, psi.wi, bs.wo);
+        bs.wo = wo;
+        if (m_use_shadowing) weight = weight * shadow_terminator(local.n, wo);
+        return {bs, weight};
+    }
+    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
+                                                 const SurfaceInteraction &si,
+                                                 const Vector3f &wo) const override {
+        Frame local;
+        SurfaceInteraction psi = perturb(si, local);
+        Vector3f pwo = local.to_local(wo);
+        if (!(Frame::cos_theta(wo) * Frame::cos_theta(pwo) > 0.f)) return {Mueller{}, 0.f};
+        auto [value, pdf] = m_nested->eval_pdf_polarized(ctx, psi, pwo);
+        value = to_unperturbed(ctx, local, value, psi.wi, pwo);
+        if (m_use_shadowing) value = value * shadow_terminator(local.n, wo);
+        return {value, pdf};
+    }
+
     /// The pass-through of a nested Null lobe does not depend on the normal.
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {
         return m_nested->eval_null_transmission(si);
     }
     Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const override {
         return m_nested->eval_diffuse_reflectance(si);
+    }
+
+    /// A nested matrix between the implicit frames of the perturbed directions wi, wo (light
+    /// from wo to wi in radiance mode, BSDF's conventions), between those of the unperturbed.
+    static Mueller to_unperturbed(const BSDFContext &ctx, const Frame &local, const Mueller &M,
+                                  const Vector3f &wi, const Vector3f &wo) {
+        const bool radiance = ctx.mode == TransportMode::Radiance;
+        return mueller::to_world(local, M, radiance ? -wo : -wi, radiance ? wi : wo);
     }
 
     /// The perturbed frame relative to si.sh_frame (normal = the perturbed normal, flipped to

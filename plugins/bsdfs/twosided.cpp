@@ -73,17 +73,19 @@ public:
 
     std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
                                           float sample1, const Point2f &sample2) const override {
-        float cos_i = Frame::cos_theta(si.wi);
-        if (cos_i > 0.f) {
-            if (!front_enabled(ctx)) return {BSDFSample(), Color3f(0.f)};
-            return m_front->sample(ctx, si, sample1, sample2);
-        }
-        BSDFContext back_ctx;
-        if (cos_i == 0.f || !back_context(ctx, back_ctx)) return {BSDFSample(), Color3f(0.f)};
-        auto [bs, weight] = m_back->sample(back_ctx, mirrored(si), sample1, sample2);
-        bs.wo.z = -bs.wo.z;
-        if (bs.sampled_component != uint32_t(-1)) bs.sampled_component += m_front_count;
-        return {bs, weight};
+        return sample_impl<Color3f>(ctx, si, sample1, sample2);
+    }
+    /// The polarized mode: the side's BSDF's matrix, as Mitsuba 3 gives it (the back side's in
+    /// the mirrored frame).
+    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
+                                                    const SurfaceInteraction &si, float sample1,
+                                                    const Point2f &sample2) const override {
+        return sample_impl<Mueller>(ctx, si, sample1, sample2);
+    }
+    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
+                                                 const SurfaceInteraction &si,
+                                                 const Vector3f &wo) const override {
+        return eval_pdf_impl<Mueller>(ctx, si, wo);
     }
 
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
@@ -112,14 +114,7 @@ public:
 
     std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
                                        const Vector3f &wo) const override {
-        float cos_i = Frame::cos_theta(si.wi);
-        if (cos_i > 0.f) {
-            if (!front_enabled(ctx)) return {Color3f(0.f), 0.f};
-            return m_front->eval_pdf(ctx, si, wo);
-        }
-        BSDFContext back_ctx;
-        if (cos_i == 0.f || !back_context(ctx, back_ctx)) return {Color3f(0.f), 0.f};
-        return m_back->eval_pdf(back_ctx, mirrored(si), mirror(wo));
+        return eval_pdf_impl<Color3f>(ctx, si, wo);
     }
 
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {
@@ -148,6 +143,34 @@ public:
     }
 
 private:
+    template <typename V>
+    std::pair<BSDFSample, V> sample_impl(const BSDFContext &ctx, const SurfaceInteraction &si,
+                                         float sample1, const Point2f &sample2) const {
+        float cos_i = Frame::cos_theta(si.wi);
+        if (cos_i > 0.f) {
+            if (!front_enabled(ctx)) return {BSDFSample(), V{}};
+            return sample_as<V>(*m_front, ctx, si, sample1, sample2);
+        }
+        BSDFContext back_ctx;
+        if (cos_i == 0.f || !back_context(ctx, back_ctx)) return {BSDFSample(), V{}};
+        auto [bs, weight] = sample_as<V>(*m_back, back_ctx, mirrored(si), sample1, sample2);
+        bs.wo.z = -bs.wo.z;
+        if (bs.sampled_component != uint32_t(-1)) bs.sampled_component += m_front_count;
+        return {bs, weight};
+    }
+
+    template <typename V> std::pair<V, float>
+    eval_pdf_impl(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo) const {
+        float cos_i = Frame::cos_theta(si.wi);
+        if (cos_i > 0.f) {
+            if (!front_enabled(ctx)) return {V{}, 0.f};
+            return eval_pdf_as<V>(*m_front, ctx, si, wo);
+        }
+        BSDFContext back_ctx;
+        if (cos_i == 0.f || !back_context(ctx, back_ctx)) return {V{}, 0.f};
+        return eval_pdf_as<V>(*m_back, back_ctx, mirrored(si), mirror(wo));
+    }
+
     static Vector3f mirror(const Vector3f &v) { return {v.x, v.y, -v.z}; }
     static SurfaceInteraction mirrored(const SurfaceInteraction &si) {
         SurfaceInteraction back = si;
