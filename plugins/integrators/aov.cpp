@@ -95,6 +95,10 @@ public:
         return names;
     }
 
+    void begin_render(const Sensor &sensor) const override {
+        if (m_nested) m_nested->begin_render(sensor);
+    }
+
     Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray,
                    float *aovs) const override {
         Color3f result(0.f);

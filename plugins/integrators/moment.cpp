@@ -78,6 +78,10 @@ public:
         return result;
     }
 
+    void begin_render(const Sensor &sensor) const override {
+        for (const Nested &n : m_nested) n.integrator->begin_render(sensor);
+    }
+
     std::vector<std::string> aov_names() const override { return m_names; }
 
     std::string to_string() const override {

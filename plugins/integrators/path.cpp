@@ -28,6 +28,8 @@ bounces, Russian roulette ends paths whose throughput has become small.
 #include <facet/frame.h>
 #include <facet/integrator.h>
 #include <facet/mis.h>
+#include <facet/mode.h>
+#include <facet/mueller.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/sampler.h>
@@ -37,6 +39,8 @@ bounces, Russian roulette ends paths whose throughput has become small.
 #include <fmt/format.h>
 
 #include <limits>
+#include <tuple>
+#include <type_traits>
 
 namespace facet {
 
@@ -46,15 +50,50 @@ public:
         m_max_depth = read_max_depth(props, "path");
         m_rr_depth = read_rr_depth(props, "path");
         m_hide_emitters = props.get_bool("hide_emitters", false);
+        m_polarized = is_polarized(props.mode());
     }
 
     Color3f sample(const Scene &scene, Sampler &sampler, const Ray &camera_ray,
                    float * /*aovs*/) const override {
-        if (m_max_depth == 0) return Color3f(0.f);
+        if (m_polarized) return trace<true>(scene, sampler, camera_ray).s[0];
+        return trace<false>(scene, sampler, camera_ray);
+    }
+
+    Stokes sample_stokes(const Scene &scene, Sampler &sampler, const Ray &camera_ray,
+                         float * /*aovs*/) const override {
+        if (m_polarized) return trace<true>(scene, sampler, camera_ray);
+        return Stokes::unpolarized(trace<false>(scene, sampler, camera_ray));
+    }
+    bool has_stokes() const override { return true; }
+
+    std::string to_string() const override {
+        return fmt::format("PathIntegrator[max_depth = {}, rr_depth = {}, hide_emitters = {}]",
+                           m_max_depth == std::numeric_limits<uint32_t>::max()
+                               ? std::string("-1")
+                               : std::to_string(m_max_depth),
+                           m_rr_depth, m_hide_emitters);
+    }
+
+private:
+    /// The path's radiance: a colour, or in the polarized mode (Polarized) the Stokes vector of
+    /// the light arriving along the camera ray. The polarized path's throughput is a Mueller
+    /// matrix in the world's implicit frames (mueller.h): the product of the BSDF matrices along
+    /// the path, each turned from its local frame (mueller::to_world()); unpolarised emitted
+    /// light adds its first column times the radiance.
+    template <bool Polarized> std::conditional_t<Polarized, Stokes, Color3f>
+    trace(const Scene &scene, Sampler &sampler, const Ray &camera_ray) const {
+        using Value = std::conditional_t<Polarized, Stokes, Color3f>;
+        using Throughput = std::conditional_t<Polarized, Mueller, Color3f>;
+        if (m_max_depth == 0) return Value{};
 
         const BSDFContext ctx;
         Ray ray = camera_ray;
-        Color3f result(0.f), throughput(1.f);
+        Value result{};
+        Throughput throughput;
+        if constexpr (Polarized)
+            throughput = Mueller::identity();
+        else
+            throughput = Color3f(1.f);
         float eta = 1.f;
         uint32_t depth = 0;
         SurfaceInteraction si;
@@ -70,8 +109,9 @@ public:
             // ---- Emission found by the previous BSDF sample (or by the camera ray) ----
             if (!hit) {
                 if (count_emission)
-                    result += throughput *
-                              environment_mis(scene, si, prev_si, prev_bsdf_pdf, prev_bsdf_delta);
+                    add_emission(
+                        result, throughput,
+                        environment_mis(scene, si, prev_si, prev_bsdf_pdf, prev_bsdf_delta));
                 break;
             }
             // The emitter and BSDF of the shape hit, read inline (si.emitter() and si.bsdf()
@@ -87,7 +127,7 @@ public:
                                 scene.pdf_emitter_direction(prev_si, direction_to(si, prev_si));
                             w = mis_weight(prev_bsdf_pdf, em_pdf);
                         }
-                        result += throughput * L * w;
+                        add_emission(result, throughput, L * w);
                     }
                 }
             }
@@ -104,7 +144,19 @@ public:
             float sample1 = sampler.draw_1d();
             Point2f sample2 = sampler.draw_2d();
             FACET_ASSERT(Frame::is_unit(si.wi));
-            auto [bs, bsdf_weight] = bsdf->sample(ctx, si, sample1, sample2);
+            // In the polarized mode a BSDF that polarises gives Mueller matrices; the others'
+            // colours depolarise (or pass the light unchanged, through a Null lobe).
+            const bool polarizing = Polarized && has_flag(bsdf->flags(), BSDFFlags::Polarizing);
+            BSDFSample bs;
+            Color3f bsdf_weight;
+            Mueller bsdf_mueller;
+            if (polarizing) {
+                std::tie(bs, bsdf_mueller) = bsdf->sample_polarized(ctx, si, sample1, sample2);
+                FACET_ASSERT(bsdf_mueller.is_finite());
+                bsdf_weight = bsdf_mueller.unpolarized();
+            } else {
+                std::tie(bs, bsdf_weight) = bsdf->sample(ctx, si, sample1, sample2);
+            }
             FACET_ASSERT(bsdf_weight.is_finite());
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
@@ -116,11 +168,31 @@ public:
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);
                     FACET_ASSERT(Frame::is_unit(wo) && Frame::is_unit(si.wi));
-                    auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
+                    Color3f f;
+                    float bsdf_pdf;
+                    Mueller f_mueller;
+                    if (polarizing) {
+                        std::tie(f_mueller, bsdf_pdf) = bsdf->eval_pdf_polarized(ctx, si, wo);
+                        f = f_mueller.unpolarized();
+                    } else {
+                        std::tie(f, bsdf_pdf) = bsdf->eval_pdf(ctx, si, wo);
+                    }
                     FACET_ASSERT(bsdf_pdf >= 0.f && f.is_finite());
                     if (!f.is_black() && scene.emitter_visible(si, ds)) {
                         float w = ds.delta ? 1.f : mis_weight(ds.pdf, bsdf_pdf);
-                        result += throughput * f * em_weight * w;
+                        if constexpr (Polarized) {
+                            // The emitter's light is unpolarised: the first column of the
+                            // BSDF's matrix, in the world's frames, is what leaves towards wi.
+                            if (polarizing)
+                                result += throughput *
+                                          (mueller::to_world(si.sh_frame, f_mueller, -wo, si.wi)
+                                               .column(0) *
+                                           (em_weight * w));
+                            else
+                                result += throughput.column(0) * (f * em_weight * w);
+                        } else {
+                            result += throughput * f * em_weight * w;
+                        }
                     }
                 }
             }
@@ -129,7 +201,17 @@ public:
             if (bsdf_weight.is_black()) break;
             FACET_ASSERT(bs.pdf >= 0.f && Frame::is_unit(bs.wo));
 
-            throughput *= bsdf_weight;
+            if constexpr (Polarized) {
+                if (polarizing)
+                    throughput =
+                        throughput * mueller::to_world(si.sh_frame, bsdf_mueller, -bs.wo, si.wi);
+                else if (has_flag(bs.sampled_type, BSDFFlags::Null))
+                    throughput = throughput * bsdf_weight; // passed through unchanged
+                else
+                    depolarize(throughput, bsdf_weight);
+            } else {
+                throughput *= bsdf_weight;
+            }
             eta *= bs.eta;
             prev_si = si;
             prev_bsdf_pdf = bs.pdf;
@@ -141,29 +223,39 @@ public:
             if (render_should_stop(depth)) break;
 
             // ---- Russian roulette; eta² undoes the radiance scaling of refraction ----
-            float throughput_max = throughput.max();
+            float throughput_max = intensity(throughput).max();
             if (!(throughput_max > 0.f) || !std::isfinite(throughput_max)) break;
             if (depth >= m_rr_depth) {
                 float q = std::min(throughput_max * eta * eta, 0.95f);
                 if (!(sampler.draw_1d() < q)) break;
-                throughput /= q;
+                throughput = throughput * Color3f(1.f / q);
             }
         }
         return result;
     }
 
-    std::string to_string() const override {
-        return fmt::format("PathIntegrator[max_depth = {}, rr_depth = {}, hide_emitters = {}]",
-                           m_max_depth == std::numeric_limits<uint32_t>::max()
-                               ? std::string("-1")
-                               : std::to_string(m_max_depth),
-                           m_rr_depth, m_hide_emitters);
+    /// Light `L` (unpolarised) reaching the camera through `throughput`.
+    static void add_emission(Color3f &result, const Color3f &throughput, const Color3f &L) {
+        result += throughput * L;
     }
+    static void add_emission(Stokes &result, const Mueller &throughput, const Color3f &L) {
+        result += throughput.column(0) * L;
+    }
+    /// throughput·depolarizer(weight): a BSDF that does not polarise keeps the first column.
+    static void depolarize(Mueller &throughput, const Color3f &weight) {
+        for (int i = 0; i < 4; ++i) {
+            throughput.m[i][0] *= weight;
+            for (int j = 1; j < 4; ++j) throughput.m[i][j] = Color3f(0.f);
+        }
+    }
+    /// What Russian roulette weighs: the throughput of unpolarised light.
+    static const Color3f &intensity(const Color3f &throughput) { return throughput; }
+    static const Color3f &intensity(const Mueller &throughput) { return throughput.unpolarized(); }
 
-private:
     uint32_t m_max_depth;
     uint32_t m_rr_depth;
     bool m_hide_emitters;
+    bool m_polarized;
 };
 
 } // namespace facet
