@@ -1,8 +1,9 @@
 # The compatibility suite (label compat): every scene of compat/data/peer-scenes rendered at its
 # test spp and checked against Mitsuba 3's own image of it (compat/data/peer-renders) with
 # `facet compare`, one ctest per line of compat/scenes.txt, and one per other colour mode with a
-# reference in compat/data/peer-renders-modes (`<name>-mono`, `<name>-spectral`, labels
-# compat-mono, compat-spectral). A scene that
+# reference in compat/data/peer-renders-modes (`<name>-mono`, `<name>-spectral`,
+# `<name>-spectral_polarized`, labels compat-mono, compat-spectral, compat-spectral_polarized).
+# A scene that
 # needs a plugin that does not exist in plugins/ yet is registered DISABLED, with the missing
 # plugins named (configure output, the test's FACET_MISSING_PLUGINS property and environment); it
 # enables itself once they exist. compat/disabled.txt disables known gaps, each with its reason.
@@ -19,7 +20,7 @@ set(FACET_COMPAT_SCENES ${FACET_COMPAT_DIR}/data/peer-scenes)
 set(FACET_COMPAT_REFS ${FACET_COMPAT_DIR}/data/peer-renders)
 # References in the other colour modes: <name>_<mode>_mean_rgb.exr, one test <name>-<mode> each.
 set(FACET_COMPAT_MODE_REFS ${FACET_COMPAT_DIR}/data/peer-renders-modes)
-set(FACET_COMPAT_MODES mono spectral)
+set(FACET_COMPAT_MODES mono spectral spectral_polarized)
 set(FACET_COMPAT_WORK ${CMAKE_BINARY_DIR}/tests/compat)
 file(MAKE_DIRECTORY ${FACET_COMPAT_WORK})
 
