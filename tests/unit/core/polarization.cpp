@@ -507,3 +507,44 @@ TEST(Polarization, BSDFMatricesAgreeWithTheirColoursAndTheirDensities) {
         }
     }
 }
+
+TEST(Polarization, EachMicrofacetReflectsAsASmoothConductorInItsOwnFrame) {
+    // roughconductor's matrix at (wi, wo), normalised by its (0, 0) entry, is the smooth
+    // conductor's for the mirror whose normal is h = (wi + wo)/|wi + wo|, taken from the
+    // frame of h to the surface's frame.
+    const std::shared_ptr<BSDF> rough = load_bsdf(
+        R"(<bsdf version="3.0.0" type="roughconductor"><string name="material" value="Au"/>
+            <float name="alpha" value="0.4"/></bsdf>)");
+    const std::shared_ptr<BSDF> smooth = load_bsdf(
+        R"(<bsdf version="3.0.0" type="conductor"><string name="material" value="Au"/></bsdf>)");
+    ASSERT_TRUE(rough && smooth);
+    PCG32 rng(11);
+    int checked = 0;
+    for (int i = 0; i < 200; ++i) {
+        auto upper = [&]() {
+            const float z = 0.1f + 0.9f * rng.next_float(), phi = 2.f * Pi * rng.next_float();
+            const float r = std::sqrt(1.f - z * z);
+            return Vector3f(r * std::cos(phi), r * std::sin(phi), z);
+        };
+        SurfaceInteraction si;
+        si.wavelengths = Wavelengths(450.f, 550.f, 650.f);
+        si.wi = upper();
+        const Vector3f wo = upper();
+        const auto [M, pdf] = rough->eval_pdf_polarized(BSDFContext(), si, wo);
+        if (M.is_black()) continue;
+        const Frame fh(normalize(si.wi + wo));
+        SurfaceInteraction hi = si;
+        hi.wi = fh.to_local(si.wi);
+        const auto [bs, S] = smooth->sample_polarized(BSDFContext(), hi, 0.5f, Point2f(0.5f));
+        ASSERT_LT(norm(fh.to_world(bs.wo) - wo), 1e-4f);
+        const Mueller expected = mueller::to_world(fh, S, -bs.wo, hi.wi);
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                for (int lane = 0; lane < 3; ++lane)
+                    EXPECT_NEAR(M.m[a][b][lane] / M.m[0][0][lane],
+                                expected.m[a][b][lane] / expected.m[0][0][lane], 2e-4)
+                        << "entry " << a << ", " << b << " lane " << lane << " sample " << i;
+        ++checked;
+    }
+    EXPECT_GT(checked, 150);
+}
