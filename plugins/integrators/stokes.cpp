@@ -18,6 +18,9 @@ a warning says so.
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | (nested) | integrator | — | A sampling integrator that follows polarisation (`path`) |
+| timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
+| samples_per_pass | integer | (all) | Render in passes over the image of this many samples per pixel (must divide the sample count) |
+| block_size | integer | 0 | Side of the square image blocks, in pixels; 0 chooses 32 |
 
 ```xml
 <integrator type="stokes">
@@ -66,9 +69,10 @@ public:
             FACET_THROW_AT(props.location(), "stokes: needs a nested integrator (e.g. path)");
         if (!is_polarized(m_mode))
             FACET_LOG(Warn,
-                      "{}: the stokes integrator in the mode {}: light is unpolarised there "
+                      "{}the stokes integrator in the mode {}: light is unpolarised there "
                       "(S1 = S2 = S3 = 0); render in scalar_spectral_polarized",
-                      props.location().to_string(), mode_name(m_mode));
+                      props.location().valid() ? props.location().to_string() + ": " : "",
+                      mode_name(m_mode));
     }
 
     std::vector<std::string> aov_names() const override {
@@ -104,9 +108,8 @@ public:
                 weight[i] = pdf > 0.f ? 1.f / pdf : 0.f;
             }
         for (int k = 0; k < 4; ++k) {
-            const Color3f c = is_spectral(m_mode)
-                                  ? spectral_to_srgb(s.s[k], ray.wavelengths, weight)
-                                  : s.s[k];
+            const Color3f c =
+                is_spectral(m_mode) ? spectral_to_srgb(s.s[k], ray.wavelengths, weight) : s.s[k];
             aovs[3 * k] = c.r;
             aovs[3 * k + 1] = c.g;
             aovs[3 * k + 2] = c.b;

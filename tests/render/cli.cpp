@@ -455,7 +455,7 @@ TEST_F(CliTest, UnknownModeListsTheModes) {
     EXPECT_EQ(
         line,
         "facet: error: unknown mode \"foo\"; the modes facet renders: scalar_rgb, scalar_mono, "
-        "scalar_spectral");
+        "scalar_spectral, scalar_spectral_polarized");
     line = expect_one_line_error("render scene.xml -m scalar_rbg");
     EXPECT_NE(line.find("did you mean \"scalar_rgb\"?"), std::string::npos) << line;
     EXPECT_EQ(files(), std::set<std::string>{"scene.xml"});

@@ -25,7 +25,8 @@ TEST(BlendBSDF, CreationAndFlags) {
     ASSERT_EQ(bsdf->component_count(), 3u);
     EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(2), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(2),
+              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1) | bsdf->flags(2));
     EXPECT_NE(bsdf->to_string().find("BlendBSDF"), std::string::npos);
 

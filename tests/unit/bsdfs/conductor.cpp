@@ -72,7 +72,8 @@ TEST(ConductorData, UnknownMaterialSuggestsTheClosest) {
 TEST(Conductor, CreationAndFlags) {
     auto bsdf = make_bsdf("conductor");
     ASSERT_EQ(bsdf->component_count(), 1u);
-    EXPECT_EQ(bsdf->flags(), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(),
+              BSDFFlags::DeltaReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
     EXPECT_NE(bsdf->to_string().find("Conductor"), std::string::npos);
     expect_documented("conductor", {{"specular_reflectance", 0.5}});
     expect_documented("conductor", {{"eta", 0.5}, {"k", 2.0}});

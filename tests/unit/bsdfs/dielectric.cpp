@@ -12,7 +12,7 @@ using namespace bsdf_checks;
 TEST(Dielectric, CreationAndFlags) {
     auto bsdf = make_bsdf("dielectric");
     ASSERT_EQ(bsdf->component_count(), 2u);
-    BSDFFlags sides = BSDFFlags::FrontSide | BSDFFlags::BackSide;
+    BSDFFlags sides = BSDFFlags::FrontSide | BSDFFlags::BackSide | BSDFFlags::Polarizing;
     EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | sides);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DeltaTransmission | sides | BSDFFlags::NonSymmetric);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1));

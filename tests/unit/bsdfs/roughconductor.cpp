@@ -55,10 +55,11 @@ std::vector<Config> configs() {
 TEST(RoughConductor, CreationAndFlags) {
     auto bsdf = make_bsdf("roughconductor");
     ASSERT_EQ(bsdf->component_count(), 1u);
-    EXPECT_EQ(bsdf->flags(), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(),
+              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
     auto aniso = make_bsdf("roughconductor", {{"alpha_u", 0.1}, {"alpha_v", 0.3}});
-    EXPECT_EQ(aniso->flags(),
-              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Anisotropic);
+    EXPECT_EQ(aniso->flags(), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
+                                  BSDFFlags::Anisotropic | BSDFFlags::Polarizing);
     auto equal = make_bsdf("roughconductor", {{"alpha_u", 0.2}, {"alpha_v", 0.2}});
     EXPECT_FALSE(has_flag(equal->flags(), BSDFFlags::Anisotropic));
     EXPECT_NE(bsdf->to_string().find("RoughConductor"), std::string::npos);

@@ -36,15 +36,17 @@ TEST(TwoSided, CreationAndFlags) {
     ASSERT_EQ(two->component_count(), 3u);
     EXPECT_EQ(two->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(two->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(two->flags(2), BSDFFlags::GlossyReflection | BSDFFlags::BackSide);
+    EXPECT_EQ(two->flags(2),
+              BSDFFlags::GlossyReflection | BSDFFlags::BackSide | BSDFFlags::Polarizing);
     EXPECT_NE(two->to_string().find("back"), std::string::npos);
 
     // A front-and-back BSDF has its side flags replaced per half.
     auto glass = make_nested("twosided", {make_bsdf("dielectric")}, {{"allow_transmission", true}});
     ASSERT_EQ(glass->component_count(), 4u);
-    EXPECT_EQ(glass->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(glass->flags(3),
-              BSDFFlags::DeltaTransmission | BSDFFlags::BackSide | BSDFFlags::NonSymmetric);
+    EXPECT_EQ(glass->flags(0),
+              BSDFFlags::DeltaReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
+    EXPECT_EQ(glass->flags(3), BSDFFlags::DeltaTransmission | BSDFFlags::BackSide |
+                                   BSDFFlags::NonSymmetric | BSDFFlags::Polarizing);
 
     Properties props("twosided");
     props.set_object("_arg_0", diffuse);

@@ -123,6 +123,9 @@ TEST(MonoMode, TheSceneAndItsPropertiesKnowTheMode) {
     EXPECT_EQ(std::dynamic_pointer_cast<Scene>(load_string(xml, opts))->mode(),
               ColourMode::Spectral);
     opts.mode = "scalar_spectral_polarized";
+    EXPECT_EQ(std::dynamic_pointer_cast<Scene>(load_string(xml, opts))->mode(),
+              ColourMode::SpectralPolarized);
+    opts.mode = "scalar_rgb_polarized";
     EXPECT_THROW(load_string(xml, opts), Error);
 
     // A colour read straight from Properties follows the mode; so do defaults.

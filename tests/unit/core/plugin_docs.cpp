@@ -75,7 +75,7 @@ Properties valid_properties(const std::string &name) {
         film.set_int("width", 1);
         film.set_int("height", 1);
         p.set_object("film", make(ObjectType::Film, film));
-    } else if (name == "moment") {
+    } else if (name == "moment" || name == "stokes") {
         p.set_object("_arg_0", make(ObjectType::Integrator, Properties("path")));
     } else if (name == "blackbody") {
         p.set_float("temperature", 5000.0);

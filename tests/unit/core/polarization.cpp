@@ -7,9 +7,9 @@
 
 #include <facet/bsdf.h>
 #include <facet/fresnel.h>
-#include <facet/random.h>
 #include <facet/mode.h>
 #include <facet/mueller.h>
+#include <facet/random.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
@@ -121,8 +121,7 @@ TEST(Polarization, TotalInternalReflectionKeepsAllLightAndShiftsThePhases) {
         EXPECT_NEAR(delta, expected, 2e-6) << angle;
         // Each phase alone: φ_s = 2 atan(√(sin²θ − n²)/cos θ), φ_p = 2 atan(√(…)/(n² cos θ)).
         EXPECT_NEAR(std::arg(C(f.a_s)), 2.0 * std::atan(std::sqrt(s2 - n * n) / c), 2e-6);
-        EXPECT_NEAR(std::arg(C(f.a_p)), 2.0 * std::atan(std::sqrt(s2 - n * n) / (n * n * c)),
-                    2e-6);
+        EXPECT_NEAR(std::arg(C(f.a_p)), 2.0 * std::atan(std::sqrt(s2 - n * n) / (n * n * c)), 2e-6);
         // The Mueller matrix turns linear light at 45 degrees elliptical by δ.
         const Mueller M = mueller::specular_reflection(-float(c), 1.5f);
         EXPECT_NEAR(M.m[2][2].r, std::cos(delta), 2e-6);
@@ -206,8 +205,8 @@ TEST(Polarization, StokesFramesTurnAboutTheDirectionOfTravel) {
     const Mueller M = mueller::specular_reflection(0.6f, Color3f(0.2f), Color3f(3.f));
     const Frame f(normalize(Vector3f(0.3f, -0.5f, 0.8f)));
     const Vector3f in = normalize(Vector3f(0.2f, 0.1f, -0.9f)), out(0.6f, 0.f, 0.8f);
-    const Mueller back_again = mueller::to_local(f, mueller::to_world(f, M, in, out),
-                                                 f.to_world(in), f.to_world(out));
+    const Mueller back_again =
+        mueller::to_local(f, mueller::to_world(f, M, in, out), f.to_world(in), f.to_world(out));
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j) EXPECT_NEAR(back_again.m[i][j].g, M.m[i][j].g, 1e-5);
 }
@@ -270,10 +269,8 @@ TEST(Polarization, MalusLawThroughTwoPolarizersOnTurnedSheets) {
     const std::string mode = "scalar_spectral_polarized";
     // The open scene: the same sheets, passing everything (same random numbers: a Null lobe
     // each).
-    const std::vector<double> open =
-        render_sheets(sheet(1.f, 0.f, "<bsdf type=\"null\"/>") +
-                          sheet(2.f, 0.f, "<bsdf type=\"null\"/>"),
-                      mode);
+    const std::vector<double> open = render_sheets(
+        sheet(1.f, 0.f, "<bsdf type=\"null\"/>") + sheet(2.f, 0.f, "<bsdf type=\"null\"/>"), mode);
     ASSERT_GT(open[1], 0.5);
     // A polarizer's axis is its sheet's first tangent turned by −theta (theta turns it from u
     // towards −v), and the sheet turns it with itself: the light through both is ½·cos² of the
@@ -285,19 +282,17 @@ TEST(Polarization, MalusLawThroughTwoPolarizersOnTurnedSheets) {
                           Case{0, 0, 90}, Case{10, 60, -25}}) {
         const double diff = deg((c.turn2 - c.theta2) - (0.f - c.theta1));
         const std::vector<double> m = render_sheets(
-            sheet(1.f, 0.f, polarizer(c.theta1)) + sheet(2.f, c.turn2, polarizer(c.theta2)),
-            mode);
+            sheet(1.f, 0.f, polarizer(c.theta1)) + sheet(2.f, c.turn2, polarizer(c.theta2)), mode);
         for (int ch = 0; ch < 3; ++ch)
             EXPECT_NEAR(m[size_t(ch)] / open[size_t(ch)], 0.5 * sqr(std::cos(diff)), 2e-5)
                 << c.theta1 << " / " << c.turn2 << " + " << c.theta2 << " channel " << ch;
     }
     // Without polarisation the two sheets pass a quarter, whatever their angles.
-    const std::vector<double> rgb_open = render_sheets(
-        sheet(1.f, 0.f, "<bsdf type=\"null\"/>") + sheet(2.f, 0.f, "<bsdf type=\"null\"/>"),
-        "scalar_spectral");
-    const std::vector<double> crossed =
-        render_sheets(sheet(1.f, 0.f, polarizer(0)) + sheet(2.f, 0.f, polarizer(90)),
-                      "scalar_spectral");
+    const std::vector<double> rgb_open = render_sheets(sheet(1.f, 0.f, "<bsdf type=\"null\"/>") +
+                                                           sheet(2.f, 0.f, "<bsdf type=\"null\"/>"),
+                                                       "scalar_spectral");
+    const std::vector<double> crossed = render_sheets(
+        sheet(1.f, 0.f, polarizer(0)) + sheet(2.f, 0.f, polarizer(90)), "scalar_spectral");
     EXPECT_NEAR(crossed[1] / rgb_open[1], 0.25, 1e-5);
 }
 
@@ -313,27 +308,27 @@ TEST(Polarization, AQuarterWavePlateTurnsLinearLightCircular) {
     const std::string linear_then_plate =
         sheet(1.f, 0.f, polarizer(45)) +
         sheet(2.f, 0.f, R"(<bsdf type="retarder"><float name="delta" value="90"/></bsdf>)");
-    const double right = render_sheets(linear_then_plate +
-                                           sheet(3.f, 0.f, R"(<bsdf type="circular"/>)"),
-                                       mode)[1];
-    const double left =
-        render_sheets(linear_then_plate +
-                          sheet(3.f, 0.f,
-                                R"(<bsdf type="circular"><boolean name="left_handed" value="true"/></bsdf>)"),
-                      mode)[1];
+    const double right =
+        render_sheets(linear_then_plate + sheet(3.f, 0.f, R"(<bsdf type="circular"/>)"), mode)[1];
+    const double left = render_sheets(
+        linear_then_plate +
+            sheet(3.f, 0.f,
+                  R"(<bsdf type="circular"><boolean name="left_handed" value="true"/></bsdf>)"),
+        mode)[1];
     EXPECT_NEAR(right / open, 0.5, 2e-5);
     EXPECT_NEAR(left / open, 0.0, 2e-5);
     // Without the plate, linear light is half right and half left.
-    const double no_plate = render_sheets(sheet(1.f, 0.f, polarizer(45)) +
-                                              sheet(2.f, 0.f, "<bsdf type=\"null\"/>") +
-                                              sheet(3.f, 0.f, R"(<bsdf type="circular"/>)"),
-                                          mode)[1];
+    const double no_plate =
+        render_sheets(sheet(1.f, 0.f, polarizer(45)) + sheet(2.f, 0.f, "<bsdf type=\"null\"/>") +
+                          sheet(3.f, 0.f, R"(<bsdf type="circular"/>)"),
+                      mode)[1];
     EXPECT_NEAR(no_plate / open, 0.25, 2e-5);
 }
 
 TEST(Polarization, TheStokesIntegratorGivesTheComponentsInTheCamerasFrame) {
     const std::string mode = "scalar_spectral_polarized";
-    const std::string integrator = R"(<integrator type="stokes"><integrator type="path"/></integrator>)";
+    const std::string integrator =
+        R"(<integrator type="stokes"><integrator type="path"/></integrator>)";
     // Channels: R, G, B, then S0.R, S0.G, S0.B, S1.R, ... (the film may add A before them).
     auto components = [&](const std::string &sheets) {
         const std::vector<double> m = render_sheets(sheets, mode, integrator);
@@ -403,12 +398,14 @@ TEST(Polarization, ATiltedGlassSlabTransmitsEachPolarisationOnItsOwn) {
         return sum / 16.0;
     };
     const double open = render_many("", "scalar_spectral_polarized");
-    const double slab = render_many(face(2.5f, false) + face(2.f, true), "scalar_spectral_polarized");
+    const double slab =
+        render_many(face(2.5f, false) + face(2.f, true), "scalar_spectral_polarized");
     // The spectral mode, without polarisation, gives the averaged figure; it draws the same
     // lobes with the same random numbers, so the difference of the two ratios is the
     // polarisation's alone, with little noise.
     const double spectral_open = render_many("", "scalar_spectral");
-    const double spectral_slab = render_many(face(2.5f, false) + face(2.f, true), "scalar_spectral");
+    const double spectral_slab =
+        render_many(face(2.5f, false) + face(2.f, true), "scalar_spectral");
     EXPECT_NEAR(slab / open, polarised, 0.004) << "the unpolarised average gives " << averaged;
     EXPECT_NEAR(spectral_slab / spectral_open, averaged, 0.004);
     EXPECT_NEAR(slab / open - spectral_slab / spectral_open, polarised - averaged, 0.0006);
