@@ -19,8 +19,7 @@ public:
     }
 
     std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
-                                                    const SurfaceInteraction &si,
-                                                    float /*sample1*/,
+                                                    const SurfaceInteraction &si, float /*sample1*/,
                                                     const Point2f & /*sample2*/) const override {
         BSDFSample bs;
         if (!pass(ctx, bs, si)) return {bs, Mueller{}};
@@ -45,8 +44,8 @@ public:
 
 protected:
     OpticalElement() {
-        set_components({BSDFFlags::Null | BSDFFlags::FrontSide | BSDFFlags::BackSide |
-                        BSDFFlags::Polarizing});
+        set_components(
+            {BSDFFlags::Null | BSDFFlags::FrontSide | BSDFFlags::BackSide | BSDFFlags::Polarizing});
     }
     /// What the element passes of unpolarised light (the modes without polarisation).
     virtual Color3f unpolarized(const SurfaceInteraction &si) const = 0;

@@ -39,11 +39,11 @@ struct Stokes {
         for (int k = 0; k < 4; ++k) s[k] += o.s[k];
         return *this;
     }
-    Stokes operator*(const Color3f &c) const {
-        return {{s[0] * c, s[1] * c, s[2] * c, s[3] * c}};
-    }
+    Stokes operator*(const Color3f &c) const { return {{s[0] * c, s[1] * c, s[2] * c, s[3] * c}}; }
     /// Unpolarised light of intensity `c`.
-    static Stokes unpolarized(const Color3f &c) { return {{c, Color3f(0.f), Color3f(0.f), Color3f(0.f)}}; }
+    static Stokes unpolarized(const Color3f &c) {
+        return {{c, Color3f(0.f), Color3f(0.f), Color3f(0.f)}};
+    }
 };
 
 /// A Mueller matrix per wavelength: m[i][j] holds entry (i, j) at the path's wavelengths.
@@ -192,10 +192,8 @@ inline void specular_reflection(float cos_i, const std::complex<float> &eta, flo
         cos_d = z.real();
         sin_d = z.imag();
     }
-    const float r[4][4] = {{a, b, 0, 0},
-                           {b, a, 0, 0},
-                           {0, 0, c * cos_d, -c * sin_d},
-                           {0, 0, c * sin_d, c * cos_d}};
+    const float r[4][4] = {
+        {a, b, 0, 0}, {b, a, 0, 0}, {0, 0, c * cos_d, -c * sin_d}, {0, 0, c * sin_d, c * cos_d}};
     std::memcpy(m, r, sizeof r);
 }
 /// specular_reflection() at the same real IOR at every wavelength.
@@ -225,8 +223,7 @@ inline Mueller specular_reflection(float cos_i, const Color3f &eta, const Color3
 inline Mueller specular_transmission(float cos_i, float eta) {
     FresnelPolarized f;
     fresnel_polarized(cos_i, std::complex<float>(eta, 0.f), f);
-    const float factor =
-        std::abs(cos_i) > 1e-8f ? -f.eta_it.real() * (f.cos_t / cos_i) : 0.f;
+    const float factor = std::abs(cos_i) > 1e-8f ? -f.eta_it.real() * (f.cos_t / cos_i) : 0.f;
     const float t_s = 1.f + f.a_s.real(), t_p = (1.f + f.a_p.real()) * f.eta_ti.real();
     const float a = 0.5f * factor * (t_s * t_s + t_p * t_p),
                 b = 0.5f * factor * (t_s * t_s - t_p * t_p), c = factor * std::abs(t_s * t_p);
