@@ -66,6 +66,7 @@ negative sampling rate is an error.
 #include <facet/bsdf.h>
 #include <facet/fresnel.h>
 #include <facet/microfacet.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/principled.h>
 #include <facet/properties.h>
@@ -84,6 +85,7 @@ class Principled final : public BSDF {
 public:
     explicit Principled(const Properties &props) {
         m_base_color = props.texture("base_color", 0.5f);
+        m_spectral = is_spectral(props.mode());
         m_roughness = props.texture("roughness", 0.5f);
         m_has_anisotropic = lobe_present(props, "anisotropic");
         m_anisotropic = props.texture("anisotropic", 0.f);
@@ -250,6 +252,7 @@ private:
     /// The parameters at one surface point (absent lobes read as 0).
     struct Point {
         Color3f base_color;
+        Color3f tint; ///< the base colour normalised by its luminance (if a tint is used)
         float roughness, anisotropic, metallic, spec_trans, spec_tint, sheen, sheen_tint, flatness,
             clearcoat, clearcoat_gloss;
         float brdf, bsdf; ///< weights of the opaque base and of the transmission lobe
@@ -276,6 +279,9 @@ private:
     Point at(const SurfaceInteraction &si) const {
         Point p;
         p.base_color = m_base_color->eval(si);
+        if (m_has_spec_tint || m_has_sheen_tint)
+            p.tint =
+                tint_color(p.base_color, tint_luminance(p.base_color, si.wavelengths, m_spectral));
         p.roughness = m_roughness->eval_1(si);
         p.anisotropic = m_has_anisotropic ? m_anisotropic->eval_1(si) : 0.f;
         p.metallic = m_has_metallic ? m_metallic->eval_1(si) : 0.f;
@@ -353,8 +359,8 @@ private:
         Color3f value(0.f);
         float D = distr.eval(h);
         if (on.spec && refl_ok && F > 0.f) {
-            Color3f Fp = principled_fresnel(F, p.metallic, p.spec_tint, p.base_color, wi_h, front,
-                                            p.bsdf, m_eta);
+            Color3f Fp = principled_fresnel(F, p.metallic, p.spec_tint, p.base_color, p.tint, wi_h,
+                                            front, p.bsdf, m_eta);
             value += Fp * (D * distr.G(wi, wo, h) / (4.f * std::abs(cos_i)));
         }
         if (on.trans && trans_ok && p.bsdf > 0.f && F < 1.f) {
@@ -381,7 +387,7 @@ private:
                 value += p.base_color * (p.brdf * std::abs(cos_o) * InvPi * f);
             }
             if (p.sheen > 0.f && 1.f - p.metallic > 0.f)
-                value += sheen_color(p.base_color, p.sheen_tint, cos_d) *
+                value += sheen_color(p.tint, p.sheen_tint, cos_d) *
                          (p.sheen * (1.f - p.metallic) * std::abs(cos_o));
         }
 
@@ -411,6 +417,7 @@ private:
     bool m_eta_given = false;
     float m_diff_srate, m_spec_srate, m_clearcoat_srate;
     bool m_sample_visible;
+    bool m_spectral; ///< the tint's luminance is taken at the path's wavelengths
     bool m_has_anisotropic, m_has_spec_trans, m_has_sheen, m_has_sheen_tint, m_has_flatness,
         m_has_spec_tint, m_has_metallic, m_has_clearcoat;
     uint32_t m_comp_diffuse = 0, m_comp_clearcoat = uint32_t(-1), m_comp_trans = uint32_t(-1),
@@ -419,5 +426,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::Principled, BSDF, "principled",
-                    "The Disney/Burley principled BSDF (Mitsuba 3's principled)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::Principled, BSDF, "principled",
+                          "The Disney/Burley principled BSDF (Mitsuba 3's principled)", DOC,
+                          ::facet::AllModes)

@@ -57,6 +57,7 @@ or diff_trans outside [0, 2], is an error.
 #include <facet/bsdf.h>
 #include <facet/fresnel.h>
 #include <facet/microfacet.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/principled.h>
 #include <facet/properties.h>
@@ -75,6 +76,7 @@ class PrincipledThin final : public BSDF {
 public:
     explicit PrincipledThin(const Properties &props) {
         m_base_color = props.texture("base_color", 0.5f);
+        m_spectral = is_spectral(props.mode());
         m_roughness = props.texture("roughness", 0.5f);
         m_has_anisotropic = lobe_present(props, "anisotropic");
         m_anisotropic = props.texture("anisotropic", 0.f);
@@ -207,6 +209,7 @@ public:
 private:
     struct Point {
         Color3f base_color;
+        Color3f tint; ///< the base colour normalised by its luminance (if a tint is used)
         float roughness, anisotropic, spec_trans, eta, spec_tint, sheen, sheen_tint, flatness;
         float diff_trans; ///< diff_trans/2, in [0, 1]
     };
@@ -233,6 +236,9 @@ private:
     Point at(const SurfaceInteraction &si) const {
         Point p;
         p.base_color = m_base_color->eval(si);
+        if (m_has_spec_tint || m_has_sheen_tint)
+            p.tint =
+                tint_color(p.base_color, tint_luminance(p.base_color, si.wavelengths, m_spectral));
         p.roughness = m_roughness->eval_1(si);
         p.anisotropic = m_has_anisotropic ? m_anisotropic->eval_1(si) : 0.f;
         p.spec_trans = m_has_spec_trans ? m_spec_trans->eval_1(si) : 0.f;
@@ -305,7 +311,7 @@ private:
             float F = fresnel_dielectric(dot(wi, h), p.eta).F;
             if (refl_ok && on.spec_refl) {
                 MicrofacetDistribution distr = reflect_distribution(p);
-                Color3f Ft = thin_fresnel(F, p.spec_tint, p.base_color, dot(wi, h), p.eta);
+                Color3f Ft = thin_fresnel(F, p.spec_tint, p.tint, dot(wi, h), p.eta);
                 value += Ft * (p.spec_trans * distr.eval(h) * distr.G(wi, wo, h) / (4.f * cos_i));
                 pdf += prob.spec_refl * distr.pdf(wi, h) * jacobian;
             }
@@ -322,7 +328,7 @@ private:
             float w = (1.f - p.spec_trans) * (1.f - p.diff_trans);
             value += p.base_color * (w * cos_o * InvPi * f);
             if (p.sheen > 0.f)
-                value += sheen_color(p.base_color, p.sheen_tint, cos_d) * (p.sheen * w * cos_o);
+                value += sheen_color(p.tint, p.sheen_tint, cos_d) * (p.sheen * w * cos_o);
             pdf += prob.diff_refl * warp::square_to_cosine_hemisphere_pdf(wo);
         }
         if (refract && on.diff_trans && p.spec_trans < 1.f && p.diff_trans > 0.f) {
@@ -336,6 +342,7 @@ private:
         m_spec_tint, m_sheen, m_sheen_tint, m_flatness, m_diff_trans;
     float m_spec_refl_srate, m_spec_trans_srate, m_diff_trans_srate, m_diff_refl_srate;
     bool m_sample_visible;
+    bool m_spectral; ///< the tint's luminance is taken at the path's wavelengths
     bool m_has_anisotropic, m_has_spec_trans, m_has_sheen, m_has_sheen_tint, m_has_flatness,
         m_has_spec_tint, m_has_diff_trans;
     uint32_t m_comp_spec_trans = uint32_t(-1), m_comp_spec_refl = 2;
@@ -343,5 +350,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::PrincipledThin, BSDF, "principledthin",
-                    "The thin-sheet principled BSDF (Mitsuba 3's principledthin)", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::PrincipledThin, BSDF, "principledthin",
+                          "The thin-sheet principled BSDF (Mitsuba 3's principledthin)", DOC,
+                          ::facet::AllModes)

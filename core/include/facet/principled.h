@@ -5,6 +5,7 @@
 #include <facet/fresnel.h>
 #include <facet/math.h>
 #include <facet/properties.h>
+#include <facet/spectrum.h>
 
 #include <cmath>
 #include <string>
@@ -54,9 +55,21 @@ template <typename T> T schlick_fresnel(const T &r0, float cos_i, float eta) {
     return r0 * (1.f - w) + T(1.f) * w;
 }
 
-/// The base colour normalised by its luminance (white where the luminance is zero).
-inline Color3f tint_color(const Color3f &base_color) {
-    float lum = base_color.luminance();
+/**
+ * The luminance the tint normalises the base colour by, as Mitsuba 3 takes it: Rec.709 Y of an
+ * RGB colour (of mono's equal channels: the value); in the spectral modes (`spectral`) the mean
+ * over the path's wavelengths `lambda` of ȳ(λ)·value, with the CIE 1931 ȳ (peak 1) and no
+ * division by the wavelengths' density.
+ */
+inline float tint_luminance(const Color3f &base_color, const Wavelengths &lambda, bool spectral) {
+    if (!spectral) return base_color.luminance();
+    float sum = 0.f;
+    for (int i = 0; i < 3; ++i) sum += cie1931_xyz(lambda[i]).g * base_color[i];
+    return sum * (1.f / 3.f);
+}
+
+/// The base colour normalised by its luminance `lum` (tint_luminance(); white where it is zero).
+inline Color3f tint_color(const Color3f &base_color, float lum) {
     return lum > 0.f ? base_color / lum : Color3f(1.f);
 }
 
@@ -152,12 +165,12 @@ inline float diffuse_factor(float cos_i, float cos_o, float cos_d, float roughne
     return (f_diff + f_retro) * (1.f - flatness) + f_ss * flatness;
 }
 
-/// Sheen colour: white blended towards the luminance-normalised base colour by `sheen_tint`, times
-/// the Schlick weight of cos θd (Burley 2012, B.1). Without the cosine and the lobe weights.
-inline Color3f sheen_color(const Color3f &base_color, float sheen_tint, float cos_d) {
-    Color3f tint = sheen_tint > 0.f
-                       ? Color3f(1.f) * (1.f - sheen_tint) + tint_color(base_color) * sheen_tint
-                       : Color3f(1.f);
+/// Sheen colour: white blended towards the tint (the luminance-normalised base colour,
+/// tint_color()) by `sheen_tint`, times the Schlick weight of cos θd (Burley 2012, B.1). Without
+/// the cosine and the lobe weights.
+inline Color3f sheen_color(const Color3f &tint_colour, float sheen_tint, float cos_d) {
+    Color3f tint = sheen_tint > 0.f ? Color3f(1.f) * (1.f - sheen_tint) + tint_colour * sheen_tint
+                                    : Color3f(1.f);
     return tint * schlick_weight(std::abs(cos_d));
 }
 
@@ -169,23 +182,24 @@ inline Color3f sheen_color(const Color3f &base_color, float sheen_tint, float co
  * transmission lobe's share `bsdf` = (1 − metallic)·spec_trans.
  */
 inline Color3f principled_fresnel(float F_d, float metallic, float spec_tint,
-                                  const Color3f &base_color, float cos_i, bool front_side,
-                                  float bsdf, float eta) {
+                                  const Color3f &base_color, const Color3f &tint_colour,
+                                  float cos_i, bool front_side, float bsdf, float eta) {
     if (!front_side) return Color3f(bsdf * F_d);
     float eta_it = cos_i >= 0.f ? eta : 1.f / eta;
     Color3f F = Color3f((1.f - metallic) * (1.f - spec_tint) * F_d);
     if (metallic > 0.f) F += metallic * schlick_fresnel(base_color, cos_i, eta);
     if (spec_tint > 0.f)
         F += (1.f - metallic) * spec_tint *
-             schlick_fresnel(tint_color(base_color) * schlick_r0(eta_it), cos_i, eta);
+             schlick_fresnel(tint_colour * schlick_r0(eta_it), cos_i, eta);
     return F;
 }
 
-/// `principledthin`'s Fresnel: F_d blended by spec_tint towards Schlick with the tinted R0.
-inline Color3f thin_fresnel(float F_d, float spec_tint, const Color3f &base_color, float cos_i,
+/// `principledthin`'s Fresnel: F_d blended by spec_tint towards Schlick with the tinted R0
+/// (`tint_colour`, tint_color()).
+inline Color3f thin_fresnel(float F_d, float spec_tint, const Color3f &tint_colour, float cos_i,
                             float eta) {
     if (!(spec_tint > 0.f)) return Color3f(F_d);
-    Color3f F_s = schlick_fresnel(tint_color(base_color) * schlick_r0(eta), cos_i, eta);
+    Color3f F_s = schlick_fresnel(tint_colour * schlick_r0(eta), cos_i, eta);
     return Color3f(F_d) * (1.f - spec_tint) + F_s * spec_tint;
 }
 
