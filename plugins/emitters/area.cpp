@@ -85,7 +85,8 @@ public:
 
     /// Emitted rays: a uniform point on the shape and a cosine-weighted direction on its front
     /// side; the weight L·π/pdf_area is the power the ray carries per unit of the joint density.
-    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
         const Shape &shape = require_shape();
         PositionSample ps = shape.sample_position(u_pos);
         if (!(ps.pdf > 0.f)) return {Ray(), Color3f(0.f)};
@@ -97,7 +98,8 @@ public:
         origin.t = 0.f;
         DirectionSample at;
         static_cast<PositionSample &>(at) = ps;
-        return {origin.spawn_ray(d), radiance_at(at, Wavelengths()) * (Pi / ps.pdf)};
+        origin.wavelengths = wavelengths;
+        return {origin.spawn_ray(d), radiance_at(at, wavelengths) * (Pi / ps.pdf)};
     }
 
     std::optional<Color3f> constant_radiance() const override {

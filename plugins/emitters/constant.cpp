@@ -72,13 +72,16 @@ public:
 
     /// A ray entering the bounding sphere: travel direction w uniform on the sphere, origin on
     /// the disk of radius r facing it (centre c - w r). Power per ray: L 4π · π r².
-    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
         const Vector3f w = warp::square_to_uniform_sphere(u_dir);
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
         const Frame frame(w);
         const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y - w) * m_radius;
         const float area = Pi * m_radius * m_radius;
-        return {Ray(o, w), radiance_along(-w, Wavelengths()) * (4.f * Pi * area)};
+        Ray ray(o, w);
+        ray.wavelengths = wavelengths;
+        return {ray, radiance_along(-w, wavelengths) * (4.f * Pi * area)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override { return m_radiance->eval(si); }

@@ -59,11 +59,14 @@ public:
     /// Emitted rays (light tracing): a uniform point on the disk of the scene's bounding sphere
     /// that faces the light, one radius up-beam of the centre, travelling along the direction;
     /// the weight irradiance x disk area is the power each ray carries.
-    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &,
+                                       const Wavelengths &wavelengths) const override {
         const Frame frame(m_direction);
         const Point2f p = warp::square_to_uniform_disk_concentric(u_pos) * m_radius;
         const Point3f o = m_center - m_direction * m_radius + frame.s * p.x + frame.t * p.y;
-        return {Ray(o, m_direction), m_irradiance.mean() * (Pi * m_radius * m_radius)};
+        Ray ray(o, m_direction);
+        ray.wavelengths = wavelengths;
+        return {ray, m_irradiance.at(wavelengths) * (Pi * m_radius * m_radius)};
     }
 
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,

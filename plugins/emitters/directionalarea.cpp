@@ -56,7 +56,8 @@ public:
 
     /// A uniform point on the shape and the normal there; the weight is radiance / pdf_area
     /// (radiance times the area for uniform sampling): the power of the ray.
-    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &,
+                                       const Wavelengths &wavelengths) const override {
         const Shape &shape = require_shape();
         PositionSample ps = shape.sample_position(u_pos);
         if (!(ps.pdf > 0.f)) return {Ray(), Color3f(0.f)};
@@ -64,7 +65,8 @@ public:
         origin.p = ps.p;
         origin.n = ps.n;
         origin.t = 0.f;
-        return {origin.spawn_ray(ps.n), radiance_at(ps) / ps.pdf};
+        origin.wavelengths = wavelengths;
+        return {origin.spawn_ray(ps.n), radiance_at(ps, wavelengths) / ps.pdf};
     }
 
     std::string to_string() const override {
@@ -82,9 +84,10 @@ private:
         return *m_shape;
     }
 
-    Color3f radiance_at(const PositionSample &ps) const {
-        if (!m_radiance->is_spatially_varying()) return m_radiance->mean();
+    /// The radiance at a sampled point and the path's wavelengths (the spectral modes).
+    Color3f radiance_at(const PositionSample &ps, const Wavelengths &wavelengths) const {
         SurfaceInteraction si;
+        si.wavelengths = wavelengths;
         si.p = ps.p;
         si.n = ps.n;
         si.uv = ps.uv;
@@ -100,5 +103,6 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::DirectionalAreaLight, Emitter, "directionalarea",
-                    "Area light that emits only along the surface normal", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::DirectionalAreaLight, Emitter, "directionalarea",
+                          "Area light that emits only along the surface normal", DOC,
+                          ::facet::AllModes)

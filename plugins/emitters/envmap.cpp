@@ -173,7 +173,8 @@ public:
     /// A ray entering the bounding sphere (the particle tracer): the direction it comes from is
     /// drawn as sample_direction() draws it, the origin uniformly on the disk of the sphere's
     /// radius facing that direction, just outside the sphere. Power per ray: L / pdf · π r².
-    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
         Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir))
                                             : warp::square_to_uniform_sphere(u_dir);
         const Vector3f from = normalize(m_to_world.apply_vector(local));
@@ -185,9 +186,9 @@ public:
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
         const Frame frame(from);
         const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y + from) * radius;
-        // (The light tracer does not render the spectral mode yet: sample_ray has no wavelengths
-        // to give radiance(), which then reads the curves, not the colours, and gives zero.)
-        return {Ray(o, -from), radiance(g, Wavelengths()) * (Pi * radius * radius / pdf)};
+        Ray ray(o, -from);
+        ray.wavelengths = wavelengths;
+        return {ray, radiance(g, wavelengths) * (Pi * radius * radius / pdf)};
     }
 
     Color3f eval(const SurfaceInteraction &si) const override {

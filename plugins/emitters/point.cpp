@@ -73,9 +73,11 @@ public:
 
     /// Emitted rays: uniform directions; the weight is the total power per unit of the
     /// direction density, 4π·intensity.
-    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
-        Vector3f d = warp::square_to_uniform_sphere(u_dir);
-        return {Ray(m_position, d), m_intensity.mean() * (4.f * Pi)};
+    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
+        Ray ray(m_position, warp::square_to_uniform_sphere(u_dir));
+        ray.wavelengths = wavelengths;
+        return {ray, m_intensity.at(wavelengths) * (4.f * Pi)};
     }
 
     float pdf_ray_direction(const Vector3f &d) const override {

@@ -105,9 +105,11 @@ public:
 
     /// Emitted rays: a uniform point of the image rectangle at distance 1 (the texture is not
     /// importance-sampled); the weight is intensity over the direction density, π·E(uv)·area.
-    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
         const Vector3f local((1.f - 2.f * u_dir.x) * m_tan_x, (1.f - 2.f * u_dir.y) * m_tan_y, 1.f);
         Ray ray(m_position, normalize(m_to_world.apply_vector(local)));
+        ray.wavelengths = wavelengths;
         return {ray, eval_irradiance(u_dir, ray.wavelengths) * (Pi * m_scale * m_plane_area)};
     }
 

@@ -101,10 +101,12 @@ public:
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
 
     /// Directions uniformly inside the cone (the falloff is smooth enough not to need more).
-    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir) const override {
+    std::pair<Ray, Color3f> sample_ray(const Point2f &, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
         Vector3f local = warp::square_to_uniform_cone(u_dir, m_cos_cutoff);
         float pdf = warp::square_to_uniform_cone_pdf(local, m_cos_cutoff);
         Ray ray(m_position, normalize(m_to_world.apply_vector(local)));
+        ray.wavelengths = wavelengths;
         return {ray, intensity(local, ray.wavelengths) / pdf};
     }
 

@@ -21,6 +21,11 @@ The sensor must support sampling a direction towards it (perspective, thinlens, 
 Every emitter emits rays: environments send them into the scene's bounding sphere from a disk
 facing the sampled direction, so an environment lights the scene as it does for the path tracer.
 
+In the spectral modes each light path draws its three wavelengths as a camera ray does and
+splats its value developed through CIE XYZ; in `scalar_spectral_polarized` the light carries
+its Stokes vector from the (unpolarised) emitter through every BSDF that polarises, and the
+sensor records its intensity.
+
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | max_depth | integer | -1 | Longest path, in segments: -1 is unbounded, 1 shows only directly visible emitters, 2 adds direct illumination, ... |
@@ -40,17 +45,21 @@ facing the sampled direction, so an environment lights the scene as it does for 
 #include <facet/emitter.h>
 #include <facet/film.h>
 #include <facet/integrator.h>
+#include <facet/mode.h>
+#include <facet/mueller.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/sampler.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
 #include <facet/shape.h>
+#include <facet/spectrum.h>
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <limits>
+#include <tuple>
 
 namespace facet {
 
@@ -60,6 +69,8 @@ public:
         m_max_depth = read_max_depth(props, "ptracer");
         m_rr_depth = read_rr_depth(props, "ptracer");
         m_hide_emitters = props.get_bool("hide_emitters", false);
+        m_spectral = is_spectral(props.mode());
+        m_polarized = is_polarized(props.mode());
     }
 
     std::string to_string() const override {
@@ -73,21 +84,54 @@ public:
     /// One sample: the emitter connection (directly visible emitters) and one light path.
     void trace(const Scene &scene, const Sensor &sensor, Sampler &sampler,
                SplatTarget &film) const override {
+        if (m_polarized)
+            trace_path<true>(scene, sensor, sampler, film);
+        else
+            trace_path<false>(scene, sensor, sampler, film);
+    }
+
+private:
+    /// The path's wavelengths (the spectral modes) and what a value at them adds to the film.
+    struct Spectral {
+        bool on = false;
+        Wavelengths lambda;
+        Color3f weight;
+        /// Splats `value` (at the wavelengths, or RGB) at `uv`.
+        void splat(SplatTarget &film, const Point2f &uv, const Color3f &value) const {
+            if (value.is_black() || !value.is_finite()) return;
+            film.splat(uv, on ? spectral_to_srgb(value, lambda, weight) : value);
+        }
+    };
+
+    /// The light path. In the polarized mode (Polarized) the light carries a Stokes vector in
+    /// the implicit frame of its direction of travel (mueller.h), which each BSDF's matrix
+    /// (importance mode: light from −wi to wo) turns into the next one; the sensor records S0.
+    template <bool Polarized> void trace_path(const Scene &scene, const Sensor &sensor,
+                                              Sampler &sampler, SplatTarget &film) const {
         const auto &emitters = scene.emitters();
         if (emitters.empty()) return;
+        Spectral spectral;
+        if (m_spectral) {
+            spectral.on = true;
+            std::tie(spectral.lambda, spectral.weight) = sample_wavelengths(sampler.next_1d());
+        }
         const float n_emitters = float(emitters.size());
         auto pick = [&](float u) {
             size_t i = std::min(size_t(u * n_emitters), emitters.size() - 1);
             return emitters[i].get();
         };
         if (m_max_depth != 0 && !m_hide_emitters)
-            connect_emitter(scene, sensor, *pick(sampler.next_1d()), n_emitters, sampler, film);
+            connect_emitter(scene, sensor, *pick(sampler.next_1d()), n_emitters, sampler, spectral,
+                            film);
 
         const Emitter &emitter = *pick(sampler.next_1d());
         const Point2f u_dir = sampler.next_2d(), u_pos = sampler.next_2d();
-        auto [ray, power] = emitter.sample_ray(u_pos, u_dir);
+        auto [ray, power] = emitter.sample_ray(u_pos, u_dir, spectral.lambda);
         Color3f throughput = power * n_emitters;
         if (throughput.is_black() || !throughput.is_finite()) return;
+        // The polarized mode's light: unpolarised as it leaves the emitter (`throughput` is
+        // then its S0).
+        Stokes light = Stokes::unpolarized(throughput);
 
         const BSDFContext ctx(TransportMode::Importance);
         SurfaceInteraction si;
@@ -96,6 +140,7 @@ public:
         for (uint32_t depth = 1; depth < m_max_depth;) {
             const BSDF *bsdf = si.bsdf();
             if (!bsdf) return;
+            const bool polarizing = Polarized && has_flag(bsdf->flags(), BSDFFlags::Polarizing);
             // ---- Connect this vertex to the sensor ----
             {
                 auto [ds, importance] = sensor.sample_direction(si, sampler.next_2d());
@@ -103,9 +148,14 @@ public:
                     const Vector3f wo = si.to_local(ds.d);
                     const float correction = shading_correction(si, ds.d, wo);
                     if (correction > 0.f && !scene.ray_test(si.spawn_ray_to(ds.p))) {
-                        Color3f f = bsdf->eval(ctx, si, wo);
-                        Color3f value = throughput * f * importance * correction;
-                        if (!value.is_black() && value.is_finite()) film.splat(ds.uv, value);
+                        Color3f arriving; // S0 of the light leaving towards the sensor
+                        if (polarizing) {
+                            const Mueller M = bsdf->eval_pdf_polarized(ctx, si, wo).first;
+                            arriving = (mueller::to_world(si.sh_frame, M, -si.wi, wo) * light).s[0];
+                        } else {
+                            arriving = throughput * bsdf->eval(ctx, si, wo);
+                        }
+                        spectral.splat(film, ds.uv, arriving * importance * correction);
                     }
                 }
             }
@@ -113,12 +163,31 @@ public:
             // ---- BSDF sampling: the next segment of the light path ----
             const float sample1 = sampler.next_1d();
             const Point2f sample2 = sampler.next_2d();
-            auto [bs, weight] = bsdf->sample(ctx, si, sample1, sample2);
+            BSDFSample bs;
+            Color3f weight;
+            Mueller M;
+            if (polarizing) {
+                std::tie(bs, M) = bsdf->sample_polarized(ctx, si, sample1, sample2);
+                weight = M.unpolarized();
+            } else {
+                std::tie(bs, weight) = bsdf->sample(ctx, si, sample1, sample2);
+            }
             if (weight.is_black()) return;
             const Vector3f wo_world = si.to_world(bs.wo);
             const float correction = shading_correction(si, wo_world, bs.wo);
             if (!(correction > 0.f)) return;
-            throughput *= weight * correction;
+            if constexpr (Polarized) {
+                if (polarizing)
+                    light = mueller::to_world(si.sh_frame, M, -si.wi, bs.wo) * light;
+                else if (has_flag(bs.sampled_type, BSDFFlags::Null))
+                    light = light * weight; // passed through unchanged
+                else
+                    light = Stokes::unpolarized(light.s[0] * weight);
+                light = light * Color3f(correction);
+                throughput = light.s[0];
+            } else {
+                throughput *= weight * correction;
+            }
             eta *= bs.eta;
             const float throughput_max = throughput.max();
             if (!(throughput_max > 0.f) || !std::isfinite(throughput_max)) return;
@@ -134,6 +203,7 @@ public:
                 const float q = std::min(throughput.max() * eta * eta, 0.95f);
                 if (!(sampler.next_1d() < q)) return;
                 throughput /= q;
+                if constexpr (Polarized) light = light * Color3f(1.f / q);
             }
         }
     }
@@ -153,11 +223,13 @@ public:
     /// Emitters seen directly: a point on the emitter's shape connected to the sensor, weighted
     /// by the emitted radiance towards the sensor and the emitter's cosine.
     void connect_emitter(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
-                         float n_emitters, Sampler &sampler, SplatTarget &film) const {
+                         float n_emitters, Sampler &sampler, const Spectral &spectral,
+                         SplatTarget &film) const {
         const Point2f u_pos = sampler.next_2d(), u_sensor = sampler.next_2d();
         if (emitter.is_infinite()) {
             if (!emitter.is_delta())
-                connect_environment(scene, sensor, emitter, n_emitters, u_pos, u_sensor, film);
+                connect_environment(scene, sensor, emitter, n_emitters, u_pos, u_sensor, spectral,
+                                    film);
             return;
         }
         // Point and spot lights are invisible to a camera; only emitters on shapes are seen.
@@ -172,6 +244,7 @@ public:
         si.sh_frame = Frame(ps.n);
         si.shape = shape;
         si.t = 0.f;
+        si.wavelengths = spectral.lambda;
         auto [ds, importance] = sensor.sample_direction(si, u_sensor);
         if (importance.is_black()) return;
         si.wi = si.to_local(ds.d);
@@ -180,8 +253,7 @@ public:
         Color3f L = emitter.eval(si);
         if (L.is_black()) return;
         if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
-        Color3f value = L * (cos_theta * n_emitters / ps.pdf) * importance;
-        if (value.is_finite()) film.splat(ds.uv, value);
+        spectral.splat(film, ds.uv, L * (cos_theta * n_emitters / ps.pdf) * importance);
     }
 
     /// An environment seen directly: a direction sampled by the emitter from the sensor's
@@ -191,11 +263,12 @@ public:
     /// that sphere and no cosine. The radiance is the environment's along the connection.
     void connect_environment(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
                              float n_emitters, const Point2f &u_pos, const Point2f &u_sensor,
-                             SplatTarget &film) const {
+                             const Spectral &spectral, SplatTarget &film) const {
         Interaction ref;
         ref.p = sensor.to_world().apply_point(Point3f(0.f));
         ref.n = Normal3f(0.f);
         ref.t = 0.f;
+        ref.wavelengths = spectral.lambda;
         auto [eds, eweight] = emitter.sample_direction(ref, u_pos);
         if (!(eds.pdf > 0.f) || eweight.is_black()) return;
         // The far point, outside the scene's bounding sphere wherever the sensor is (the
@@ -216,18 +289,21 @@ public:
         if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
         // The radiance a camera ray from the sensor point along -ds.d would find.
         SurfaceInteraction miss;
-        Scene::escaped(Ray(ds.p, -ds.d), miss);
+        Ray camera_ray(ds.p, -ds.d);
+        camera_ray.wavelengths = spectral.lambda;
+        Scene::escaped(camera_ray, miss);
         const Color3f L = emitter.eval(miss);
-        Color3f value = L * (dist2 * n_emitters / eds.pdf) * importance;
-        if (!value.is_black() && value.is_finite()) film.splat(ds.uv, value);
+        spectral.splat(film, ds.uv, L * (dist2 * n_emitters / eds.pdf) * importance);
     }
 
     uint32_t m_max_depth;
     uint32_t m_rr_depth;
     bool m_hide_emitters;
+    bool m_spectral, m_polarized;
 };
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::ParticleTracer, Integrator, "ptracer",
-                    "Particle tracer: light paths connected to the sensor", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::ParticleTracer, Integrator, "ptracer",
+                          "Particle tracer: light paths connected to the sensor", DOC,
+                          ::facet::AllModes)

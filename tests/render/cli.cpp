@@ -274,8 +274,13 @@ TEST_F(CliTest, PluginsListsEveryKind) {
     EXPECT_NE(bsdfs.out.find("diffuse"), std::string::npos);
     EXPECT_EQ(bsdfs.out.find("perspective"), std::string::npos) << bsdfs.out;
     // A plugin that does not render in every mode says which it renders in.
+    Result integrators = run("plugins integrator");
+    ASSERT_EQ(integrators.code, 0) << integrators.err;
     EXPECT_TRUE(std::regex_search(
-        bsdfs.out, std::regex(R"(\n\s+principled\s[^\n]*\(only scalar_rgb, scalar_mono\)\n)")))
+        integrators.out, std::regex(R"(\n\s+depth\s[^\n]*\(only scalar_rgb, scalar_mono\)\n)")))
+        << integrators.out;
+    EXPECT_TRUE(
+        std::regex_search(bsdfs.out, std::regex(R"(\n\s+principled\s+[^\n]*'s principled\)\n)")))
         << bsdfs.out;
     EXPECT_TRUE(std::regex_search(
         bsdfs.out, std::regex(R"(\n\s+diffuse\s+Smooth diffuse \(Lambertian\) reflection\n)")))

@@ -48,9 +48,12 @@ public:
 
     /// Samples a ray leaving the emitter (light tracing, photon emission) from two uniform pairs:
     /// `u_pos` for the position, `u_dir` for the direction. Returns the ray and the power
-    /// weight (emitted intensity or radiance·cos over the joint density). Not every emitter
-    /// supports it; those that do not throw.
-    virtual std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const {
+    /// weight (emitted intensity or radiance·cos over the joint density). In the spectral modes
+    /// the weight is the power at the path's `wavelengths`, which the ray carries
+    /// (Ray::wavelengths); in the others they are ignored. Not every emitter supports it; those
+    /// that do not throw.
+    virtual std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir,
+                                               const Wavelengths &wavelengths) const {
         FACET_THROW("{} cannot sample emitted rays", to_string());
     }
     /// Solid-angle density of the directions sample_ray() draws, for emitters with one origin

@@ -345,7 +345,8 @@ EmissionAdapter::EmissionAdapter(std::shared_ptr<Emitter> emitter) : m_emitter(s
 
 Chi2Sample EmissionAdapter::sample(const float *u) const {
     // One origin: the position sample does not matter.
-    auto [ray, weight] = m_emitter->sample_ray(Point2f(0.5f, 0.5f), Point2f(u[0], u[1]));
+    auto [ray, weight] =
+        m_emitter->sample_ray(Point2f(0.5f, 0.5f), Point2f(u[0], u[1]), ChiSquareWavelengths);
     Chi2Sample s;
     s.kind = weight.is_black() ? Chi2Sample::Kind::Failed : Chi2Sample::Kind::Smooth;
     s.d = ray.d;

@@ -247,17 +247,17 @@ TEST(SpectralMode, ConductorPresetsUseTheMeasuredDataPerWavelength) {
 
 TEST(SpectralMode, PluginsThatDoNotRenderTheModeAreRefusedByName) {
     const std::string xml = R"(<scene version="3.0.0">
-        <integrator type="ptracer"/>
+        <integrator type="depth"/>
         <shape type="sphere"/>
     </scene>)";
     LoadOptions opts;
     opts.mode = "scalar_spectral";
     try {
         load_string(xml, opts);
-        ADD_FAILURE() << "ptracer was accepted in the spectral mode";
+        ADD_FAILURE() << "depth was accepted in the spectral mode";
     } catch (const Error &e) {
         EXPECT_NE(std::string(e.what()).find(
-                      "the integrator plugin \"ptracer\" does not render in the mode "
+                      "the integrator plugin \"depth\" does not render in the mode "
                       "scalar_spectral (it renders in: scalar_rgb, scalar_mono)"),
                   std::string::npos)
             << e.what();

@@ -63,7 +63,7 @@ TEST(DirectionalArea, SampleRayIsUniformAlongTheNormalWithThePower) {
     std::vector<int> hist(size_t(bins * bins), 0);
     for (int i = 0; i < n; ++i) {
         const Point2f u_pos = next_point2f(rng);
-        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng));
+        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng), Wavelengths());
         // Power: radiance x area (3 x 1) for every ray.
         EXPECT_NEAR(weight.r, 9.f, 1e-4f);
         EXPECT_NEAR(weight.b, 6.f, 1e-4f);

@@ -128,7 +128,7 @@ TEST(EmitterPoint, SampleRay) {
     Vector3f mean_d(0.f);
     for (int i = 0; i < 10000; ++i) {
         const Point2f u_pos = next_point2f(rng);
-        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng));
+        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng), Wavelengths());
         EXPECT_EQ(ray.o, Point3f(1.f, -2.f, 0.5f));
         EXPECT_NEAR(norm(ray.d), 1.f, 1e-5f);
         EXPECT_NEAR(e->pdf_ray_direction(ray.d), InvFourPi, 1e-7f);
@@ -257,7 +257,7 @@ TEST(EmitterArea, SampleRayCarriesThePower) {
     const int n = 20000;
     for (int i = 0; i < n; ++i) {
         const Point2f u_pos = next_point2f(rng);
-        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng));
+        auto [ray, weight] = e->sample_ray(u_pos, next_point2f(rng), Wavelengths());
         expect_color_near(weight, Color3f(2.f, 1.f, 0.5f) * (Pi * 4.f), 1e-5f);
         EXPECT_LE(std::abs(ray.o.x), 1.f + 1e-5f);
         EXPECT_LE(std::abs(ray.o.y), 1.f + 1e-5f);

@@ -269,7 +269,8 @@ TEST(EnvironmentMap, SamplesOnTheEdgesOfTheSquareAreValid) {
                 auto [ds, w] = env.sample_direction(ref, Point2f(ux, uy));
                 expect_valid_direction_sample(ds, w, ux, uy);
                 EXPECT_EQ(env.pdf_direction(ref, ds), ds.pdf);
-                auto [ray, power] = env.sample_ray(Point2f(0.5f, 0.5f), Point2f(ux, uy));
+                auto [ray, power] =
+                    env.sample_ray(Point2f(0.5f, 0.5f), Point2f(ux, uy), Wavelengths());
                 EXPECT_TRUE(std::isfinite(ray.d.x) && std::isfinite(ray.o.x));
                 EXPECT_TRUE(power.is_finite());
             }

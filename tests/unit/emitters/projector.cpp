@@ -163,7 +163,8 @@ TEST(Projector, EmittedRaysCarryIntensityOverDensity) {
     auto proj = make_projector(props);
     PCG32 rng(11);
     for (int i = 0; i < 100; ++i) {
-        auto [ray, weight] = proj->sample_ray(Point2f(0.5f, 0.5f), next_point2f(rng));
+        auto [ray, weight] =
+            proj->sample_ray(Point2f(0.5f, 0.5f), next_point2f(rng), Wavelengths());
         ASSERT_FALSE(weight.is_black());
         EXPECT_NEAR(norm(ray.d), 1.f, 1e-5f);
         // Intensity towards ray.d: the sample_direction weight times dist².
