@@ -270,17 +270,14 @@ inline Mueller rotate_mueller_basis_collinear(const Mueller &M, const Vector3f &
  * A BSDF's reflection matrix `M`, given in the frames of the s direction n × d (n the interface's
  * normal, +Z or a microfacet's), turned into the implicit frames of the local directions: light
  * arrives along −wo_hat and leaves along wi_hat (see BSDF). At normal incidence, where the plane
- * of incidence is undefined, both s directions are the x axis.
+ * of incidence is undefined, the s direction is the x axis (for each direction on its own).
  */
 inline Mueller reflection_to_implicit(const Mueller &M, const Vector3f &n, const Vector3f &wo_hat,
                                       const Vector3f &wi_hat) {
-    Vector3f s_in = cross(n, -wo_hat), s_out = cross(n, wi_hat);
-    if (s_in.x == 0.f && s_in.y == 0.f && s_in.z == 0.f) {
-        s_in = s_out = Vector3f(1.f, 0.f, 0.f);
-    } else {
-        s_in = normalize(s_in);
-        s_out = normalize(s_out);
-    }
+    auto s_axis = [](const Vector3f &s) {
+        return s.x == 0.f && s.y == 0.f && s.z == 0.f ? Vector3f(1.f, 0.f, 0.f) : normalize(s);
+    };
+    const Vector3f s_in = s_axis(cross(n, -wo_hat)), s_out = s_axis(cross(n, wi_hat));
     return rotate_mueller_basis(M, -wo_hat, s_in, stokes_basis(-wo_hat), wi_hat, s_out,
                                 stokes_basis(wi_hat));
 }
