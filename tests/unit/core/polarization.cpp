@@ -22,6 +22,7 @@
 #include <cmath>
 #include <complex>
 #include <string>
+#include <tuple>
 
 using namespace facet;
 
@@ -462,6 +463,8 @@ TEST(Polarization, BSDFMatricesAgreeWithTheirColoursAndTheirDensities) {
         "<bsdf version=\"3.0.0\" type=\"mask\"><float name=\"opacity\" value=\"0.6\"/>" + rough +
             "</bsdf>",
         R"(<bsdf version="3.0.0" type="polarizer"><float name="theta" value="30"/></bsdf>)",
+        R"(<bsdf version="3.0.0" type="pplastic"><string name="distribution" value="ggx"/>
+            <float name="alpha" value="0.2"/><rgb name="diffuse_reflectance" value="0.2, 0.5, 0.8"/></bsdf>)",
     };
     PCG32 rng(7);
     for (const std::string &xml : bsdfs) {
@@ -505,45 +508,56 @@ TEST(Polarization, BSDFMatricesAgreeWithTheirColoursAndTheirDensities) {
     }
 }
 
-TEST(Polarization, EachMicrofacetReflectsAsASmoothConductorInItsOwnFrame) {
-    // roughconductor's matrix at (wi, wo), normalised by its (0, 0) entry, is the smooth
-    // conductor's for the mirror whose normal is h = (wi + wo)/|wi + wo|, taken from the
-    // frame of h to the surface's frame.
-    const std::shared_ptr<BSDF> rough = load_bsdf(
-        R"(<bsdf version="3.0.0" type="roughconductor"><string name="material" value="Au"/>
-            <float name="alpha" value="0.4"/></bsdf>)");
-    const std::shared_ptr<BSDF> smooth = load_bsdf(
-        R"(<bsdf version="3.0.0" type="conductor"><string name="material" value="Au"/></bsdf>)");
-    ASSERT_TRUE(rough && smooth);
-    PCG32 rng(11);
-    int checked = 0;
-    for (int i = 0; i < 200; ++i) {
-        auto upper = [&]() {
-            const float z = 0.1f + 0.9f * rng.next_float(), phi = 2.f * Pi * rng.next_float();
-            const float r = std::sqrt(1.f - z * z);
-            return Vector3f(r * std::cos(phi), r * std::sin(phi), z);
-        };
-        SurfaceInteraction si;
-        si.wavelengths = Wavelengths(450.f, 550.f, 650.f);
-        si.wi = upper();
-        const Vector3f wo = upper();
-        const auto [M, pdf] = rough->eval_pdf_polarized(BSDFContext(), si, wo);
-        if (M.is_black()) continue;
-        const Frame fh(normalize(si.wi + wo));
-        SurfaceInteraction hi = si;
-        hi.wi = fh.to_local(si.wi);
-        const auto [bs, S] = smooth->sample_polarized(BSDFContext(), hi, 0.5f, Point2f(0.5f));
-        ASSERT_LT(norm(fh.to_world(bs.wo) - wo), 1e-4f);
-        const Mueller expected = mueller::to_world(fh, S, -bs.wo, hi.wi);
-        for (int a = 0; a < 4; ++a)
-            for (int b = 0; b < 4; ++b)
-                for (int lane = 0; lane < 3; ++lane)
-                    EXPECT_NEAR(M.m[a][b][lane] / M.m[0][0][lane],
-                                expected.m[a][b][lane] / expected.m[0][0][lane], 2e-4)
-                        << "entry " << a << ", " << b << " lane " << lane << " sample " << i;
-        ++checked;
+TEST(Polarization, EachMicrofacetReflectsAsASmoothInterfaceInItsOwnFrame) {
+    // A microfacet BSDF's reflection matrix at (wi, wo), normalised by its (0, 0) entry, is the
+    // smooth interface's for the mirror whose normal is h = (wi + wo)/|wi + wo|, taken from the
+    // frame of h to the surface's frame: roughconductor against conductor, pplastic's glossy
+    // lobe against the dielectric's reflection.
+    BSDFContext reflection;
+    reflection.component = 0;
+    const std::vector<std::tuple<std::string, std::string, BSDFContext>> pairs = {
+        {R"(<bsdf version="3.0.0" type="roughconductor"><string name="material" value="Au"/>
+            <float name="alpha" value="0.4"/></bsdf>)",
+         R"(<bsdf version="3.0.0" type="conductor"><string name="material" value="Au"/></bsdf>)",
+         BSDFContext()},
+        {R"(<bsdf version="3.0.0" type="pplastic"><float name="alpha" value="0.4"/></bsdf>)",
+         R"(<bsdf version="3.0.0" type="dielectric"><float name="int_ior" value="1.49"/>
+            <float name="ext_ior" value="1.000277"/></bsdf>)",
+         reflection},
+    };
+    for (const auto &[rough_xml, smooth_xml, ctx] : pairs) {
+        const std::shared_ptr<BSDF> rough = load_bsdf(rough_xml), smooth = load_bsdf(smooth_xml);
+        ASSERT_TRUE(rough && smooth);
+        PCG32 rng(11);
+        int checked = 0;
+        for (int i = 0; i < 200; ++i) {
+            auto upper = [&]() {
+                const float z = 0.1f + 0.9f * rng.next_float(), phi = 2.f * Pi * rng.next_float();
+                const float r = std::sqrt(1.f - z * z);
+                return Vector3f(r * std::cos(phi), r * std::sin(phi), z);
+            };
+            SurfaceInteraction si;
+            si.wavelengths = Wavelengths(450.f, 550.f, 650.f);
+            si.wi = upper();
+            const Vector3f wo = upper();
+            const auto [M, pdf] = rough->eval_pdf_polarized(ctx, si, wo);
+            if (M.is_black()) continue;
+            const Frame fh(normalize(si.wi + wo));
+            SurfaceInteraction hi = si;
+            hi.wi = fh.to_local(si.wi);
+            const auto [bs, S] = smooth->sample_polarized(ctx, hi, 0.f, Point2f(0.5f));
+            ASSERT_LT(norm(fh.to_world(bs.wo) - wo), 1e-4f) << smooth_xml;
+            const Mueller expected = mueller::to_world(fh, S, -bs.wo, hi.wi);
+            for (int a = 0; a < 4; ++a)
+                for (int b = 0; b < 4; ++b)
+                    for (int lane = 0; lane < 3; ++lane)
+                        EXPECT_NEAR(M.m[a][b][lane] / M.m[0][0][lane],
+                                    expected.m[a][b][lane] / expected.m[0][0][lane], 2e-4)
+                            << rough_xml << " entry " << a << ", " << b << " sample " << i;
+            ++checked;
+        }
+        EXPECT_GT(checked, 150) << rough_xml;
     }
-    EXPECT_GT(checked, 150);
 }
 
 namespace {
