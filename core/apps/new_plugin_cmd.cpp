@@ -268,12 +268,17 @@ public:
 
     /// A ray entering the bounding sphere: direction w uniform over the sphere (pdf 1/4π), origin
     /// uniform on the disk of radius r facing it (pdf 1/(π r²)); weight = radiance / both pdfs.
-    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir) const override {
+    /// (The colours are RGB: the plugin renders in scalar_rgb and scalar_mono, where the path's
+    /// wavelengths are unused; the ray carries them on all the same.)
+    std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir,
+                                       const Wavelengths &wavelengths) const override {
         const Vector3f w = warp::square_to_uniform_sphere(u_dir);
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
         const Frame frame(w);
         const Point3f o = m_center + (frame.s * disk.x + frame.t * disk.y - w) * m_radius;
-        return {Ray(o, w), radiance_from(-w) * (4.f * Pi * Pi * m_radius * m_radius)};
+        Ray ray(o, w);
+        ray.wavelengths = wavelengths;
+        return {ray, radiance_from(-w) * (4.f * Pi * Pi * m_radius * m_radius)};
     }
 
     std::string to_string() const override {
