@@ -228,7 +228,10 @@ private:
             if (depth >= m_rr_depth) {
                 float q = std::min(throughput_max * eta * eta, 0.95f);
                 if (!(sampler.draw_1d() < q)) break;
-                throughput = throughput * Color3f(1.f / q);
+                if constexpr (Polarized)
+                    throughput = throughput * Color3f(1.f / q);
+                else
+                    throughput /= q;
             }
         }
         return result;
