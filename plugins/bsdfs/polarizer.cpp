@@ -61,7 +61,10 @@ protected:
         // The absorbing axis (the tangent v at theta = 0), projected onto the plane
         // perpendicular to the light; the transmission axis is perpendicular to both.
         const Vector3f absorbing(std::sin(m_theta), std::cos(m_theta), 0.f);
-        const Vector3f a = normalize(absorbing - forward * dot(absorbing, forward));
+        const Vector3f projected = absorbing - forward * dot(absorbing, forward);
+        // Light travelling along the absorbing axis itself (grazing the sheet) passes nothing.
+        if (!(dot(projected, projected) > 1e-12f)) return Mueller{};
+        const Vector3f a = normalize(projected);
         const Vector3f transmitting = cross(forward, a);
         const Mueller M = mueller::rotate_mueller_basis_collinear(
             mueller::linear_polarizer(), forward, transmitting, mueller::stokes_basis(forward));

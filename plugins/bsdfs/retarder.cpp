@@ -8,9 +8,11 @@ polarisation about the fast axis). Light crosses it without changing direction (
 both sides). In the modes without polarisation it passes the light, times `transmittance`.
 
 The fast axis lies in the surface: at `theta` = 0 it is the shading frame's first tangent (the u
-direction of a rectangle or disk), and `theta` turns it in the surface's plane (seen from the
-back of the sheet, the turn is mirrored). Light crossing obliquely sees the delay scaled by
-|cos θ| of its direction.
+direction of a rectangle or disk), and `theta` turns it towards the second tangent v
+(counter-clockwise seen from the front; note that `polarizer`'s `theta` turns the other way, as
+in Mitsuba 3). Light crossing obliquely sees the delay scaled by |cos θ| of its direction, and,
+as in Mitsuba 3, the tangent u itself as its reference axis (not projected onto the plane
+perpendicular to the light): an approximation for light near the normal.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -58,9 +60,10 @@ protected:
     }
 
     Mueller polarized(const SurfaceInteraction &si, const Vector3f &forward) const override {
-        const float cos_i = Frame::cos_theta(si.wi);
-        Mueller M = mueller::linear_retarder(m_delta * std::abs(cos_i));
-        M = mueller::rotated_element(cos_i < 0.f ? -m_theta : m_theta, M);
+        // The axes turn with the frame (x, forward × x) of the light's direction of travel,
+        // which is mirrored for light crossing the sheet towards its back.
+        Mueller M = mueller::linear_retarder(m_delta * std::abs(Frame::cos_theta(si.wi)));
+        M = mueller::rotated_element(forward.z < 0.f ? -m_theta : m_theta, M);
         // The element's frame has the surface's first tangent as its x axis.
         M = mueller::rotate_mueller_basis_collinear(M, forward, Vector3f(1.f, 0.f, 0.f),
                                                     mueller::stokes_basis(forward));
