@@ -562,9 +562,11 @@ TEST(Polarization, EachMicrofacetReflectsAsASmoothInterfaceInItsOwnFrame) {
 
 namespace {
 
-/// The mean G of a 16x16 view of a diffuse floor lit through two polarizers (axes `theta1`,
-/// `theta2`) by an area light above them, rendered by `integrator` in the polarized mode.
-double floor_through_polarizers(const std::string &integrator, float theta1, float theta2) {
+/// The mean G of a 16x16 view of a diffuse floor lit through three sheets (the BSDFs `upper`,
+/// `middle`, `lower`, in the order the light crosses them) by an area light above them, rendered
+/// by `integrator` in the polarized mode.
+double floor_through_sheets(const std::string &integrator, const std::string &upper,
+                            const std::string &middle, const std::string &lower) {
     const std::string xml = fmt::format(R"(<scene version="3.0.0">
         <integrator type="{}"><integer name="max_depth" value="6"/></integrator>
         <sensor type="perspective">
@@ -580,18 +582,22 @@ double floor_through_polarizers(const std::string &integrator, float theta1, flo
         </shape>
         <shape type="rectangle">
             <transform name="to_world"><scale value="8"/><translate z="3"/></transform>
-            <bsdf type="polarizer"><float name="theta" value="{}"/></bsdf>
+            {}
+        </shape>
+        <shape type="rectangle">
+            <transform name="to_world"><scale value="8"/><translate z="2.75"/></transform>
+            {}
         </shape>
         <shape type="rectangle">
             <transform name="to_world"><scale value="8"/><translate z="2.5"/></transform>
-            <bsdf type="polarizer"><float name="theta" value="{}"/></bsdf>
+            {}
         </shape>
         <shape type="rectangle">
             <transform name="to_world"><scale value="10"/></transform>
             <bsdf type="diffuse"/>
         </shape>
     </scene>)",
-                                        integrator, theta1, theta2);
+                                        integrator, upper, middle, lower);
     LoadOptions opts;
     opts.mode = "scalar_spectral_polarized";
     auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml, opts));
@@ -611,12 +617,65 @@ TEST(Polarization, LightTracingCarriesPolarisationLikeThePathTracer) {
     // matrix maps light from −wi to wo); the path tracer from the camera. Through two
     // polarizers at 60 degrees a floor gets about a quarter of the light of parallel ones
     // (cos² 60°, a little more for oblique light): both must see it, and agree.
-    const double path_parallel = floor_through_polarizers("path", 0, 0);
-    const double path_crossed = floor_through_polarizers("path", 0, 60);
-    const double light_parallel = floor_through_polarizers("ptracer", 0, 0);
-    const double light_crossed = floor_through_polarizers("ptracer", 0, 60);
+    const std::string null = R"(<bsdf type="null"/>)";
+    const double path_parallel = floor_through_sheets("path", polarizer(0), null, polarizer(0));
+    const double path_crossed = floor_through_sheets("path", polarizer(0), null, polarizer(60));
+    const double light_parallel = floor_through_sheets("ptracer", polarizer(0), null, polarizer(0));
+    const double light_crossed = floor_through_sheets("ptracer", polarizer(0), null, polarizer(60));
     ASSERT_GT(path_parallel, 0.01);
     EXPECT_NEAR(path_crossed / path_parallel, 0.25, 0.03);
     EXPECT_NEAR(light_parallel / path_parallel, 1.0, 0.02);
     EXPECT_NEAR(light_crossed / path_crossed, 1.0, 0.03);
+    // Linear light, a quarter-wave plate at 45 degrees to it, a circular polariser: the plate's
+    // axis must turn the same way for light traced from either end (about all the light, or
+    // none, passes the circular polariser, depending on the handedness).
+    const std::string plate =
+        R"(<bsdf type="retarder"><float name="theta" value="45"/><float name="delta" value="90"/></bsdf>)";
+    for (const char *circular :
+         {R"(<bsdf type="circular"/>)",
+          R"(<bsdf type="circular"><boolean name="left_handed" value="true"/></bsdf>)"}) {
+        const double path = floor_through_sheets("path", polarizer(0), plate, circular);
+        const double light = floor_through_sheets("ptracer", polarizer(0), plate, circular);
+        EXPECT_NEAR(light, path, 0.03 * path_parallel) << circular;
+    }
+}
+
+TEST(Polarization, AGlassSphereInAUniformSkyIsTheSky) {
+    // A furnace: a smooth glass sphere under a uniform, unpolarised sky. Reflection and
+    // refraction conserve the intensity of light of any polarisation (the (0, 0) and (0, 1)
+    // entries of their matrices sum to 1 and 0), so the sphere disappears: in the spectral mode
+    // every path's weight is exactly 1, in the polarized mode it is 1 in expectation.
+    auto render_centre = [](const std::string &mode, bool sphere) {
+        const std::string xml =
+            fmt::format(R"(<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="64"/>
+                <integer name="rr_depth" value="64"/></integrator>
+            <sensor type="orthographic">
+                <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+                <sampler type="independent"><integer name="sample_count" value="256"/></sampler>
+                <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/>
+                    <rfilter type="box"/></film>
+            </sensor>
+            <emitter type="constant"><spectrum name="radiance" value="1"/></emitter>
+            {}
+        </scene>)",
+                        sphere ? R"(<shape type="sphere"><float name="radius" value="0.9"/>
+                <bsdf type="dielectric"><float name="int_ior" value="1.6"/></bsdf></shape>)"
+                               : "");
+        LoadOptions opts;
+        opts.mode = mode;
+        auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml, opts));
+        RenderOptions ro;
+        ro.progress = false;
+        const Image image = render(*scene, *scene->sensors().at(0), ro).image;
+        // The centre of the image sees the sky through the sphere.
+        double mean = 0.0;
+        for (int y = 4; y < 12; ++y)
+            for (int x = 4; x < 12; ++x) mean += image.at(x, y, 1) / 64.0;
+        return mean;
+    };
+    for (const char *mode : {"scalar_spectral_polarized", "scalar_spectral"}) {
+        const double ratio = render_centre(mode, true) / render_centre(mode, false);
+        EXPECT_NEAR(ratio, 1.0, std::string(mode) == "scalar_spectral" ? 1e-4 : 0.01) << mode;
+    }
 }
