@@ -77,8 +77,7 @@ public:
         const float s_mean = m_specular_reflectance ? m_specular_reflectance->mean().mean() : 1.f;
         m_specular_sampling_weight = d_mean + s_mean > 0.f ? s_mean / (d_mean + s_mean) : 0.5f;
 
-        BSDFFlags spec =
-            BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
+        BSDFFlags spec = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
         BSDFFlags diff =
             BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
         if (m_microfacet.is_anisotropic()) spec |= BSDFFlags::Anisotropic;
@@ -172,10 +171,8 @@ public:
                 mueller::specular_transmission(std::abs(Frame::cos_theta(wo_hat)), m_eta);
             const float cos_t = fresnel_dielectric(Frame::cos_theta(wi_hat), m_eta).cos_t;
             const Mueller T_out = mueller::specular_transmission(std::abs(cos_t), 1.f / m_eta);
-            const Mueller D =
-                T_out * mueller::depolarizer(m_diffuse_reflectance->eval(si)) * T_in;
-            value += mueller::reflection_to_implicit(D, n, wo_hat, wi_hat) *
-                     Color3f(cos_o * InvPi);
+            const Mueller D = T_out * mueller::depolarizer(m_diffuse_reflectance->eval(si)) * T_in;
+            value += mueller::reflection_to_implicit(D, n, wo_hat, wi_hat) * Color3f(cos_o * InvPi);
         }
         return {value, pdf(ctx, si, wo)};
     }
