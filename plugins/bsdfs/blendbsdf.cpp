@@ -30,6 +30,8 @@ Components: the first BSDF's components, then the second's; the flags are their 
 ```
 )DOC";
 
+#include "forwarding_bsdf.h"
+
 #include <facet/bsdf.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -39,7 +41,9 @@ Components: the first BSDF's components, then the second's; the flags are their 
 
 namespace facet {
 
-class BlendBSDF final : public BSDF {
+class BlendBSDF final : public ForwardingBSDF<BlendBSDF> {
+    friend class ForwardingBSDF<BlendBSDF>;
+
 public:
     explicit BlendBSDF(const Properties &props) {
         size_t count = 0;
@@ -82,22 +86,6 @@ public:
         m_first_count = uint32_t(m_nested[0]->component_count());
     }
 
-    std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                          float sample1, const Point2f &sample2) const override {
-        return sample_impl<Color3f>(ctx, si, sample1, sample2);
-    }
-    /// The polarized mode: the same blend of the nested BSDFs' matrices.
-    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
-                                                    const SurfaceInteraction &si, float sample1,
-                                                    const Point2f &sample2) const override {
-        return sample_impl<Mueller>(ctx, si, sample1, sample2);
-    }
-    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
-                                                 const SurfaceInteraction &si,
-                                                 const Vector3f &wo) const override {
-        return eval_pdf_impl<Mueller>(ctx, si, wo);
-    }
-
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
                  const Vector3f &wo) const override {
         float w = weight(si);
@@ -124,11 +112,6 @@ public:
         if (w < 1.f) result += m_nested[0]->pdf(ctx, si, wo) * (1.f - w);
         if (w > 0.f) result += m_nested[1]->pdf(ctx, si, wo) * w;
         return result;
-    }
-
-    std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                       const Vector3f &wo) const override {
-        return eval_pdf_impl<Color3f>(ctx, si, wo);
     }
 
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {

@@ -27,6 +27,8 @@ Components: the nested BSDF's components, then the pass-through (Null, both side
 ```
 )DOC";
 
+#include "forwarding_bsdf.h"
+
 #include <facet/bsdf.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -36,7 +38,9 @@ Components: the nested BSDF's components, then the pass-through (Null, both side
 
 namespace facet {
 
-class Mask final : public BSDF {
+class Mask final : public ForwardingBSDF<Mask> {
+    friend class ForwardingBSDF<Mask>;
+
 public:
     explicit Mask(const Properties &props) {
         for (const auto &[name, obj] : props.objects()) {
@@ -70,23 +74,6 @@ public:
         m_null_index = uint32_t(component_count() - 1);
     }
 
-    std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                          float sample1, const Point2f &sample2) const override {
-        return sample_impl<Color3f>(ctx, si, sample1, sample2);
-    }
-    /// The polarized mode: the nested BSDF's matrices; the light passed through keeps its
-    /// polarisation.
-    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
-                                                    const SurfaceInteraction &si, float sample1,
-                                                    const Point2f &sample2) const override {
-        return sample_impl<Mueller>(ctx, si, sample1, sample2);
-    }
-    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
-                                                 const SurfaceInteraction &si,
-                                                 const Vector3f &wo) const override {
-        return eval_pdf_impl<Mueller>(ctx, si, wo);
-    }
-
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
                  const Vector3f &wo) const override {
         if (!nested_enabled(ctx)) return Color3f(0.f);
@@ -99,11 +86,6 @@ public:
         bool has_nested = nested_enabled(ctx);
         if (!has_nested) return 0.f;
         return m_nested->pdf(ctx, si, wo) * selection_opacity(opacity(si), has_null, has_nested);
-    }
-
-    std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                       const Vector3f &wo) const override {
-        return eval_pdf_impl<Color3f>(ctx, si, wo);
     }
 
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {

@@ -25,6 +25,8 @@ back side is shifted down by the front BSDF's component count before it reaches 
 ```
 )DOC";
 
+#include "forwarding_bsdf.h"
+
 #include <facet/bsdf.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
@@ -33,7 +35,9 @@ back side is shifted down by the front BSDF's component count before it reaches 
 
 namespace facet {
 
-class TwoSided final : public BSDF {
+class TwoSided final : public ForwardingBSDF<TwoSided> {
+    friend class ForwardingBSDF<TwoSided>;
+
 public:
     explicit TwoSided(const Properties &props) {
         std::vector<std::shared_ptr<BSDF>> nested;
@@ -71,23 +75,6 @@ public:
         m_front_count = uint32_t(m_front->component_count());
     }
 
-    std::pair<BSDFSample, Color3f> sample(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                          float sample1, const Point2f &sample2) const override {
-        return sample_impl<Color3f>(ctx, si, sample1, sample2);
-    }
-    /// The polarized mode: the side's BSDF's matrix, as Mitsuba 3 gives it (the back side's in
-    /// the mirrored frame).
-    std::pair<BSDFSample, Mueller> sample_polarized(const BSDFContext &ctx,
-                                                    const SurfaceInteraction &si, float sample1,
-                                                    const Point2f &sample2) const override {
-        return sample_impl<Mueller>(ctx, si, sample1, sample2);
-    }
-    std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
-                                                 const SurfaceInteraction &si,
-                                                 const Vector3f &wo) const override {
-        return eval_pdf_impl<Mueller>(ctx, si, wo);
-    }
-
     Color3f eval(const BSDFContext &ctx, const SurfaceInteraction &si,
                  const Vector3f &wo) const override {
         float cos_i = Frame::cos_theta(si.wi);
@@ -110,11 +97,6 @@ public:
         BSDFContext back_ctx;
         if (cos_i == 0.f || !back_context(ctx, back_ctx)) return 0.f;
         return m_back->pdf(back_ctx, mirrored(si), mirror(wo));
-    }
-
-    std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
-                                       const Vector3f &wo) const override {
-        return eval_pdf_impl<Color3f>(ctx, si, wo);
     }
 
     Color3f eval_null_transmission(const SurfaceInteraction &si) const override {
@@ -143,6 +125,8 @@ public:
     }
 
 private:
+    /// sample() and sample_polarized() (ForwardingBSDF): the side's BSDF; in the polarized mode
+    /// the back side's matrix is passed on in the mirrored frame, as Mitsuba 3 does.
     template <typename V>
     std::pair<BSDFSample, V> sample_impl(const BSDFContext &ctx, const SurfaceInteraction &si,
                                          float sample1, const Point2f &sample2) const {
