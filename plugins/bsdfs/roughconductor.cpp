@@ -103,19 +103,10 @@ public:
 
     std::pair<Color3f, float> eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si,
                                        const Vector3f &wo) const override {
-        float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
-        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f || cos_o <= 0.f)
-            return {Color3f(0.f), 0.f};
-
-        MicrofacetDistribution distr = m_microfacet.at(si);
-        Vector3f h = normalize(si.wi + wo);
-        float D = distr.eval(h);
-        if (D == 0.f) return {Color3f(0.f), 0.f};
-        float wi_dot_h = dot(si.wi, h);
-        // f·cos θo = F·D·G / (4 cos θi).
-        float value = D * distr.G(si.wi, wo, h) / (4.f * cos_i);
-        Color3f F = fresnel_conductor(wi_dot_h, m_eta->eval(si), m_k->eval(si));
-        float pdf = distr.pdf(si.wi, h) / (4.f * dot(wo, h));
+        Vector3f h;
+        float value, pdf;
+        if (!lobe(ctx, si, wo, h, value, pdf)) return {Color3f(0.f), 0.f};
+        Color3f F = fresnel_conductor(dot(si.wi, h), m_eta->eval(si), m_k->eval(si));
         return {F * m_specular_reflectance->eval(si) * value, pdf};
     }
 
@@ -124,19 +115,13 @@ public:
     std::pair<Mueller, float> eval_pdf_polarized(const BSDFContext &ctx,
                                                  const SurfaceInteraction &si,
                                                  const Vector3f &wo) const override {
-        float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
-        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f || cos_o <= 0.f)
-            return {Mueller{}, 0.f};
-        MicrofacetDistribution distr = m_microfacet.at(si);
-        Vector3f h = normalize(si.wi + wo);
-        float D = distr.eval(h);
-        if (D == 0.f) return {Mueller{}, 0.f};
-        float value = D * distr.G(si.wi, wo, h) / (4.f * cos_i);
+        Vector3f h;
+        float value, pdf;
+        if (!lobe(ctx, si, wo, h, value, pdf)) return {Mueller{}, 0.f};
         const bool radiance = ctx.mode == TransportMode::Radiance;
         const Vector3f wo_hat = radiance ? wo : si.wi, wi_hat = radiance ? si.wi : wo;
         Mueller F = mueller::specular_reflection(dot(wo_hat, h), m_eta->eval(si), m_k->eval(si));
         F = mueller::reflection_to_implicit(F, h, wo_hat, wi_hat);
-        float pdf = distr.pdf(si.wi, h) / (4.f * dot(wo, h));
         return {F * (m_specular_reflectance->eval(si) * value), pdf};
     }
 
@@ -148,6 +133,22 @@ public:
     }
 
 private:
+    /// The lobe at wo without its Fresnel term and tint: the half vector h, f·cos θo / F =
+    /// D·G / (4 cos θi), and the density; false where it is zero.
+    bool lobe(const BSDFContext &ctx, const SurfaceInteraction &si, const Vector3f &wo, Vector3f &h,
+              float &value, float &pdf) const {
+        const float cos_i = Frame::cos_theta(si.wi), cos_o = Frame::cos_theta(wo);
+        if (!ctx.is_enabled(BSDFFlags::GlossyReflection, 0) || cos_i <= 0.f || cos_o <= 0.f)
+            return false;
+        const MicrofacetDistribution distr = m_microfacet.at(si);
+        h = normalize(si.wi + wo);
+        const float D = distr.eval(h);
+        if (D == 0.f) return false;
+        value = D * distr.G(si.wi, wo, h) / (4.f * cos_i);
+        pdf = distr.pdf(si.wi, h) / (4.f * dot(wo, h));
+        return true;
+    }
+
     /// Draws a microfacet normal and reflects wi about it into bs (all but the pdf); false when
     /// the sample fails.
     bool sample_direction(const BSDFContext &ctx, const SurfaceInteraction &si,
