@@ -1,3 +1,4 @@
+#include "direction_cone.h"
 #include "mesh_inline.h"
 
 #include <facet/bsdf.h>
@@ -362,6 +363,25 @@ size_t Mesh::find_area_face(float u_x) const {
     size_t f =
         size_t(std::upper_bound(m_area_cdf.begin(), m_area_cdf.end(), u_x) - m_area_cdf.begin());
     return std::min(f, m_area_cdf.size() - 1);
+}
+
+std::pair<Vector3f, float> Mesh::normal_cone() const {
+    detail::DirectionCone cone;
+    auto add = [&](const Vector3f &n) {
+        if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) return;
+        if (!cone.empty() && dot(cone.axis, n) >= std::cos(cone.theta)) return; // inside
+        cone = detail::merge(cone, detail::DirectionCone{n, 0.f});
+    };
+    for (size_t f = 0; f < face_count(); ++f) add(Vector3f(face_normal(f)));
+    if (has_vertex_normals())
+        for (size_t i = 0; i + 2 < m_normals.size(); i += 3) {
+            const Vector3f n =
+                normalize(Vector3f(m_normals[i], m_normals[i + 1], m_normals[i + 2]));
+            add(m_flip_normals ? -n : n);
+        }
+    if (cone.empty()) return Shape::normal_cone();
+    // A margin for the rounding of the normals.
+    return {cone.axis, std::cos(std::min(cone.theta + 1e-3f, Pi))};
 }
 
 Normal3f Mesh::face_normal(size_t f) const {

@@ -1,6 +1,8 @@
+#include <facet/emitter.h>
 #include <facet/plugin.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <dlfcn.h>
 #include <filesystem>
@@ -41,6 +43,12 @@ std::string with_article(ObjectType kind) {
     std::string name = kind_name(kind);
     bool vowel = !name.empty() && std::string("aeiou").find(name[0]) != std::string::npos;
     return (vowel ? "an " : "a ") + name;
+}
+
+/// Whether the scene gave `name` and nothing has read it yet.
+bool is_unqueried(const Properties &props, const std::string &name) {
+    const std::vector<std::string> unused = props.unqueried();
+    return std::find(unused.begin(), unused.end(), name) != unused.end();
 }
 
 } // namespace
@@ -215,6 +223,19 @@ std::shared_ptr<Object> PluginRegistry::create(ObjectType expected, const Proper
         FACET_THROW_AT(props.location(), "plugin \"{}\" created {}, but {} was expected here", name,
                        with_article(obj->type()), with_article(expected));
     if (!props.id().empty()) obj->set_id(props.id());
+    if (auto *emitter = dynamic_cast<Emitter *>(obj.get());
+        emitter && is_unqueried(props, "sampling_weight")) {
+        // Every emitter's parameter, as in Mitsuba 3: how often light samples go to it. (Looked
+        // up among the unqueried names, so that a plugin's own parameters, which its table
+        // lists, are all that it asks for.)
+        const double weight = props.get_float("sampling_weight");
+        if (!(weight >= 0.0) || !std::isfinite(float(weight)))
+            FACET_THROW_AT(props.location("sampling_weight"),
+                           "{} plugin of type \"{}\": sampling_weight must be a finite number >= "
+                           "0, got {}",
+                           kind_name(desc->kind), name, weight);
+        emitter->set_sampling_weight(float(weight));
+    }
     check_unqueried(props, obj->type(), lenient);
     return obj;
 }

@@ -1,3 +1,4 @@
+#include "light_bvh.h"
 #include "mesh_inline.h"
 #include "scene_queries.h"
 #include "stats.h"
@@ -191,6 +192,12 @@ size_t Scene::rebuild(const Properties &props) {
     std::swap(m_sensors, next.m_sensors);
     std::swap(m_integrator, next.m_integrator);
     std::swap(m_emitter_table, next.m_emitter_table);
+    std::swap(m_emitter_uniform, next.m_emitter_uniform);
+    std::swap(m_emitter_distr, next.m_emitter_distr);
+    std::swap(m_light_bvh, next.m_light_bvh);
+    std::swap(m_hierarchy_share, next.m_hierarchy_share);
+    std::swap(m_outside_pmf, next.m_outside_pmf);
+    std::swap(m_outside_hierarchy, next.m_outside_hierarchy);
     std::swap(m_geometries, next.m_geometries);
     std::swap(m_bbox, next.m_bbox);
     std::swap(m_accel_seconds, next.m_accel_seconds);
@@ -318,6 +325,7 @@ void Scene::build(const Properties &props, Scene *previous) {
         m_bbox = previous->m_bbox;
         m_accel_seconds = previous->m_accel_seconds;
         for (auto &emitter : m_emitters) emitter->set_scene(*this);
+        build_emitter_selection();
         for (auto &sensor : m_sensors)
             if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
                 needs_scene->set_scene(*this);
@@ -368,6 +376,7 @@ void Scene::build(const Properties &props, Scene *previous) {
             FACET_THROW("building the Embree scene failed: {}", embree_error_name(err));
 
         for (auto &emitter : m_emitters) emitter->set_scene(*this);
+        build_emitter_selection();
         for (auto &sensor : m_sensors)
             if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
                 needs_scene->set_scene(*this);
@@ -412,6 +421,7 @@ bool Scene::replace_geometries(Scene &previous) {
 
     auto set_scene = [&] {
         for (auto &emitter : m_emitters) emitter->set_scene(*this);
+        build_emitter_selection();
         for (auto &sensor : m_sensors)
             if (auto *needs_scene = dynamic_cast<SceneSensor *>(sensor.get()))
                 needs_scene->set_scene(*this);
@@ -574,10 +584,20 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     Color3f &weight = result.second;
     const size_t count = m_emitter_table.size();
     if (count == 0) return result;
-    // Uniform emitter selection; the sample is stretched back to [0, 1) for the emitter.
-    float scaled = u.x * float(count);
-    size_t index = std::min(size_t(scaled), count - 1);
-    u.x = std::min(scaled - float(index), OneMinusEpsilon);
+    // The uniform choice keeps its own arithmetic (images as before to the last bit).
+    const bool uniform = m_emitter_uniform && !m_light_bvh;
+    size_t index;
+    float pmf = 0.f;
+    if (uniform) {
+        // The sample is stretched back to [0, 1) for the emitter.
+        float scaled = u.x * float(count);
+        index = std::min(size_t(scaled), count - 1);
+        u.x = std::min(scaled - float(index), OneMinusEpsilon);
+    } else {
+        std::tie(index, pmf) = pick_emitter(&ref, u.x);
+        // None can reach ref, or sampling_weight 0 (never picked but by rounding).
+        if (!(pmf > 0.f)) return result;
+    }
     const EmitterEntry &entry = m_emitter_table[index];
 
     if (entry.mesh) {
@@ -601,8 +621,13 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     }
     // Delta emitters report pdf 1 (not a density): it is left as returned, as in
     // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
-    if (!ds.delta) ds.pdf /= float(count);
-    weight *= float(count);
+    if (uniform) {
+        if (!ds.delta) ds.pdf /= float(count);
+        weight *= float(count);
+    } else {
+        if (!ds.delta) ds.pdf *= pmf;
+        weight /= pmf;
+    }
 
     if (test_visibility && !emitter_visible(ref, ds)) weight = Color3f(0.f);
     return result;
@@ -614,12 +639,169 @@ bool Scene::emitter_visible(const Interaction &ref, const DirectionSample &ds) c
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {
     if (!ds.emitter || m_emitter_table.empty()) return 0.f;
-    const float count = float(m_emitter_table.size());
     const uint32_t index = ds.emitter->scene_index();
-    if (index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter &&
-        m_emitter_table[index].mesh)
-        return triangle_light_pdf(m_emitter_table[index].inv_area, ds) / count;
-    return ds.emitter->pdf_direction(ref, ds) / count;
+    const bool ours =
+        index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter;
+    if (m_emitter_uniform && !m_light_bvh) {
+        const float count = float(m_emitter_table.size());
+        if (ours && m_emitter_table[index].mesh)
+            return triangle_light_pdf(m_emitter_table[index].inv_area, ds) / count;
+        return ds.emitter->pdf_direction(ref, ds) / count;
+    }
+    if (!ours) return 0.f;
+    const float pmf = pick_pmf(&ref, index);
+    if (!(pmf > 0.f)) return 0.f;
+    const EmitterEntry &entry = m_emitter_table[index];
+    return (entry.mesh ? triangle_light_pdf(entry.inv_area, ds)
+                       : ds.emitter->pdf_direction(ref, ds)) *
+           pmf;
+}
+
+std::pair<size_t, float> Scene::pick_emitter(const Interaction *ref, float &u) const {
+    const size_t count = m_emitter_table.size();
+    if (ref && m_light_bvh) {
+        if (u < m_hierarchy_share) {
+            u = std::min(u / m_hierarchy_share, OneMinusEpsilon);
+            const auto [index, pmf] = m_light_bvh->sample(ref->p, ref->n, u);
+            return {size_t(index), pmf * m_hierarchy_share};
+        }
+        const size_t k = m_outside_hierarchy.size();
+        const float scaled = (u - m_hierarchy_share) / (1.f - m_hierarchy_share) * float(k);
+        const size_t j = std::min(size_t(scaled), k - 1);
+        u = std::clamp(scaled - float(j), 0.f, OneMinusEpsilon);
+        return {size_t(m_outside_hierarchy[j]), m_outside_pmf};
+    }
+    size_t index;
+    if (m_emitter_uniform) {
+        float scaled = u * float(count);
+        index = std::min(size_t(scaled), count - 1);
+        u = std::min(scaled - float(index), OneMinusEpsilon);
+    } else {
+        index = m_emitter_distr.sample_reuse(u);
+    }
+    return {index, m_emitter_table[index].pmf};
+}
+
+float Scene::pick_pmf(const Interaction *ref, size_t index) const {
+    if (ref && m_light_bvh)
+        return m_emitter_table[index].in_hierarchy
+                   ? m_hierarchy_share * m_light_bvh->pmf(ref->p, ref->n, uint32_t(index))
+                   : m_outside_pmf;
+    return m_emitter_table[index].pmf;
+}
+
+std::pair<const Emitter *, float> Scene::sample_emitter(float &u) const {
+    if (m_emitter_table.empty()) return {nullptr, 0.f};
+    const auto [index, pmf] = pick_emitter(nullptr, u);
+    return {m_emitter_table[index].emitter, pmf};
+}
+
+std::pair<const Emitter *, float> Scene::sample_emitter(const Interaction &ref, float &u) const {
+    if (m_emitter_table.empty()) return {nullptr, 0.f};
+    const auto [index, pmf] = pick_emitter(&ref, u);
+    if (!(pmf > 0.f)) return {nullptr, 0.f};
+    return {m_emitter_table[index].emitter, pmf};
+}
+
+float Scene::emitter_pmf(const Emitter &emitter) const {
+    const uint32_t index = emitter.scene_index();
+    if (index >= m_emitter_table.size() || m_emitter_table[index].emitter != &emitter) return 0.f;
+    return pick_pmf(nullptr, index);
+}
+
+float Scene::emitter_pmf(const Interaction &ref, const Emitter &emitter) const {
+    const uint32_t index = emitter.scene_index();
+    if (index >= m_emitter_table.size() || m_emitter_table[index].emitter != &emitter) return 0.f;
+    return pick_pmf(&ref, index);
+}
+
+void Scene::build_emitter_selection() {
+    m_emitter_uniform = true;
+    m_emitter_distr = DiscreteDistribution();
+    m_light_bvh.reset();
+    m_outside_hierarchy.clear();
+    for (EmitterEntry &entry : m_emitter_table) entry.in_hierarchy = false;
+    bool given = false;
+    for (const EmitterEntry &entry : m_emitter_table)
+        given = given || entry.emitter->sampling_weight() >= 0.f;
+    if (!given) build_light_hierarchy();
+    build_emitter_distribution(given);
+}
+
+void Scene::build_light_hierarchy() {
+    // The emitters with bounds and a power that is a number, when there are enough of them for
+    // the choice per point to pay for its cost: a pick reads two nodes per level, and where a
+    // few emitters all matter everywhere it only costs (Veach's scene, 4 lights: 8.5 % more CPU
+    // for the same noise; the 13-light staircase: 30 % more samples for an error).
+    constexpr size_t MinHierarchy = 8;
+    std::vector<std::pair<uint32_t, LightBounds>> items;
+    for (uint32_t i = 0; i < m_emitter_table.size(); ++i) {
+        std::optional<LightBounds> bounds = m_emitter_table[i].emitter->light_bounds();
+        if (!bounds || !bounds->bbox.valid() || !(bounds->power >= 0.f) ||
+            !std::isfinite(bounds->power))
+            continue;
+        items.emplace_back(i, *bounds);
+    }
+    if (items.size() < MinHierarchy) return;
+    m_light_bvh = std::make_unique<detail::LightBVH>();
+    m_light_bvh->build(items);
+    for (const auto &item : items) m_emitter_table[item.first].in_hierarchy = true;
+    for (uint32_t i = 0; i < m_emitter_table.size(); ++i)
+        if (!m_emitter_table[i].in_hierarchy) m_outside_hierarchy.push_back(i);
+    const size_t n = m_emitter_table.size();
+    m_hierarchy_share = items.size() == n ? 1.f : float(double(items.size()) / double(n));
+    m_outside_pmf = m_outside_hierarchy.empty()
+                        ? 0.f
+                        : (1.f - m_hierarchy_share) / float(m_outside_hierarchy.size());
+}
+
+void Scene::build_emitter_distribution(bool given) {
+    const size_t n = m_emitter_table.size();
+    for (EmitterEntry &entry : m_emitter_table) entry.pmf = 1.f / float(n);
+    std::vector<float> weights(n);
+    if (given) {
+        // Mitsuba 3's rule: the weights as given, 1 where none is; all 1 is the uniform choice.
+        bool all_one = true;
+        for (size_t i = 0; i < n; ++i) {
+            const float w = m_emitter_table[i].emitter->sampling_weight();
+            weights[i] = w >= 0.f ? w : 1.f;
+            all_one = all_one && weights[i] == 1.f;
+        }
+        if (all_one) return;
+        double total = 0.0;
+        for (float w : weights) total += double(w);
+        if (!(total > 0.0))
+            FACET_THROW("the scene's emitters all have sampling_weight 0: light samples would go "
+                        "to none of them");
+    } else {
+        // facet's choice where the scene makes none. The emitters at infinity keep the share
+        // the uniform choice gives them (their power, the light crossing the scene's bounding
+        // sphere, says little about what reaches the surfaces seen); the others share the rest
+        // half in proportion to their power and half uniformly, so that a dim emitter keeps at
+        // least half its uniform share. The expected image is the same whatever the choice.
+        size_t finite = 0;
+        double total = 0.0;
+        std::vector<double> power(n, 0.0);
+        for (size_t i = 0; i < n; ++i) {
+            const Emitter &emitter = *m_emitter_table[i].emitter;
+            if (emitter.is_infinite()) continue;
+            ++finite;
+            power[i] = double(emitter.power());
+            if (!(power[i] >= 0.0) || !std::isfinite(power[i])) return; // unknown: uniform
+            total += power[i];
+        }
+        if (finite < 2 || !(total > 0.0) || !std::isfinite(total)) return;
+        for (size_t i = 0; i < n; ++i)
+            weights[i] = m_emitter_table[i].emitter->is_infinite()
+                             ? float(1.0 / double(n))
+                             : float(double(finite) / double(n) *
+                                     (0.5 * power[i] / total + 0.5 / double(finite)));
+        if (std::all_of(weights.begin(), weights.end(), [&](float w) { return w == weights[0]; }))
+            return; // equal powers: the uniform choice, exactly
+    }
+    m_emitter_distr.build(weights.data(), n);
+    m_emitter_uniform = false;
+    for (size_t i = 0; i < n; ++i) m_emitter_table[i].pmf = m_emitter_distr.pmf(i);
 }
 
 void Scene::escaped(const Ray &ray, SurfaceInteraction &si) {

@@ -11,6 +11,7 @@ luminance of its texels), so a light of very uneven brightness is sampled where 
 |-----------|------|---------|-------------|
 | radiance | spectrum or texture | 1 | Emitted radiance (a number, `rgb`, `spectrum` or nested texture, evaluated at the surface uv) |
 | to_world | transform | — | Not accepted (an error): the emitter follows the shape it is nested in |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 An area emitter must be nested in a shape (or referenced by one).
 
@@ -31,6 +32,8 @@ An area emitter must be nested in a shape (or referenced by one).
 #include <facet/warp.h>
 
 #include <fmt/format.h>
+
+#include <tuple>
 
 namespace facet {
 
@@ -110,6 +113,23 @@ public:
     Color3f eval(const SurfaceInteraction &si) const override {
         if (Frame::cos_theta(si.wi) <= 0.f) return Color3f(0.f);
         return m_radiance->eval(si);
+    }
+
+    /// Radiance times area times π (every direction of the front side).
+    float power() const override {
+        if (!m_shape) return -1.f;
+        return Pi * m_shape->surface_area() * std::max(m_radiance->mean().luminance(), 0.f);
+    }
+
+    /// The shape's box and normals; light leaves into the hemisphere of each normal.
+    std::optional<LightBounds> light_bounds() const override {
+        if (!m_shape) return std::nullopt;
+        LightBounds b;
+        b.bbox = m_shape->bbox();
+        std::tie(b.axis, b.cos_normals) = m_shape->normal_cone();
+        b.cos_emission = 0.f;
+        b.power = power();
+        return b;
     }
 
     std::string to_string() const override {

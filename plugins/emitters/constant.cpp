@@ -10,6 +10,7 @@ sphere's radius facing it, just outside the sphere, as in Mitsuba.
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | radiance | spectrum or texture | 1 | Emitted radiance (a number, `rgb`, `spectrum` or texture) |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 ```xml
 <emitter type="constant">
@@ -85,6 +86,11 @@ public:
     }
 
     Color3f eval(const SurfaceInteraction &si) const override { return m_radiance->eval(si); }
+
+    /// The radiance arriving from every direction at the scene's bounding sphere.
+    float power() const override {
+        return 4.f * Pi * Pi * m_radius * m_radius * std::max(m_radiance->mean().luminance(), 0.f);
+    }
 
     std::string to_string() const override {
         return fmt::format("ConstantLight[radiance = {}, bounding sphere = ({}, {}, {}) r {}]",

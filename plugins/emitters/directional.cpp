@@ -10,6 +10,7 @@ unit area on a surface perpendicular to the direction.
 | irradiance | spectrum or rgb  | 1       | Irradiance on a surface facing the light (W/m²)     |
 | direction  | vector           | —       | Direction the light travels in (world space)        |
 | to_world   | transform        | —       | Alternatively: the light travels along local +Z     |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 ```xml
 <emitter type="directional">
@@ -84,6 +85,11 @@ public:
 
     float pdf_direction(const Interaction &, const DirectionSample &) const override { return 0.f; }
     Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
+
+    /// The irradiance over the disk of the scene's bounding sphere.
+    float power() const override {
+        return Pi * m_radius * m_radius * std::max(m_irradiance.mean().luminance(), 0.f);
+    }
 
     std::string to_string() const override {
         return fmt::format("DirectionalEmitter[direction=[{}, {}, {}], irradiance=[{}, {}, {}]]",

@@ -12,6 +12,7 @@ light. The emitted power is `radiance` times the shape's surface area.
 |-----------|------|---------|-------------|
 | radiance | spectrum or texture | 1 | Emitted power per unit area along the normal (a number, `rgb`, `spectrum` or nested texture, evaluated at the surface uv) |
 | to_world | transform | — | Not accepted (an error): the emitter follows the shape it is nested in |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 ```xml
 <shape type="rectangle">
@@ -29,6 +30,8 @@ light. The emitted power is `radiance` times the shape's surface area.
 #include <facet/texture.h>
 
 #include <fmt/format.h>
+
+#include <tuple>
 
 namespace facet {
 
@@ -67,6 +70,22 @@ public:
         origin.t = 0.f;
         origin.wavelengths = wavelengths;
         return {origin.spawn_ray(ps.n), radiance_at(ps, wavelengths) / ps.pdf};
+    }
+
+    float power() const override {
+        if (!m_shape) return -1.f;
+        return m_shape->surface_area() * std::max(m_radiance->mean().luminance(), 0.f);
+    }
+
+    /// The shape's box and normals (light leaves along them; bounded here by their hemispheres).
+    std::optional<LightBounds> light_bounds() const override {
+        if (!m_shape) return std::nullopt;
+        LightBounds b;
+        b.bbox = m_shape->bbox();
+        std::tie(b.axis, b.cos_normals) = m_shape->normal_cone();
+        b.cos_emission = 0.f;
+        b.power = power();
+        return b;
     }
 
     std::string to_string() const override {

@@ -25,6 +25,7 @@ scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba
 | mis_compensation    | boolean   | false    | Sample only where the map is brighter than its mean luminance      |
 | filter_type         | string    | bilinear | Lookup filter: bilinear or nearest (facet extension)               |
 | importance_sampling | boolean   | true     | false: sample directions uniformly (facet extension, for testing)  |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 ```xml
 <emitter type="envmap">
@@ -197,6 +198,10 @@ public:
         return radiance(grid_point(local), si.wavelengths);
     }
 
+    /// The map's mean radiance (over the sphere of directions) arriving from every direction
+    /// at the scene's bounding sphere.
+    float power() const override { return 4.f * Pi * Pi * m_radius * m_radius * m_mean_luminance; }
+
     std::string to_string() const override {
         return fmt::format("EnvironmentMap[\"{}\", {}x{}, scale={}, mis_compensation={}]", m_path,
                            m_width, m_height, m_scale, m_mis_compensation);
@@ -363,13 +368,18 @@ private:
     void build_distribution() {
         const int W = m_width, H = m_height;
         std::vector<float> lum(size_t(W) * H);
-        double sum = 0.0;
+        double sum = 0.0, sphere_sum = 0.0, sphere_weight = 0.0;
         float min_lum = Infinity;
         for (size_t k = 0; k < lum.size(); ++k) {
             lum[k] = pixel(int(k % size_t(W)), int(k / size_t(W))).luminance();
             sum += double(lum[k]);
             min_lum = std::min(min_lum, lum[k]);
+            // The mean over the sphere (for power()): each pixel weighted by its row's sin θ.
+            const double sin_theta = std::sin(double(k / size_t(W)) * Pi / double(H - 1));
+            sphere_sum += std::max(double(lum[k]), 0.0) * sin_theta;
+            sphere_weight += sin_theta;
         }
+        m_mean_luminance = sphere_weight > 0.0 ? float(sphere_sum / sphere_weight) : 0.f;
         // MIS compensation (Karlík et al. 2019): sample only where the map is brighter than its
         // mean; skipped for near-constant maps, where it would leave (almost) nothing.
         float offset = 0.f;
@@ -417,6 +427,7 @@ private:
     DiscreteDistribution m_cells;
     double m_total = 0.0;
     float m_density_scale = 0.f;
+    float m_mean_luminance = 0.f; ///< over the sphere of directions, for power()
     Point3f m_center;
     float m_radius = 1.f;
 };

@@ -9,6 +9,7 @@ angle θ with the direction to the light is `intensity`·cos θ/d². It cannot b
 | intensity | spectrum | 1 | Radiant intensity (power per unit solid angle; a number, `rgb` or `spectrum`) |
 | position | point | (0, 0, 0) | Position of the light (give this or `to_world`, not both) |
 | to_world | transform | identity | Places the light at the image of the origin |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 ```xml
 <emitter type="point">
@@ -82,6 +83,18 @@ public:
 
     float pdf_ray_direction(const Vector3f &d) const override {
         return warp::square_to_uniform_sphere_pdf(d);
+    }
+
+    float power() const override {
+        return 4.f * Pi * std::max(m_intensity.mean().luminance(), 0.f);
+    }
+
+    std::optional<LightBounds> light_bounds() const override {
+        LightBounds b;
+        b.bbox.expand(m_position);
+        b.cos_normals = -1.f; // every direction
+        b.power = power();
+        return b;
     }
 
     std::string to_string() const override {

@@ -20,6 +20,7 @@ there is no light. A delta-position light: it is reached only by direct light sa
 | fov_axis | string | x | Axis of `fov`: x, y, diagonal, smaller or larger (read only with `fov`) |
 | focal_length | string | 50mm | 35 mm equivalent focal length; not with `fov` |
 | to_world | transform | identity | Projector-to-world transform (usually a `<lookat>`) |
+| sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
 
 ```xml
 <emitter type="projector">
@@ -123,6 +124,11 @@ public:
     }
 
     Color3f eval(const SurfaceInteraction &) const override { return Color3f(0.f); }
+
+    /// The irradiance on the plane at unit distance, over the image's extent there.
+    float power() const override {
+        return Pi * m_scale * m_plane_area * std::max(m_irradiance->mean().luminance(), 0.f);
+    }
 
     std::string to_string() const override {
         return fmt::format(

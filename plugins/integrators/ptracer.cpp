@@ -108,26 +108,27 @@ private:
     /// (importance mode: light from −wi to wo) turns into the next one; the sensor records S0.
     template <bool Polarized> void trace_path(const Scene &scene, const Sensor &sensor,
                                               Sampler &sampler, SplatTarget &film) const {
-        const auto &emitters = scene.emitters();
-        if (emitters.empty()) return;
+        if (scene.emitters().empty()) return;
         Spectral spectral;
         if (m_spectral) {
             spectral.on = true;
             std::tie(spectral.lambda, spectral.weight) = sample_wavelengths(sampler.next_1d());
         }
-        const float n_emitters = float(emitters.size());
+        // The emitter as the scene picks light samples' emitters (by power where it can), and
+        // the inverse of the probability it had.
         auto pick = [&](float u) {
-            size_t i = std::min(size_t(u * n_emitters), emitters.size() - 1);
-            return emitters[i].get();
+            const auto [emitter, pmf] = scene.sample_emitter(u);
+            return std::pair<const Emitter *, float>(emitter, pmf > 0.f ? 1.f / pmf : 0.f);
         };
-        if (m_max_depth != 0 && !m_hide_emitters)
-            connect_emitter(scene, sensor, *pick(sampler.next_1d()), n_emitters, sampler, spectral,
-                            film);
+        if (m_max_depth != 0 && !m_hide_emitters) {
+            const auto [emitter, inv_pmf] = pick(sampler.next_1d());
+            connect_emitter(scene, sensor, *emitter, inv_pmf, sampler, spectral, film);
+        }
 
-        const Emitter &emitter = *pick(sampler.next_1d());
+        const auto [emitter, inv_pmf] = pick(sampler.next_1d());
         const Point2f u_dir = sampler.next_2d(), u_pos = sampler.next_2d();
-        auto [ray, power] = emitter.sample_ray(u_pos, u_dir, spectral.lambda);
-        Color3f throughput = power * n_emitters;
+        auto [ray, power] = emitter->sample_ray(u_pos, u_dir, spectral.lambda);
+        Color3f throughput = power * inv_pmf;
         if (throughput.is_black() || !throughput.is_finite()) return;
         // The polarized mode's light: unpolarised as it leaves the emitter (`throughput` is
         // then its S0).
@@ -223,12 +224,12 @@ private:
     /// Emitters seen directly: a point on the emitter's shape connected to the sensor, weighted
     /// by the emitted radiance towards the sensor and the emitter's cosine.
     void connect_emitter(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
-                         float n_emitters, Sampler &sampler, const Spectral &spectral,
+                         float inv_pmf, Sampler &sampler, const Spectral &spectral,
                          SplatTarget &film) const {
         const Point2f u_pos = sampler.next_2d(), u_sensor = sampler.next_2d();
         if (emitter.is_infinite()) {
             if (!emitter.is_delta())
-                connect_environment(scene, sensor, emitter, n_emitters, u_pos, u_sensor, spectral,
+                connect_environment(scene, sensor, emitter, inv_pmf, u_pos, u_sensor, spectral,
                                     film);
             return;
         }
@@ -253,7 +254,7 @@ private:
         Color3f L = emitter.eval(si);
         if (L.is_black()) return;
         if (scene.ray_test(si.spawn_ray_to(ds.p))) return;
-        spectral.splat(film, ds.uv, L * (cos_theta * n_emitters / ps.pdf) * importance);
+        spectral.splat(film, ds.uv, L * (cos_theta * inv_pmf / ps.pdf) * importance);
     }
 
     /// An environment seen directly: a direction sampled by the emitter from the sensor's
@@ -262,7 +263,7 @@ private:
     /// connected to the sensor like a point of a surface, with the area density pdf / dist² of
     /// that sphere and no cosine. The radiance is the environment's along the connection.
     void connect_environment(const Scene &scene, const Sensor &sensor, const Emitter &emitter,
-                             float n_emitters, const Point2f &u_pos, const Point2f &u_sensor,
+                             float inv_pmf, const Point2f &u_pos, const Point2f &u_sensor,
                              const Spectral &spectral, SplatTarget &film) const {
         Interaction ref;
         ref.p = sensor.to_world().apply_point(Point3f(0.f));
@@ -293,7 +294,7 @@ private:
         camera_ray.wavelengths = spectral.lambda;
         Scene::escaped(camera_ray, miss);
         const Color3f L = emitter.eval(miss);
-        spectral.splat(film, ds.uv, L * (dist2 * n_emitters / eds.pdf) * importance);
+        spectral.splat(film, ds.uv, L * (dist2 * inv_pmf / eds.pdf) * importance);
     }
 
     uint32_t m_max_depth;

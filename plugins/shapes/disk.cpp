@@ -117,6 +117,11 @@ public:
         return ps;
     }
 
+    /// One normal (with a margin for its rounding).
+    std::pair<Vector3f, float> normal_cone() const override {
+        return {Vector3f(m_normal), std::cos(1e-3f)};
+    }
+
     std::string to_string() const override {
         return fmt::format("Disk[to_world={}, area={}, flip_normals={}, bsdf={}, emitter={}]",
                            m_to_world.to_string(), m_area, m_flip_normals,

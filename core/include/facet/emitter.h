@@ -1,5 +1,6 @@
 #pragma once
 
+#include <facet/bbox.h>
 #include <facet/color.h>
 #include <facet/interaction.h>
 #include <facet/logger.h>
@@ -26,6 +27,21 @@ constexpr EmitterFlags operator&(EmitterFlags a, EmitterFlags b) {
     return EmitterFlags(uint32_t(a) & uint32_t(b));
 }
 constexpr bool has_flag(EmitterFlags a, EmitterFlags b) { return (uint32_t(a) & uint32_t(b)) != 0; }
+
+/// Where an emitter lies and where its light goes, for choosing among emitters by their
+/// importance to a point (the scene's light hierarchy). Light leaves from inside `bbox`, from
+/// surfaces whose normals lie within the angle acos(cos_normals) of `axis` (every direction at
+/// -1), each into directions within acos(cos_emission) of its normal (0: a hemisphere, as a
+/// Lambertian surface; -1: every direction). `two_sided`: the opposite normals as well. `power`:
+/// Emitter::power(). Bounds may be loose (the choice only gets worse), never too tight.
+struct LightBounds {
+    BoundingBox3f bbox;
+    Vector3f axis = Vector3f(0.f, 0.f, 1.f);
+    float cos_normals = -1.f;
+    float cos_emission = 0.f;
+    float power = 0.f;
+    bool two_sided = false;
+};
 
 /// A light source.
 ///
@@ -69,6 +85,19 @@ public:
     /// with the shape's own direction sampling; the scene may then compute them from the value
     /// and the shape. Default: none (the scene always asks the emitter).
     virtual std::optional<Color3f> constant_radiance() const { return std::nullopt; }
+    /// An estimate of the power the emitter sends into the scene (luminance; radiance · m² · sr),
+    /// used only to choose which emitter a light sample goes to: it changes the noise, never the
+    /// expected image. Called once the scene's bounds are known (after set_scene()). Negative:
+    /// unknown (the default), and the scene then picks every emitter with the same probability.
+    virtual float power() const { return -1.f; }
+    /// Bounds for the scene's light hierarchy (LightBounds), once the scene is known; none (the
+    /// default) for emitters without a place (at infinity) or whose bounds are unknown: the
+    /// scene then gives them the share of light samples the uniform choice would.
+    virtual std::optional<LightBounds> light_bounds() const { return std::nullopt; }
+    /// The `sampling_weight` the scene gave the emitter (as in Mitsuba 3: light samples go to
+    /// emitters in proportion to their weights), or a negative value when it gave none.
+    float sampling_weight() const { return m_sampling_weight; }
+    void set_sampling_weight(float weight) { m_sampling_weight = weight; }
     /// Position in the emitter list of the scene that holds it (set by the scene).
     uint32_t scene_index() const { return m_scene_index; }
     void set_scene_index(uint32_t index) { m_scene_index = index; }
@@ -87,6 +116,7 @@ protected:
     EmitterFlags m_flags = EmitterFlags::Empty;
     const Shape *m_shape = nullptr;
     uint32_t m_scene_index = uint32_t(-1);
+    float m_sampling_weight = -1.f;
 };
 
 } // namespace facet

@@ -17,6 +17,8 @@ public:
     explicit Mesh(const Properties &props);
 
     BoundingBox3f bbox() const override { return m_bbox; }
+    /// The faces' normals and, with vertex normals, those too (flip_normals applied).
+    std::pair<Vector3f, float> normal_cone() const override;
     float surface_area() const override { return m_area; }
     RTCGeometry embree_geometry(RTCDevice device) const override;
     /// Final: every mesh, whatever loader filled it, computes its hits the same way.

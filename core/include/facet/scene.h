@@ -2,6 +2,7 @@
 
 #include <facet/bbox.h>
 #include <facet/color.h>
+#include <facet/distribution.h>
 #include <facet/interaction.h>
 #include <facet/object.h>
 #include <facet/properties.h>
@@ -26,7 +27,8 @@ public:
 struct SceneDescription;
 namespace detail {
 class SceneQueries;
-}
+class LightBVH;
+} // namespace detail
 
 /// The scene: shapes in one Embree scene, emitters, sensors and the integrator.
 /// Immutable while it renders; every query is thread-safe. Only traverse() (facet/params.h)
@@ -48,8 +50,9 @@ public:
     static void escaped(const Ray &ray, SurfaceInteraction &si);
     /// Any hit in [ray.mint, ray.maxt] (rtcOccluded1).
     bool ray_test(const Ray &ray) const;
-    /// Picks an emitter uniformly and samples a direction to it from ref. The weight includes the
-    /// selection probability; with `test_visibility` an occluded sample gets weight zero.
+    /// Picks an emitter (sample_emitter()) and samples a direction to it from ref. The weight
+    /// includes the selection probability; with `test_visibility` an occluded sample gets weight
+    /// zero.
     std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
                                                                  bool test_visibility) const;
     /// The visibility test of sample_emitter_direction() on its own: true when nothing blocks
@@ -58,6 +61,24 @@ public:
     bool emitter_visible(const Interaction &ref, const DirectionSample &ds) const;
     /// Density of sample_emitter_direction() for ds (selection probability included).
     float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const;
+    /// Picks the emitter of a light sample for the point `ref` (sample_emitter_direction()'s
+    /// choice). Where the scene gives emitters a `sampling_weight`: in proportion to it (1 for
+    /// the others), as Mitsuba 3 does, whatever the point. Otherwise the emitters with
+    /// light_bounds() (two or more) share the samples the uniform choice would give them
+    /// through the light hierarchy, in proportion to a bound of their importance at ref.p
+    /// (power, distance, orientation, ref.n); the others keep their uniform share. Returns the
+    /// emitter and the probability it had (null and 0 when none can reach ref); `u` becomes a
+    /// fresh uniform variate for the emitter's own sample.
+    std::pair<const Emitter *, float> sample_emitter(const Interaction &ref, float &u) const;
+    /// The probability that sample_emitter(ref, ...) picks `emitter` (0 for one not in the
+    /// scene).
+    float emitter_pmf(const Interaction &ref, const Emitter &emitter) const;
+    /// The choice without a point (light tracing): by `sampling_weight` as above, else the
+    /// emitters at infinity keep their uniform share and the others share the rest half in
+    /// proportion to their power() and half uniformly (all uniformly when a power is unknown).
+    std::pair<const Emitter *, float> sample_emitter(float &u) const;
+    /// The probability that sample_emitter(u) picks `emitter` (0 for one not in the scene).
+    float emitter_pmf(const Emitter &emitter) const;
 
     const std::vector<std::shared_ptr<Shape>> &shapes() const { return m_shapes; }
     const std::vector<std::shared_ptr<Emitter>> &emitters() const { return m_emitters; }
@@ -137,8 +158,29 @@ private:
         const Mesh *mesh = nullptr; ///< set for a triangle light
         Color3f radiance;           ///< of a triangle light
         float inv_area = 0.f;       ///< of a triangle light: its area density
+        float pmf = 0.f;            ///< the probability that sample_emitter(u) picks it
+        bool in_hierarchy = false;  ///< in m_light_bvh
     };
     std::vector<EmitterEntry> m_emitter_table;
+    /// The emitters' selection (sample_emitter()): uniform, or by m_emitter_distr.
+    bool m_emitter_uniform = true;
+    DiscreteDistribution m_emitter_distr;
+    /// The choice for a point: the light hierarchy, which gets m_hierarchy_share of the
+    /// samples, and the emitters outside it, each with probability m_outside_pmf. Null: the
+    /// choice without a point serves for every point.
+    std::unique_ptr<detail::LightBVH> m_light_bvh;
+    float m_hierarchy_share = 0.f, m_outside_pmf = 0.f;
+    std::vector<uint32_t> m_outside_hierarchy;
+    /// Sets the entries' pmf, the distribution and the hierarchy once the emitters know the
+    /// scene: build_light_hierarchy() (unless the scene gives sampling weights) and
+    /// build_emitter_distribution().
+    void build_emitter_selection();
+    void build_light_hierarchy();
+    void build_emitter_distribution(bool weights_given);
+    /// The emitter (its index) for a light sample from `ref` (null: the choice without a point)
+    /// and its probability (0: none).
+    std::pair<size_t, float> pick_emitter(const Interaction *ref, float &u) const;
+    float pick_pmf(const Interaction *ref, size_t index) const;
     /// Per Embree geometry id: its shape, and the same shape as a Mesh when the scene computes
     /// the hits on it itself (without this the real-scene bench ran matpreview 2.2% to 8.1%
     /// slower in three of four paired measurements).

@@ -29,6 +29,11 @@ public:
 
     virtual BoundingBox3f bbox() const = 0;
     virtual float surface_area() const = 0;
+    /// A cone holding every normal of the surface (shading normals included): its axis and the
+    /// cosine of its half-angle. Default: every direction (cosine -1).
+    virtual std::pair<Vector3f, float> normal_cone() const {
+        return {Vector3f(0.f, 0.f, 1.f), -1.f};
+    }
 
     /// Creates and commits this shape's Embree geometry on `device`. The scene attaches it and
     /// keeps the mapping from geometry id back to the shape. nullptr: nothing to attach (a

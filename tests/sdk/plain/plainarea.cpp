@@ -18,6 +18,8 @@ so the scene asks it for every sample. Built out of tree by facet's SDK test.
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace facet {
 
 class PlainArea final : public Emitter {
@@ -45,6 +47,12 @@ public:
 
     Color3f eval(const SurfaceInteraction &si) const override {
         return Frame::cos_theta(si.wi) > 0.f ? m_radiance : Color3f(0.f);
+    }
+
+    /// What the scene picks light samples by (radiance · area · π, as `area` estimates it):
+    /// without it, plainarea's lights would be picked uniformly, area's by power.
+    float power() const override {
+        return Pi * shape().surface_area() * std::max(m_radiance.luminance(), 0.f);
     }
 
     std::string to_string() const override {
