@@ -98,13 +98,13 @@ uint32_t LightBVH::build_range(std::vector<std::pair<uint32_t, LightBounds>> &it
     return at;
 }
 
-float LightBVH::importance(const Node &node, const Point3f &p, const Normal3f &n) const {
+inline float LightBVH::importance(const Node &node, const Point3f &p, const Normal3f &n) {
     const Vector3f v = p - node.center;
     const float dist2 = squared_norm(v);
     // Inside the node's sphere every direction may lead to it, and the distance is bounded
     // below by the sphere's radius.
     if (!(dist2 > node.radius2)) return node.radius2 > 0.f ? node.power / node.radius2 : 0.f;
-    const float inv_dist = 1.f / std::sqrt(dist2);
+    const float inv_dist = 1.f / std::sqrt(dist2), inv_dist2 = inv_dist * inv_dist;
     // The sphere around the node seen from p: the half-angle of its cone of directions.
     const float sin_bound = node.radius * inv_dist;
     const float cos2_bound = 1.f - sin_bound * sin_bound;
@@ -121,7 +121,7 @@ float LightBVH::importance(const Node &node, const Point3f &p, const Normal3f &n
         cos_p = cos_minus(sin_x, cos_x, sin_bound, cos_bound);
         if (cos_p <= node.cos_emission) return 0.f;
     }
-    float result = node.power * cos_p / dist2;
+    float result = node.power * cos_p * inv_dist2;
     if (n.x != 0.f || n.y != 0.f || n.z != 0.f) {
         // The best cosine at p (either side: p may transmit) over the sphere's directions: 1
         // when the normal's direction (or its opposite) points into the sphere.

@@ -43,7 +43,7 @@ private:
         bool leaf = false;
         uint32_t child = 0; ///< inner: the second child (the first follows the node); leaf: scene index
     };
-    float importance(const Node &node, const Point3f &p, const Normal3f &n) const;
+    static float importance(const Node &node, const Point3f &p, const Normal3f &n);
     uint32_t build_range(std::vector<std::pair<uint32_t, LightBounds>> &items, size_t begin,
                          size_t end, uint64_t bits, int depth);
 
