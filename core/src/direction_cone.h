@@ -43,7 +43,13 @@ inline DirectionCone merge(const DirectionCone &a, const DirectionCone &b) {
     // a's axis turned towards b's by theta - a.theta, about their common perpendicular.
     Vector3f w = cross(a.axis, b.axis);
     const float len = norm(w);
-    if (!(len > 1e-6f)) return DirectionCone::all(); // opposite axes
+    if (!(len > 1e-6f)) {
+        // (Nearly) the same axis, a rounding apart: a's, widened by the angle between them;
+        // opposite axes: every direction.
+        if (dot(a.axis, b.axis) > 0.f)
+            return {a.axis, std::min(std::max(a.theta, between + b.theta), Pi)};
+        return DirectionCone::all();
+    }
     w /= len;
     const float turn = theta - a.theta;
     const Vector3f axis = a.axis * std::cos(turn) + cross(w, a.axis) * std::sin(turn);

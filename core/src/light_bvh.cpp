@@ -23,8 +23,8 @@ struct Group {
         bbox.expand(b.bbox);
         const float theta = b.cos_normals <= -1.f ? Pi : std::acos(std::min(b.cos_normals, 1.f));
         normals = merge(normals, DirectionCone{normalize(b.axis), theta});
-        theta_emission =
-            std::max(theta_emission, std::acos(std::clamp(b.cos_emission, -1.f, 1.f)));
+        // At most a hemisphere (LightBounds): beyond it the falloff bound would be negative.
+        theta_emission = std::max(theta_emission, std::acos(std::clamp(b.cos_emission, 0.f, 1.f)));
         power += double(b.power);
         two_sided = two_sided || b.two_sided;
     }
@@ -84,7 +84,9 @@ uint32_t LightBVH::build_range(std::vector<std::pair<uint32_t, LightBounds>> &it
     BoundingBox3f centres;
     for (size_t i = begin; i < end; ++i) centres.expand(items[i].second.bbox.center());
     const Vector3f extent = centres.max - centres.min;
-    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
+                     : extent.y >= extent.z                       ? 1
+                                                                  : 2;
     const size_t mid = begin + (end - begin) / 2;
     std::nth_element(items.begin() + long(begin), items.begin() + long(mid),
                      items.begin() + long(end), [axis](const auto &a, const auto &b) {
@@ -126,9 +128,12 @@ inline float LightBVH::importance(const Node &node, const Point3f &p, const Norm
         // The best cosine at p (either side: p may transmit) over the sphere's directions: 1
         // when the normal's direction (or its opposite) points into the sphere.
         const float cos_i = std::abs(dot(v, Vector3f(n))) * inv_dist;
+        // (Floored: light arriving along the surface still counts where a shading normal, from
+        // a bump or normal map, turns the surface towards it.)
         if (cos_i * cos_i < cos2_bound)
-            result *= cos_i * std::sqrt(cos2_bound) +
-                      std::sqrt(std::max(0.f, 1.f - cos_i * cos_i)) * sin_bound;
+            result *= std::max(cos_i * std::sqrt(cos2_bound) +
+                                   std::sqrt(std::max(0.f, 1.f - cos_i * cos_i)) * sin_bound,
+                               1e-3f);
     }
     return result;
 }

@@ -311,6 +311,13 @@ void Scene::build(const Properties &props, Scene *previous) {
         emitter->set_scene_index(uint32_t(m_emitter_table.size()));
         m_emitter_table.push_back(entry);
     }
+    // Checked before the emitters are given this scene: an update that fails leaves them as
+    // they were. (An emitter without a weight counts as 1.)
+    if (!m_emitters.empty() &&
+        std::all_of(m_emitters.begin(), m_emitters.end(),
+                    [](const auto &emitter) { return emitter->sampling_weight() == 0.f; }))
+        FACET_THROW("the scene's emitters all have sampling_weight 0: light samples would go "
+                    "to none of them");
 
     m_device = facet::embree_device(); // the free function, not the accessor of the same name
     rtcRetainDevice(m_device);
@@ -770,9 +777,7 @@ void Scene::build_emitter_distribution(bool given) {
         if (all_one) return;
         double total = 0.0;
         for (float w : weights) total += double(w);
-        if (!(total > 0.0))
-            FACET_THROW("the scene's emitters all have sampling_weight 0: light samples would go "
-                        "to none of them");
+        if (!(total > 0.0)) return; // (build() refuses all weights 0)
     } else {
         // facet's choice where the scene makes none. The emitters at infinity keep the share
         // the uniform choice gives them (their power, the light crossing the scene's bounding

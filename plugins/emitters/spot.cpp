@@ -128,7 +128,9 @@ public:
         LightBounds b;
         b.bbox.expand(m_position);
         b.axis = normalize(m_to_world.apply_vector(Vector3f(0.f, 0.f, 1.f)));
-        b.cos_normals = m_cos_cutoff;
+        // The cone is the local one turned into the world; a transform that stretches or shears
+        // widens it unevenly: then every direction.
+        b.cos_normals = is_similarity(m_to_world) ? m_cos_cutoff : -1.f;
         b.cos_emission = std::cos(1e-3f); // (a margin for rounding)
         b.power = power();
         return b;
@@ -140,6 +142,17 @@ public:
     }
 
 private:
+    /// Whether the linear part of `t` only turns and scales uniformly (angles are kept).
+    static bool is_similarity(const Transform &t) {
+        const Vector3f x = t.apply_vector(Vector3f(1.f, 0.f, 0.f)),
+                       y = t.apply_vector(Vector3f(0.f, 1.f, 0.f)),
+                       z = t.apply_vector(Vector3f(0.f, 0.f, 1.f));
+        const float s2 = squared_norm(x), tol = 1e-4f * s2;
+        return s2 > 0.f && std::abs(squared_norm(y) - s2) <= tol &&
+               std::abs(squared_norm(z) - s2) <= tol && std::abs(dot(x, y)) <= tol &&
+               std::abs(dot(x, z)) <= tol && std::abs(dot(y, z)) <= tol;
+    }
+
     SpectralValue m_intensity;
     std::shared_ptr<Texture> m_texture;
     Transform m_to_world;

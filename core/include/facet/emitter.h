@@ -31,9 +31,11 @@ constexpr bool has_flag(EmitterFlags a, EmitterFlags b) { return (uint32_t(a) & 
 /// Where an emitter lies and where its light goes, for choosing among emitters by their
 /// importance to a point (the scene's light hierarchy). Light leaves from inside `bbox`, from
 /// surfaces whose normals lie within the angle acos(cos_normals) of `axis` (every direction at
-/// -1), each into directions within acos(cos_emission) of its normal (0: a hemisphere, as a
-/// Lambertian surface; -1: every direction). `two_sided`: the opposite normals as well. `power`:
-/// Emitter::power(). Bounds may be loose (the choice only gets worse), never too tight.
+/// -1), each into directions within acos(cos_emission) of its normal, at most a hemisphere
+/// (cos_emission 0, a Lambertian surface; an emitter whose light leaves in every direction says
+/// cos_normals -1). `two_sided`: the opposite normals as well. `power`: Emitter::power(). Bounds
+/// may be loose (the choice only gets worse), never too tight: an emitter the bounds rule out
+/// for a point is never sampled from it.
 struct LightBounds {
     BoundingBox3f bbox;
     Vector3f axis = Vector3f(0.f, 0.f, 1.f);

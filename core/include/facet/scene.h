@@ -64,7 +64,7 @@ public:
     /// Picks the emitter of a light sample for the point `ref` (sample_emitter_direction()'s
     /// choice). Where the scene gives emitters a `sampling_weight`: in proportion to it (1 for
     /// the others), as Mitsuba 3 does, whatever the point. Otherwise the emitters with
-    /// light_bounds() (two or more) share the samples the uniform choice would give them
+    /// light_bounds() (eight or more) share the samples the uniform choice would give them
     /// through the light hierarchy, in proportion to a bound of their importance at ref.p
     /// (power, distance, orientation, ref.n); the others keep their uniform share. Returns the
     /// emitter and the probability it had (null and 0 when none can reach ref); `u` becomes a

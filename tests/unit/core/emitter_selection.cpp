@@ -1,17 +1,20 @@
 // Which emitter a light sample goes to: by power where the scene says nothing (half by power,
 // half uniformly), by `sampling_weight` where it gives them (Mitsuba 3's rule), and the same
 // expected image either way, for the path tracer's MIS and for the light tracer.
+#include "direction_cone.h" // (core/src: the hierarchy's cone arithmetic)
+#include "draws.h"
+
 #include <facet/emitter.h>
 #include <facet/plugin.h>
 #include <facet/random.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/shape.h>
+#include <facet/transform.h>
 #include <facet/xml.h>
 
-#include <gtest/gtest.h>
-
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -27,8 +30,8 @@ namespace {
 /// `bright`) and a point lamp of intensity 5, each emitter with the extra XML `weights[i]`;
 /// seen from above by a 16x16 camera through `integrator` at `spp`.
 std::string scene_xml(const std::vector<std::string> &weights, float dim = 1.f,
-                      float bright = 400.f, const std::string &integrator = "path",
-                      int spp = 16, int seed = 0) {
+                      float bright = 400.f, const std::string &integrator = "path", int spp = 16,
+                      int seed = 0) {
     return fmt::format(R"(<scene version="3.0.0">
         <integrator type="{}"><integer name="max_depth" value="3"/></integrator>
         <sensor type="perspective">
@@ -64,7 +67,9 @@ std::shared_ptr<Scene> load(const std::string &xml) {
     return std::dynamic_pointer_cast<Scene>(load_string(xml, LoadOptions()));
 }
 
-std::string weight(float w) { return fmt::format(R"(<float name="sampling_weight" value="{}"/>)", w); }
+std::string weight(float w) {
+    return fmt::format(R"(<float name="sampling_weight" value="{}"/>)", w);
+}
 
 /// The scene's emitters in the order scene_xml() lists them (the point lamp, a child of the
 /// scene, is found by its type).
@@ -193,9 +198,10 @@ TEST(EmitterSelection, TheExpectedImageIsTheSame) {
         for (const auto &choice : {std::vector<std::string>{"", "", ""}, skewed}) {
             std::vector<double> a, b;
             for (int seed = 0; seed < 4; ++seed) {
-                a.push_back(render_mean(*load(scene_xml(choice, 1.f, 400.f, integrator, 1024, seed))));
-                b.push_back(
-                    render_mean(*load(scene_xml(uniform, 1.f, 400.f, integrator, 1024, seed + 10))));
+                a.push_back(
+                    render_mean(*load(scene_xml(choice, 1.f, 400.f, integrator, 1024, seed))));
+                b.push_back(render_mean(
+                    *load(scene_xml(uniform, 1.f, 400.f, integrator, 1024, seed + 10))));
             }
             auto mean = [](const std::vector<double> &v) {
                 double s = 0.0;
@@ -223,7 +229,8 @@ TEST(EmitterSelection, EmittersAtInfinityKeepTheirUniformShare) {
     // power, the light crossing the scene's bounding sphere, is no measure of what the surfaces
     // receive); the two panels and the lamp share the other 3/5 by the rule.
     std::string xml = scene_xml({"", "", ""});
-    const std::string extra = R"(<emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>
+    const std::string extra =
+        R"(<emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>
         <emitter type="directional"><vector name="direction" x="0" y="0" z="-1"/></emitter>
         <emitter type="point" id="gone">)";
     xml.replace(xml.find("<emitter type=\"point\">"), 22, extra);
@@ -251,7 +258,8 @@ TEST(EmitterSelection, EmittersAtInfinityKeepTheirUniformShare) {
 namespace {
 
 /// A corridor: a diffuse floor 24 long at z = 0 under `lamps` small panels facing down along it
-/// (radiance 20, side 0.3, height 1.5, every 2 along x), with a point lamp, a spot looking down
+/// (radiance 20, side 0.3, height 1.5, every 2 along x; their normals a few roundings apart), with
+/// a point lamp, a spot looking down (and another whose cone a stretching transform widens along x)
 /// and a glowing ball at the far end, seen from above by a 32x8 camera through `integrator`.
 /// `extra`: XML added to every emitter.
 std::string corridor_xml(int lamps, const std::string &extra, const std::string &integrator,
@@ -259,11 +267,11 @@ std::string corridor_xml(int lamps, const std::string &extra, const std::string 
     std::string panels;
     for (int i = 0; i < lamps; ++i)
         panels += fmt::format(R"(<shape type="rectangle">
-            <transform name="to_world"><scale value="0.15"/><rotate x="1" angle="180"/>
+            <transform name="to_world"><scale value="0.15"/><rotate x="1" angle="{:.5f}"/>
                 <translate x="{}" z="1.5"/></transform>
             <emitter type="area"><rgb name="radiance" value="20"/>{}</emitter>
         </shape>)",
-                              -11 + 2 * i, extra);
+                              180.0 + 3e-5 * i, -11 + 2 * i, extra);
     return fmt::format(R"(<scene version="3.0.0">
         <integrator type="{}"><integer name="max_depth" value="3"/></integrator>
         <sensor type="orthographic">
@@ -283,11 +291,14 @@ std::string corridor_xml(int lamps, const std::string &extra, const std::string 
         <emitter type="spot">
             <transform name="to_world"><lookat origin="-6, 0, 3" target="-6, 0, 0" up="0, 1, 0"/></transform>
             <rgb name="intensity" value="30"/>{}</emitter>
+        <emitter type="spot">
+            <transform name="to_world"><scale x="4"/><lookat origin="8, 0, 2" target="8, 0, 0" up="0, 1, 0"/></transform>
+            <rgb name="intensity" value="30"/>{}</emitter>
         <shape type="sphere"><point name="center" x="11" y="-1" z="0.6"/><float name="radius" value="0.3"/>
             <emitter type="area"><rgb name="radiance" value="5"/>{}</emitter>
         </shape>
     </scene>)",
-                       integrator, spp, seed, panels, extra, extra, extra);
+                       integrator, spp, seed, panels, extra, extra, extra, extra);
 }
 
 /// Reference points on the floor, on walls that are not there (normals along x and y), and in
@@ -315,7 +326,7 @@ std::vector<Interaction> reference_points() {
 
 TEST(EmitterSelection, TheLightHierarchyAgreesWithItsPmfAndMissesNoLight) {
     auto scene = load(corridor_xml(12, "", "path", 1, 0));
-    ASSERT_EQ(scene->emitters().size(), 15u);
+    ASSERT_EQ(scene->emitters().size(), 16u);
     PCG32 rng(9);
     int unreachable = 0;
     for (const Interaction &ref : reference_points()) {
@@ -345,6 +356,13 @@ TEST(EmitterSelection, TheLightHierarchyAgreesWithItsPmfAndMissesNoLight) {
             EXPECT_NEAR(double(count[emitter->scene_index()]) / n,
                         scene->emitter_pmf(ref, *emitter), 2e-3);
         EXPECT_NEAR(double(none) / n, 1.0 - sum, 2e-3);
+        // A light sample's density is what pdf_emitter_direction() gives the same point.
+        for (int k = 0; k < 32; ++k) {
+            const Point2f u(rng.next_float(), rng.next_float());
+            const auto [ds, weight] = scene->sample_emitter_direction(ref, u, false);
+            if (!(ds.pdf > 0.f) || ds.delta) continue;
+            EXPECT_NEAR(scene->pdf_emitter_direction(ref, ds), ds.pdf, 1e-5f * ds.pdf);
+        }
         // An emitter the hierarchy never picks for ref sends it no light: its own samples from
         // ref all have weight 0, or arrive along ref's plane.
         for (const auto &emitter : scene->emitters()) {
@@ -423,4 +441,52 @@ TEST(EmitterSelection, TheLightHierarchyKeepsTheImageAndLowersItsNoise) {
                                                  "uniform choice's";
         }
     }
+}
+
+TEST(EmitterSelection, AFlatLightsNormalsMakeANarrowCone) {
+    // A rectangle's two triangles have normals a rounding apart, turned any way: their cone
+    // stays within the margin around the rectangle's normal (a cone of every direction would
+    // keep the hierarchy from ruling out the points behind the light).
+    PCG32 rng(17);
+    for (int i = 0; i < 200; ++i) {
+        Vector3f axis = next_vector3f(rng) - Vector3f(0.5f);
+        if (!(norm(axis) > 0.05f)) continue;
+        axis = normalize(axis);
+        const Transform rotation = Transform::rotate(axis, 360.f * rng.next_float());
+        Properties props("rectangle");
+        props.set_transform("to_world", rotation * Transform::scale(Vector3f(0.3f, 2.f, 1.f)));
+        auto shape = std::dynamic_pointer_cast<Shape>(
+            PluginRegistry::instance().create(ObjectType::Shape, props));
+        const auto [cone_axis, cos_angle] = shape->normal_cone();
+        EXPECT_GT(cos_angle, std::cos(2e-3f)) << i;
+        const Vector3f normal = normalize(rotation.apply_vector(Vector3f(0.f, 0.f, 1.f)));
+        EXPECT_GT(dot(cone_axis, normal), std::cos(2e-3f)) << i;
+    }
+}
+
+TEST(EmitterSelection, ConesOfNormalsMergeTightly) {
+    using detail::DirectionCone;
+    // Axes a rounding or a few apart (too close for their cross product to give a direction to
+    // turn about): the cone widens by their angle, it does not become every direction, which
+    // would keep the hierarchy from ruling out the points behind a group of flat lights.
+    const Vector3f z(0.f, 0.f, 1.f);
+    for (float angle : {0.f, 1e-7f, 3e-7f, 1e-6f, 1e-5f, 1e-3f, 0.3f, 2.f}) {
+        const Vector3f tilted(std::sin(angle), 0.f, std::cos(angle));
+        const DirectionCone c =
+            detail::merge(DirectionCone{z, 1e-4f}, DirectionCone{tilted, 1e-4f});
+        EXPECT_FALSE(c.everything()) << angle;
+        EXPECT_NEAR(c.theta, 1e-4f + 0.5f * angle, 2e-6f + 1e-5f * angle) << angle;
+        // Both axes and the far edges of both cones are inside.
+        for (float edge : {-1e-4f, 0.f, angle + 1e-4f}) {
+            const Vector3f d(std::sin(edge), 0.f, std::cos(edge));
+            EXPECT_GE(dot(c.axis, d), std::cos(c.theta) - 1e-6f) << angle << " " << edge;
+        }
+    }
+    // Opposite axes: every direction; a cone inside another: the other.
+    EXPECT_TRUE(detail::merge(DirectionCone{z, 0.1f}, DirectionCone{-z, 0.1f}).everything());
+    const DirectionCone wide{z, 1.f};
+    EXPECT_EQ(
+        detail::merge(wide, DirectionCone{Vector3f(std::sin(0.5f), 0.f, std::cos(0.5f)), 0.2f})
+            .theta,
+        1.f);
 }
