@@ -41,8 +41,8 @@ private:
         float power = 0;
         bool two_sided = false;
         bool leaf = false;
-        uint32_t child =
-            0; ///< inner: the second child (the first follows the node); leaf: scene index
+        /// Inner: the second child (the first follows the node); leaf: the scene index.
+        uint32_t child = 0;
     };
     static float importance(const Node &node, const Point3f &p, const Normal3f &n);
     uint32_t build_range(std::vector<std::pair<uint32_t, LightBounds>> &items, size_t begin,
