@@ -4,6 +4,8 @@
 #include <facet/sensor.h>
 #include <facet/shape.h>
 
+#include <tuple>
+
 namespace facet {
 
 ShapeSensor::~ShapeSensor() = default;
@@ -96,6 +98,16 @@ std::string Shape::to_string() const {
                        bbox().min.x, bbox().min.y, bbox().min.z, bbox().max.x, bbox().max.y,
                        bbox().max.z, surface_area(), m_bsdf ? m_bsdf->to_string() : "none",
                        emitter_label());
+}
+
+std::optional<LightBounds> Emitter::surface_light_bounds() const {
+    if (!m_shape) return std::nullopt;
+    LightBounds b;
+    b.bbox = m_shape->bbox();
+    std::tie(b.axis, b.cos_normals) = m_shape->normal_cone();
+    b.cos_emission = 0.f;
+    b.power = power();
+    return b;
 }
 
 } // namespace facet

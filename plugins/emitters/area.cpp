@@ -33,8 +33,6 @@ An area emitter must be nested in a shape (or referenced by one).
 
 #include <fmt/format.h>
 
-#include <tuple>
-
 namespace facet {
 
 class AreaLight final : public Emitter {
@@ -122,15 +120,7 @@ public:
     }
 
     /// The shape's box and normals; light leaves into the hemisphere of each normal.
-    std::optional<LightBounds> light_bounds() const override {
-        if (!m_shape) return std::nullopt;
-        LightBounds b;
-        b.bbox = m_shape->bbox();
-        std::tie(b.axis, b.cos_normals) = m_shape->normal_cone();
-        b.cos_emission = 0.f;
-        b.power = power();
-        return b;
-    }
+    std::optional<LightBounds> light_bounds() const override { return surface_light_bounds(); }
 
     std::string to_string() const override {
         // Not the shape's to_string(): that one prints its emitter, i.e. this.

@@ -31,8 +31,6 @@ light. The emitted power is `radiance` times the shape's surface area.
 
 #include <fmt/format.h>
 
-#include <tuple>
-
 namespace facet {
 
 class DirectionalAreaLight final : public Emitter {
@@ -78,15 +76,7 @@ public:
     }
 
     /// The shape's box and normals (light leaves along them; bounded here by their hemispheres).
-    std::optional<LightBounds> light_bounds() const override {
-        if (!m_shape) return std::nullopt;
-        LightBounds b;
-        b.bbox = m_shape->bbox();
-        std::tie(b.axis, b.cos_normals) = m_shape->normal_cone();
-        b.cos_emission = 0.f;
-        b.power = power();
-        return b;
-    }
+    std::optional<LightBounds> light_bounds() const override { return surface_light_bounds(); }
 
     std::string to_string() const override {
         return fmt::format("DirectionalAreaLight[radiance = {}, {}]", m_radiance->to_string(),

@@ -115,6 +115,10 @@ public:
     bool is_infinite() const { return has_flag(m_flags, EmitterFlags::Infinite); }
 
 protected:
+    /// light_bounds() of an emitter whose light leaves its shape into the hemisphere of each
+    /// normal: the shape's box and normal_cone(), and power(); none without a shape.
+    std::optional<LightBounds> surface_light_bounds() const;
+
     EmitterFlags m_flags = EmitterFlags::Empty;
     const Shape *m_shape = nullptr;
     uint32_t m_scene_index = uint32_t(-1);

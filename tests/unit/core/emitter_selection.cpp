@@ -84,6 +84,20 @@ std::vector<const Emitter *> emitters_of(const Scene &scene) {
     return out;
 }
 
+double mean(const std::vector<double> &v) {
+    double s = 0.0;
+    for (double x : v) s += x;
+    return s / double(v.size());
+}
+
+/// The variance of the mean of the values `v`, estimated from their spread.
+double var_of_mean(const std::vector<double> &v) {
+    const double m = mean(v);
+    double s = 0.0;
+    for (double x : v) s += (x - m) * (x - m);
+    return s / double(v.size() - 1) / double(v.size());
+}
+
 /// The mean of a render's pixels (all three channels).
 double render_mean(const Scene &scene) {
     RenderOptions ro;
@@ -203,17 +217,6 @@ TEST(EmitterSelection, TheExpectedImageIsTheSame) {
                 b.push_back(render_mean(
                     *load(scene_xml(uniform, 1.f, 400.f, integrator, 1024, seed + 10))));
             }
-            auto mean = [](const std::vector<double> &v) {
-                double s = 0.0;
-                for (double x : v) s += x;
-                return s / double(v.size());
-            };
-            auto var_of_mean = [&](const std::vector<double> &v) {
-                const double m = mean(v);
-                double s = 0.0;
-                for (double x : v) s += (x - m) * (x - m);
-                return s / double(v.size() - 1) / double(v.size());
-            };
             const double diff = mean(a) - mean(b);
             const double sigma = std::sqrt(var_of_mean(a) + var_of_mean(b));
             EXPECT_LT(std::abs(diff), 4.0 * sigma + 1e-4 * mean(b))
@@ -420,17 +423,6 @@ TEST(EmitterSelection, TheLightHierarchyKeepsTheImageAndLowersItsNoise) {
                     }
             }
         }
-        auto mean = [](const std::vector<double> &v) {
-            double s = 0.0;
-            for (double x : v) s += x;
-            return s / double(v.size());
-        };
-        auto var_of_mean = [&](const std::vector<double> &v) {
-            const double m = mean(v);
-            double s = 0.0;
-            for (double x : v) s += (x - m) * (x - m);
-            return s / double(v.size() - 1) / double(v.size());
-        };
         const double diff = mean(a) - mean(b);
         const double sigma = std::sqrt(var_of_mean(a) + var_of_mean(b));
         EXPECT_LT(std::abs(diff), 4.0 * sigma + 1e-4 * mean(b))
