@@ -2,8 +2,6 @@
 
 #include "direction_cone.h"
 
-#include <facet/logger.h>
-
 #include <algorithm>
 #include <cmath>
 

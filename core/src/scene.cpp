@@ -591,20 +591,9 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     Color3f &weight = result.second;
     const size_t count = m_emitter_table.size();
     if (count == 0) return result;
-    // The uniform choice keeps its own arithmetic (images as before to the last bit).
-    const bool uniform = m_emitter_uniform && !m_light_bvh;
-    size_t index;
-    float pmf = 0.f;
-    if (uniform) {
-        // The sample is stretched back to [0, 1) for the emitter.
-        float scaled = u.x * float(count);
-        index = std::min(size_t(scaled), count - 1);
-        u.x = std::min(scaled - float(index), OneMinusEpsilon);
-    } else {
-        std::tie(index, pmf) = pick_emitter(&ref, u.x);
-        // None can reach ref, or sampling_weight 0 (never picked but by rounding).
-        if (!(pmf > 0.f)) return result;
-    }
+    const auto [index, pmf] = pick_emitter(&ref, u.x);
+    // None can reach ref, or sampling_weight 0 (never picked but by rounding).
+    if (!(pmf > 0.f)) return result;
     const EmitterEntry &entry = m_emitter_table[index];
 
     if (entry.mesh) {
@@ -628,7 +617,8 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     }
     // Delta emitters report pdf 1 (not a density): it is left as returned, as in
     // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
-    if (uniform) {
+    if (m_emitter_uniform && !m_light_bvh) {
+        // The uniform choice keeps its arithmetic (images as before to the last bit).
         if (!ds.delta) ds.pdf /= float(count);
         weight *= float(count);
     } else {
