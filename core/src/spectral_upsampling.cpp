@@ -123,11 +123,9 @@ std::string spectral_upsampling_table_path() {
 }
 
 SigmoidPolynomial rgb_to_sigmoid(const Color3f &rgb_in) {
-    Color3f rgb;
-    for (int i = 0; i < 3; ++i) {
-        float v = rgb_in[i];
-        rgb[i] = v > 0.f ? (v < 1.f ? v : 1.f) : 0.f; // NaN -> 0
-    }
+    const Color3f rgb = map(rgb_in, [](float v) {
+        return v > 0.f ? (v < 1.f ? v : 1.f) : 0.f; // NaN -> 0
+    });
     if (rgb.r == rgb.g && rgb.g == rgb.b && (rgb.r == 0.f || rgb.r == 1.f))
         return {0.f, 0.f, rgb.r == 0.f ? -Infinity : Infinity};
 
@@ -180,10 +178,8 @@ RGBSpectrum RGBSpectrum::scaled(const Color3f &rgb) {
 }
 
 Color3f RGBSpectrum::eval(const Wavelengths &lambda) const {
-    Color3f v(poly(lambda.r), poly(lambda.g), poly(lambda.b));
-    v *= scale;
-    if (illuminant)
-        v *= Color3f(float(cie_d65(lambda.r)), float(cie_d65(lambda.g)), float(cie_d65(lambda.b)));
+    Color3f v = map(lambda, [this](float l) { return poly(l); }) * scale;
+    if (illuminant) v *= cie_d65(lambda);
     return v;
 }
 

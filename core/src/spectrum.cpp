@@ -218,6 +218,10 @@ float sample_wavelength(float u) {
 
 } // namespace
 
+Color3f cie_d65(const Wavelengths &lambda) {
+    return map(lambda, [](float l) { return float(cie_d65(double(l))); });
+}
+
 float pdf_wavelength(float lambda) {
     if (!(lambda >= SpectralMinNm && lambda <= SpectralMaxNm)) return 0.f;
     // 1 / cosh²(x) = 4 e^{-2|x|} / (1 + e^{-2|x|})².
@@ -228,8 +232,8 @@ float pdf_wavelength(float lambda) {
 std::pair<Wavelengths, Color3f> sample_wavelengths(float u) {
     Wavelengths lambda;
     Color3f weight;
-    for (int i = 0; i < 3; ++i) {
-        float ui = u + float(i) * (1.f / 3.f);
+    for (int i = 0; i < Color3f::Channels; ++i) {
+        float ui = u + float(i) * (1.f / float(Color3f::Channels));
         if (ui >= 1.f) ui -= 1.f;
         lambda[i] = sample_wavelength(ui);
         weight[i] = 1.f / pdf_wavelength(lambda[i]);
@@ -239,8 +243,8 @@ std::pair<Wavelengths, Color3f> sample_wavelengths(float u) {
 
 Color3f spectral_to_srgb(const Color3f &L, const Wavelengths &lambda, const Color3f &weight) {
     Color3f xyz(0.f);
-    for (int i = 0; i < 3; ++i) xyz += cie1931_xyz(lambda[i]) * (L[i] * weight[i]);
-    return xyz_to_srgb(xyz * float(1.0 / (3.0 * CieYIntegral)));
+    for (int i = 0; i < Color3f::Channels; ++i) xyz += cie1931_xyz(lambda[i]) * (L[i] * weight[i]);
+    return xyz_to_srgb(xyz * float(1.0 / (Color3f::Channels * CieYIntegral)));
 }
 
 } // namespace facet

@@ -37,8 +37,7 @@ public:
     DataSpectrumTexture(SpectrumData data, SpectrumKind kind)
         : SpectralTexture(spectrum_to_rgb(data, kind)), m_data(std::move(data)) {}
     Color3f eval_wavelengths(const Wavelengths &lambda) const override {
-        return {float(m_data.eval(lambda.r)), float(m_data.eval(lambda.g)),
-                float(m_data.eval(lambda.b))};
+        return map(lambda, [this](float l) { return float(m_data.eval(l)); });
     }
     std::string to_string() const override {
         return fmt::format("DataSpectrumTexture[{}]", m_data.to_string());

@@ -368,9 +368,8 @@ private:
             float scale = ctx.mode == TransportMode::Radiance ? 1.f / sqr(eta_path) : 1.f;
             float t = std::abs(scale * (1.f - F) * D * distr.G(wi, wo, h) * sqr(eta_path) * wi_h *
                                wo_h / (cos_i * sqr(wi_h + eta_path * wo_h)));
-            Color3f tint(std::sqrt(std::max(p.base_color.r, 0.f)),
-                         std::sqrt(std::max(p.base_color.g, 0.f)),
-                         std::sqrt(std::max(p.base_color.b, 0.f)));
+            const Color3f tint =
+                map(p.base_color, [](float c) { return std::sqrt(std::max(c, 0.f)); });
             value += tint * (p.bsdf * t);
         }
         if (on.clearcoat && refl_ok && front && p.clearcoat > 0.f) {

@@ -108,11 +108,11 @@ public:
         m_texels.assign(size_t(m_width + 1) * m_height, Texel{});
         for (int y = 0; y < m_height; ++y)
             for (int x = 0; x < m_width; ++x) {
-                Color3f c;
-                for (int ch = 0; ch < 3; ++ch) {
+                auto channel = [&](int ch) {
                     float v = img.at(x, y, std::min(ch, colour_channels - 1));
-                    c[ch] = (decode ? srgb_to_linear(v) : v) * m_scale;
-                }
+                    return (decode ? srgb_to_linear(v) : v) * m_scale;
+                };
+                Color3f c(channel(0), channel(1), channel(2));
                 if (!c.is_finite())
                     FACET_THROW_AT(props.location("filename"),
                                    "envmap: \"{}\" has a non-finite pixel at ({}, {})", m_path, x,
@@ -120,8 +120,8 @@ public:
                 // Negative values are kept, as Mitsuba keeps them; only the sampling table
                 // clamps at zero. The mono mode renders the luminance.
                 c = in_mode(c, props.mode());
-                texel(x, y).radiance = c;
-                if (x == 0) texel(m_width, y).radiance = c; // column W is column 0 again
+                texel(x, y).set_radiance(c);
+                if (x == 0) texel(m_width, y).set_radiance(c); // column W is column 0 again
             }
         build_distribution();
         if (is_spectral(props.mode())) {
@@ -133,7 +133,7 @@ public:
             m_spectral = true;
             m_scales.resize(m_texels.size());
             for (size_t i = 0; i < m_texels.size(); ++i) {
-                const RGBSpectrum rs = RGBSpectrum::scaled(m_texels[i].radiance);
+                const RGBSpectrum rs = RGBSpectrum::scaled(m_texels[i].radiance());
                 m_scales[i] = rs.scale;
                 m_texels[i].curve = rs.poly;
             }
@@ -251,9 +251,15 @@ private:
     // texel row read is a miss, and separate arrays took twice as many.
     struct Texel {
         union {
-            Color3f radiance = Color3f(); ///< the pixel, times `scale`
-            SigmoidPolynomial curve;      ///< the spectral mode: the pixel's curve
+            float rgb[3] = {0.f, 0.f, 0.f}; ///< the pixel, times `scale`
+            SigmoidPolynomial curve;        ///< the spectral mode: the pixel's curve
         };
+        Color3f radiance() const { return {rgb[0], rgb[1], rgb[2]}; }
+        void set_radiance(const Color3f &c) {
+            rgb[0] = c.r;
+            rgb[1] = c.g;
+            rgb[2] = c.b;
+        }
         float weight = 0.f; ///< the sampling table's value (see build_distribution())
     };
     Texel &texel(int x, int y) { return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
@@ -262,7 +268,7 @@ private:
     }
 
     /// Pixel (x, y) for x in [0, W]: column W is column 0 again.
-    const Color3f &pixel(int x, int y) const { return texel(x, y).radiance; }
+    Color3f pixel(int x, int y) const { return texel(x, y).radiance(); }
 
     Color3f lookup(const GridPoint &g) const {
         const int i = g.i, j = g.j;
@@ -281,7 +287,7 @@ private:
         auto add = [&](int x, int y, float w) {
             const size_t i = size_t(y) * size_t(m_width + 1) + size_t(x);
             const SigmoidPolynomial &c = m_texels[i].curve;
-            curve += Color3f(c(lambda.r), c(lambda.g), c(lambda.b)) * w;
+            curve += map(lambda, c) * w;
             scale += m_scales[i] * w;
         };
         const int i = g.i, j = g.j;
@@ -294,9 +300,7 @@ private:
             add(i, j + 1, (1.f - s) * t);
             add(i + 1, j + 1, s * t);
         }
-        const Color3f d65(float(cie_d65(lambda.r)), float(cie_d65(lambda.g)),
-                          float(cie_d65(lambda.b)));
-        return curve * d65 * scale;
+        return curve * cie_d65(lambda) * scale;
     }
 
     // -- Importance sampling ------------------------------------------------------------------

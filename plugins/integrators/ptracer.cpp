@@ -21,7 +21,7 @@ The sensor must support sampling a direction towards it (perspective, thinlens, 
 Every emitter emits rays: environments send them into the scene's bounding sphere from a disk
 facing the sampled direction, so an environment lights the scene as it does for the path tracer.
 
-In the spectral modes each light path draws its three wavelengths as a camera ray does and
+In the spectral modes each light path draws its four wavelengths as a camera ray does and
 splats its value developed through CIE XYZ; in `scalar_spectral_polarized` the light carries
 its Stokes vector from the (unpolarised) emitter through every BSDF that polarises, and the
 sensor records its intensity.

@@ -103,7 +103,7 @@ public:
             s = mueller::rotate_stokes_basis(-ray.d, mueller::stokes_basis(-ray.d), target) * s;
         Color3f weight(1.f);
         if (is_spectral(m_mode))
-            for (int i = 0; i < 3; ++i) {
+            for (int i = 0; i < Color3f::Channels; ++i) {
                 const float pdf = pdf_wavelength(ray.wavelengths[i]);
                 weight[i] = pdf > 0.f ? 1.f / pdf : 0.f;
             }

@@ -71,8 +71,7 @@ public:
         if (is_spectral(m_mode)) {
             // The interpolated colour's spectrum (as a reflectance: clamped to [0, 1]).
             const SigmoidPolynomial c = rgb_to_sigmoid(Color3f(v[0], v[1], v[2]));
-            const Wavelengths &l = si.wavelengths;
-            return Color3f(c(l.r), c(l.g), c(l.b)) * m_scale;
+            return map(si.wavelengths, c) * m_scale;
         }
         return in_mode(Color3f(v[0], v[1], v[2]) * m_scale, m_mode);
     }

@@ -64,10 +64,9 @@ inline float fresnel_conductor(float cos_i, float eta, float k) {
     return 0.5f * (r_s + r_p);
 }
 
-/// fresnel_conductor() per RGB channel.
+/// fresnel_conductor() per channel.
 inline Color3f fresnel_conductor(float cos_i, const Color3f &eta, const Color3f &k) {
-    return {fresnel_conductor(cos_i, eta.r, k.r), fresnel_conductor(cos_i, eta.g, k.g),
-            fresnel_conductor(cos_i, eta.b, k.b)};
+    return map(eta, k, [cos_i](float e, float kk) { return fresnel_conductor(cos_i, e, kk); });
 }
 
 /// Result of fresnel_polarized(): the complex amplitude reflection coefficients and the

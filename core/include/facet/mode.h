@@ -38,7 +38,7 @@ std::string resolve_mode(const std::string &name);
  *   colour a scene gives (rgb, spectrum, image texel, vertex colour) becomes its luminance
  *   (Rec.709 Y, which is CIE Y) when it is read, so every channel of every value along a path is
  *   the same and the image's R = G = B is the mono image.
- * - `Spectral`: each channel of a value along a path is the quantity at one of the path's three
+ * - `Spectral`: each channel of a value along a path is the quantity at one of the path's four
  *   wavelengths (Interaction::wavelengths, sampled with the camera ray); the render loop turns
  *   the path's radiance into CIE XYZ and then the film's RGB. Colours a scene gives become
  *   spectra (RGB by the sigmoid-polynomial model, spectra and measured data per wavelength), which

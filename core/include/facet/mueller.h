@@ -205,7 +205,7 @@ inline Mueller specular_reflection(float cos_i, float eta) {
 /// specular_reflection() of a conductor whose index is eta + i·k at each wavelength.
 inline Mueller specular_reflection(float cos_i, const Color3f &eta, const Color3f &k) {
     Mueller r;
-    for (int lane = 0; lane < 3; ++lane) {
+    for (int lane = 0; lane < Color3f::Channels; ++lane) {
         float m[4][4];
         specular_reflection(cos_i, std::complex<float>(eta[lane], k[lane]), m);
         for (int i = 0; i < 4; ++i)

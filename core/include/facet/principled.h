@@ -64,8 +64,8 @@ template <typename T> T schlick_fresnel(const T &r0, float cos_i, float eta) {
 inline float tint_luminance(const Color3f &base_color, const Wavelengths &lambda, bool spectral) {
     if (!spectral) return base_color.luminance();
     float sum = 0.f;
-    for (int i = 0; i < 3; ++i) sum += cie1931_xyz(lambda[i]).g * base_color[i];
-    return sum * (1.f / 3.f);
+    for (int i = 0; i < Color3f::Channels; ++i) sum += cie1931_xyz(lambda[i]).g * base_color[i];
+    return sum * (1.f / float(Color3f::Channels));
 }
 
 /// The base colour normalised by its luminance `lum` (tint_luminance(); white where it is zero).

@@ -49,6 +49,8 @@ Color3f cie1931_xyz(double lambda);
 /// D65 relative power at `lambda` nm, scaled as Mitsuba's (to luminance 1 against the continuous
 /// CIE curves; a white reflectance integrates to 0.99889 over spectrum_to_rgb's quadrature).
 double cie_d65(double lambda);
+/// cie_d65() at each of `lambda`'s wavelengths.
+Color3f cie_d65(const Wavelengths &lambda);
 
 /// The spectral mode's wavelength range, nm: the CIE tables'.
 constexpr float SpectralMinNm = 360.f, SpectralMaxNm = 830.f;
@@ -56,8 +58,9 @@ constexpr float SpectralMinNm = 360.f, SpectralMaxNm = 830.f;
 /// 1 / cosh²(0.0072 (λ - 538)) on [360, 830] nm, a curve that follows the sum of the CIE
 /// matching functions (Mitsuba's choice), 0 outside.
 float pdf_wavelength(float lambda);
-/// The three wavelengths of a path from one uniform number `u`: stratified (u, u + 1/3, u + 2/3
-/// modulo 1), each drawn from pdf_wavelength() by inversion, with their weights 1 / pdf.
+/// The four wavelengths of a path (one per channel, Color3f::Channels) from one uniform number
+/// `u`: stratified (u + i/4 modulo 1), each drawn from pdf_wavelength() by inversion, with their
+/// weights 1 / pdf.
 std::pair<Wavelengths, Color3f> sample_wavelengths(float u);
 /// The radiance of a path of the spectral mode (`L` at `lambda`, drawn with weights `weight`)
 /// as linear Rec.709: XYZ = the mean over the channels of L·weight·(x̄, ȳ, z̄)(λ) / ∫ȳ, an

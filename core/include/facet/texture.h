@@ -111,7 +111,9 @@ public:
     virtual Color3f eval_wavelengths(const Wavelengths &lambda) const = 0;
     Color3f eval(const SurfaceInteraction &si) const final {
         // Wavelengths outside the visible range are ones a caller lost (zero).
-        FACET_ASSERT(si.wavelengths.r >= 360.f && si.wavelengths.b <= 830.f);
+        FACET_ASSERT(std::min(std::min(si.wavelengths.r, si.wavelengths.g),
+                              std::min(si.wavelengths.b, si.wavelengths.w)) >= 360.f &&
+                     si.wavelengths.max() <= 830.f);
         return eval_wavelengths(si.wavelengths);
     }
     /// A scalar parameter given as a colour or spectrum (a weight, an opacity, a roughness)

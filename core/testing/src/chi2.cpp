@@ -159,7 +159,7 @@ struct Findings {
     uint64_t bad_direction = 0, nonfinite_weight = 0, bad_pdf = 0, weight_mismatch = 0,
              pdf_mismatch = 0, adapter_problem = 0;
     double max_pdf_error = 0.0, max_weight_error = 0.0;
-    double sum[3] = {0, 0, 0}, sum_sq[3] = {0, 0, 0};
+    double sum[Color3f::Channels] = {}, sum_sq[Color3f::Channels] = {};
     uint64_t smooth = 0, delta = 0, failed = 0;
 
     void note(uint64_t index, std::string text) {
@@ -171,6 +171,7 @@ struct Findings {
 };
 
 std::string color_str(const Color3f &c) {
+    if (c.w != c.g) return fmt::format("[{:.6g}, {:.6g}, {:.6g}, {:.6g}]", c.r, c.g, c.b, c.w);
     return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", c.r, c.g, c.b);
 }
 std::string vec_str(const Vector3f &v) {
@@ -218,7 +219,7 @@ void check_sample(const Chi2Sample &s, uint64_t index, const Chi2Options &opts, 
     }
     if (s.has_value) {
         double err = (s.pdf == 0.f || !s.value.is_finite()) ? 1.0 : 0.0;
-        for (int c = 0; c < 3; ++c)
+        for (int c = 0; c < Color3f::Channels; ++c)
             err = std::max(err, rel_diff(s.weight[c], double(s.value[c]) / s.pdf));
         f.max_weight_error = std::max(f.max_weight_error, err);
         if (err > opts.weight_tolerance) {
@@ -339,7 +340,7 @@ Findings histogram(const Chi2Adapter &adapter, const Chi2Options &opts, Chi2Resu
             Chi2Sample s = adapter.sample(u);
             check_sample(s, i, opts, f);
             if (s.has_weight && s.weight.is_finite()) {
-                for (int c = 0; c < 3; ++c) {
+                for (int c = 0; c < Color3f::Channels; ++c) {
                     double w = double(s.weight[c]) * s.energy_scale;
                     f.sum[c] += w;
                     f.sum_sq[c] += w * w;
@@ -379,7 +380,7 @@ Findings histogram(const Chi2Adapter &adapter, const Chi2Options &opts, Chi2Resu
         total.smooth += f.smooth;
         total.delta += f.delta;
         total.failed += f.failed;
-        for (int c = 0; c < 3; ++c) {
+        for (int c = 0; c < Color3f::Channels; ++c) {
             total.sum[c] += f.sum[c];
             total.sum_sq[c] += f.sum_sq[c];
         }
@@ -402,7 +403,7 @@ void report_samples(const Findings &total, const Chi2Options &opts, Chi2Result &
     res.failed = total.failed;
     res.weight_mismatches = total.weight_mismatch;
     res.pdf_mismatches = total.pdf_mismatch;
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < Color3f::Channels; ++c) {
         double mean = total.sum[c] / double(n);
         double var = std::max(0.0, total.sum_sq[c] / double(n) - mean * mean);
         res.mean_weight[c] = float(mean);
@@ -512,7 +513,7 @@ void verdict(const Chi2Adapter &adapter, const Chi2Options &opts, bool tested, C
 
     // Energy: the mean weight of a passive BSDF does not exceed 1 (5 standard errors of noise).
     if (adapter.bounded_weights()) {
-        for (int c = 0; c < 3; ++c) {
+        for (int c = 0; c < Color3f::Channels; ++c) {
             double bound = 1.0 + 5.0 * res.weight_stddev[c] / std::sqrt(n) + 1e-4;
             if (res.mean_weight[c] > bound) {
                 res.failures.push_back(

@@ -26,7 +26,7 @@ namespace facet {
 namespace {
 
 /// The wavelengths (nm) the adapters evaluate spectral-mode plugins at.
-const Wavelengths ChiSquareWavelengths(450.f, 550.f, 650.f);
+const Wavelengths ChiSquareWavelengths(450.f, 550.f, 650.f, 500.f);
 
 std::string xml_escape(const std::string &s) {
     std::string out;
@@ -183,7 +183,7 @@ void BSDFAdapter::init() {
     m_si.uv = Point2f(0.5f, 0.5f);
     m_si.dp_du = Vector3f(1.f, 0.f, 0.f);
     m_si.dp_dv = Vector3f(0.f, 1.f, 0.f);
-    // Wavelengths of a spectral-mode path (the other modes ignore them): three distinct ones,
+    // Wavelengths of a spectral-mode path (the other modes ignore them): four distinct ones,
     // so that the weight check sees spectral values that differ by channel.
     m_si.wavelengths = ChiSquareWavelengths;
     if (m_ctx.component != uint32_t(-1) && m_ctx.component >= m_bsdf->component_count())
@@ -214,8 +214,10 @@ Chi2Sample BSDFAdapter::sample(const float *u) const {
         float m = std::max(std::abs(a), std::abs(b));
         return !(m == 0.f || std::abs(a - b) <= 1e-4f * m);
     };
-    if (differs(pdf2, s.pdf) || differs(value2.r, s.value.r) || differs(value2.g, s.value.g) ||
-        differs(value2.b, s.value.b))
+    bool value_differs = false;
+    for (int c = 0; c < Color3f::Channels; ++c)
+        value_differs = value_differs || differs(value2[c], s.value[c]);
+    if (differs(pdf2, s.pdf) || value_differs)
         s.problem =
             fmt::format("eval_pdf() = ({}, {}, {}; {}) but eval() = ({}, {}, {}), pdf() = {} "
                         "at {}",

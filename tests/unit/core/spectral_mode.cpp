@@ -7,9 +7,11 @@
 // suite (labels compat-spectral).
 
 #include <facet/conductor_data.h>
+#include <facet/fresnel.h>
 #include <facet/image.h>
 #include <facet/logger.h>
 #include <facet/mode.h>
+#include <facet/mueller.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
@@ -24,6 +26,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <unistd.h>
 
@@ -33,7 +36,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// ∫ f over [360, 830] nm by the spectral mode's estimator: the mean over `n` stratified
-/// uniform numbers of the three lanes' f(λ)·w (the wavelengths of n paths).
+/// uniform numbers of the four lanes' f(λ)·w (the wavelengths of n paths).
 template <typename F> Color3f estimate(F f, int n) {
     Color3f sum(0.f);
     for (int k = 0; k < n; ++k) {
@@ -54,12 +57,12 @@ template <typename F> Color3f develop(F f, int n = 3000) {
     return sum / float(n);
 }
 
-Color3f d65(const Wavelengths &l) {
-    return {float(cie_d65(l.r)), float(cie_d65(l.g)), float(cie_d65(l.b))};
-}
+Color3f d65(const Wavelengths &l) { return cie_d65(l); }
 
+/// a and b agree in every channel (the four wavelengths' values, or RGB and its copy of G).
 void expect_near(const Color3f &a, const Color3f &b, float tol, const std::string &what) {
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], tol) << what << " channel " << c;
+    for (int c = 0; c < Color3f::Channels; ++c)
+        EXPECT_NEAR(a[c], b[c], tol) << what << " channel " << c;
 }
 
 std::shared_ptr<Texture> load_texture(const std::string &xml) {
@@ -95,7 +98,7 @@ Color3f render_mean(const std::string &xml, const std::string &mode, const fs::p
     Color3f sum(0.f);
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x)
-            for (int c = 0; c < 3; ++c) sum[c] += image.at(x, y, c);
+            sum += Color3f(image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2));
     return sum / float(image.width * image.height);
 }
 
@@ -117,6 +120,52 @@ std::string furnace(const std::string &emitter, const std::string &content) {
 
 } // namespace
 
+TEST(SpectralMode, AValueHoldsFourChannelsAndAnRgbValueCopiesGreenIntoTheFourth) {
+    // Three numbers (rgb, mono) put a copy of g in w; channel-wise arithmetic keeps it a copy, so
+    // the four-channel checks see only real values.
+    const Color3f a(0.5f, 2.f, -1.f), b(4.f, 0.25f, 3.f);
+    EXPECT_EQ(a.w, a.g);
+    for (const Color3f &c : {a + b, a - b, a * b, a / b, a * 3.f, a / 3.f})
+        EXPECT_EQ(c.w, c.g) << c;
+    EXPECT_EQ(a.max(), 2.f);
+    EXPECT_FALSE(Color3f(0.f, 0.f, 0.f, 1.f).is_black());
+    EXPECT_FALSE(Color3f(1.f, 1.f, 1.f, Infinity).is_finite());
+    EXPECT_EQ(Color3f(0.f, 1.f, 0.f, 5.f).max(), 5.f);
+    // map() calls f for each of four distinct channels, takes the copy for an rgb value.
+    int calls = 0;
+    auto twice = [&calls](float v) {
+        ++calls;
+        return 2.f * v;
+    };
+    EXPECT_EQ(map(Color3f(1.f, 2.f, 3.f, 4.f), twice), Color3f(2.f, 4.f, 6.f, 8.f));
+    EXPECT_EQ(calls, 4);
+    EXPECT_EQ(map(Color3f(1.f, 2.f, 3.f), twice), Color3f(2.f, 4.f, 6.f));
+    EXPECT_EQ(calls, 7);
+    EXPECT_EQ(map(Color3f(1.f, 2.f, 3.f, 4.f), Color3f(1.f, 2.f, 3.f), std::plus<float>()),
+              Color3f(2.f, 4.f, 6.f, 6.f));
+}
+
+TEST(SpectralMode, PerWavelengthFormulasFillTheFourthChannel) {
+    // A conductor with four different indices: each channel is the scalar formula's, the
+    // reflection matrix's lanes too.
+    const Color3f eta(0.2f, 0.9f, 1.5f, 0.4f), k(3.f, 2.5f, 1.9f, 2.8f);
+    const Color3f F = fresnel_conductor(0.6f, eta, k);
+    const Mueller M = mueller::specular_reflection(0.6f, eta, k);
+    for (int c = 0; c < Color3f::Channels; ++c) {
+        EXPECT_FLOAT_EQ(F[c], fresnel_conductor(0.6f, eta[c], k[c])) << "channel " << c;
+        EXPECT_FLOAT_EQ(M.m[0][0][c], F[c]) << "channel " << c;
+    }
+    // D65 and an upsampled colour at each wavelength.
+    const Wavelengths l(420.f, 530.f, 640.f, 700.f);
+    const RGBSpectrum s = RGBSpectrum::from_rgb(Color3f(0.8f, 0.3f, 0.1f), SpectrumKind::Emission);
+    const Color3f v = s.eval(l);
+    for (int c = 0; c < Color3f::Channels; ++c) {
+        EXPECT_FLOAT_EQ(cie_d65(l)[c], float(cie_d65(double(l[c])))) << "channel " << c;
+        EXPECT_FLOAT_EQ(v[c], s.poly(l[c]) * s.scale * float(cie_d65(double(l[c]))))
+            << "channel " << c;
+    }
+}
+
 TEST(SpectralMode, TheWavelengthDensityIsNormalisedOnTheVisibleRange) {
     // The trapezoid rule over 1 nm steps.
     double sum = 0.0;
@@ -130,7 +179,7 @@ TEST(SpectralMode, TheWavelengthDensityIsNormalisedOnTheVisibleRange) {
     EXPECT_GT(pdf_wavelength(538.f), pdf_wavelength(600.f));
 }
 
-TEST(SpectralMode, ThreeStratifiedWavelengthsWithWeightsOneOverTheDensity) {
+TEST(SpectralMode, FourStratifiedWavelengthsWithWeightsOneOverTheDensity) {
     // The density's distribution function, by quadrature.
     auto cdf = [](float lambda) {
         double sum = 0.0;
@@ -141,14 +190,14 @@ TEST(SpectralMode, ThreeStratifiedWavelengthsWithWeightsOneOverTheDensity) {
         }
         return sum;
     };
-    for (float u : {0.f, 0.1f, 0.3333f, 0.5f, 0.9f, 0.99999f}) {
+    for (float u : {0.f, 0.1f, 0.25f, 0.3333f, 0.5f, 0.9f, 0.99999f}) {
         const auto [lambda, weight] = sample_wavelengths(u);
-        for (int i = 0; i < 3; ++i) {
+        for (int i = 0; i < Color3f::Channels; ++i) {
             EXPECT_GE(lambda[i], 360.f);
             EXPECT_LE(lambda[i], 830.f);
             EXPECT_FLOAT_EQ(weight[i], 1.f / pdf_wavelength(lambda[i]));
-            // Lane i sits at u + i/3 (modulo 1) of the distribution function.
-            double expected = std::fmod(double(u) + i / 3.0, 1.0);
+            // Lane i sits at u + i/4 (modulo 1) of the distribution function.
+            double expected = std::fmod(double(u) + i / 4.0, 1.0);
             EXPECT_NEAR(cdf(lambda[i]), expected, 2e-4) << "u " << u << " lane " << i;
         }
     }
@@ -167,9 +216,14 @@ TEST(SpectralMode, DevelopmentGivesD65WhiteAndTheEqualEnergyWhite) {
                 xyz_to_srgb(Color3f(1.f)), 3e-3f, "flat");
     // A spectrum nonzero in one lane only: the development is linear in each lane.
     const auto [lambda, weight] = sample_wavelengths(0.4f);
-    const Color3f one = spectral_to_srgb(Color3f(1.f, 0.f, 0.f), lambda, weight);
-    const Color3f xyz = cie1931_xyz(lambda.r) * (weight.r / (3.f * 106.7502593994140625f));
-    expect_near(one, xyz_to_srgb(xyz), 1e-5f, "one lane");
+    for (int lane = 0; lane < Color3f::Channels; ++lane) {
+        Color3f only(0.f);
+        only[lane] = 1.f;
+        const Color3f one = spectral_to_srgb(only, lambda, weight);
+        const Color3f xyz =
+            cie1931_xyz(lambda[lane]) * (weight[lane] / (4.f * 106.7502593994140625f));
+        expect_near(one, xyz_to_srgb(xyz), 1e-5f, fmt::format("lane {} alone", lane));
+    }
 }
 
 TEST(SpectralMode, ColoursComeBackThroughTheirSpectra) {
@@ -192,28 +246,29 @@ TEST(SpectralMode, ColoursComeBackThroughTheirSpectra) {
                     fmt::format("emission ({}, {}, {})", c.r, c.g, c.b));
     }
     // Black is black in every form.
-    const Wavelengths l(450.f, 550.f, 650.f);
+    const Wavelengths l(450.f, 550.f, 650.f, 500.f);
     EXPECT_EQ(RGBSpectrum::from_rgb(Color3f(0.f), SpectrumKind::Emission).eval(l), Color3f(0.f));
     EXPECT_EQ(RGBSpectrum::from_rgb(Color3f(0.f), SpectrumKind::Reflectance).eval(l), Color3f(0.f));
 }
 
 TEST(SpectralMode, SceneColoursBecomeSpectraEvaluatedAtTheWavelengths) {
-    const Wavelengths l(420.f, 530.f, 640.f);
+    const Wavelengths l(420.f, 530.f, 640.f, 700.f);
     // An rgb: its upsampled curve at each wavelength.
     const Color3f c(0.8f, 0.3f, 0.1f);
     const auto rgb = color0_of("<rgb name=\"color0\" value=\"0.8, 0.3, 0.1\"/>");
     const SigmoidPolynomial s = rgb_to_sigmoid(c);
-    EXPECT_EQ(eval_at(*rgb, l), Color3f(s(l.r), s(l.g), s(l.b)));
+    EXPECT_EQ(eval_at(*rgb, l), Color3f(s(l.r), s(l.g), s(l.b), s(l.w)));
     EXPECT_NE(eval_at(*rgb, l), eval_at(*rgb, Wavelengths(600.f, 600.f, 600.f)));
     // A number and a grey: flat.
     EXPECT_EQ(eval_at(*color0_of("<float name=\"color0\" value=\"0.4\"/>"), l), Color3f(0.4f));
     EXPECT_EQ(eval_at(*color0_of("<rgb name=\"color0\" value=\"0.4\"/>"), l), Color3f(0.4f));
     // Spectra: linear between their pairs, 0 outside them, a uniform value flat.
     const auto pairs = color0_of("<spectrum name=\"color0\" value=\"400:0.1, 500:0.7, 600:0.3\"/>");
-    const Color3f v = eval_at(*pairs, Wavelengths(450.f, 550.f, 700.f));
+    const Color3f v = eval_at(*pairs, Wavelengths(450.f, 550.f, 700.f, 425.f));
     EXPECT_NEAR(v.r, 0.4f, 1e-6f);
     EXPECT_NEAR(v.g, 0.5f, 1e-6f);
     EXPECT_EQ(v.b, 0.f);
+    EXPECT_NEAR(v.w, 0.25f, 1e-6f);
     EXPECT_EQ(eval_at(*color0_of("<spectrum name=\"color0\" value=\"0.6\"/>"), l), Color3f(0.6f));
     // Spectrum plugins per wavelength: d65 is D65, a blackbody Planck's law.
     const auto d65_plugin = color0_of("<spectrum name=\"color0\" type=\"d65\"/>");
@@ -234,9 +289,9 @@ TEST(SpectralMode, ConductorPresetsUseTheMeasuredDataPerWavelength) {
     props.set_mode(ColourMode::Spectral);
     props.set_string("material", "Au");
     const ConductorIOR ior = read_conductor_ior(props);
-    const Wavelengths l(450.f, 550.f, 650.f);
+    const Wavelengths l(450.f, 550.f, 650.f, 500.f);
     const Color3f e = eval_at(*ior.eta, l), kk = eval_at(*ior.k, l);
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < Color3f::Channels; ++i) {
         EXPECT_FLOAT_EQ(e[i], float(eta.eval(l[i])));
         EXPECT_FLOAT_EQ(kk[i], float(k.eval(l[i])));
     }
@@ -304,7 +359,7 @@ TEST(SpectralMode, AColoredPlaneUnderAWhiteEnvironmentMapIsItsColour) {
 }
 
 TEST(SpectralMode, ColoursAreClampedAlikeAndScalarsStayScalars) {
-    const Wavelengths l(420.f, 530.f, 640.f);
+    const Wavelengths l(420.f, 530.f, 640.f, 700.f);
     // An unbounded rgb is clamped to [0, 1], grey or not (as Mitsuba's spectral modes clamp it);
     // a number is not.
     Properties props("test");
@@ -318,7 +373,7 @@ TEST(SpectralMode, ColoursAreClampedAlikeAndScalarsStayScalars) {
     EXPECT_GT(std::min(colour.r, std::min(colour.g, colour.b)), 0.9f);
     EXPECT_EQ(eval_at(*props.texture("number", SpectrumKind::Unbounded), l), Color3f(1.5f));
     // A scalar parameter given as a colour (a blend weight, an opacity) is one number for every
-    // path, the rgb mode's mean, not the mean of the path's three wavelengths.
+    // path, the rgb mode's mean, not the mean of the path's wavelengths.
     props.set_color("weight", Color3f(0.9f, 0.2f, 0.1f));
     const auto weight = props.texture("weight");
     SurfaceInteraction a, b;
