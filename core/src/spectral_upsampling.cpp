@@ -178,7 +178,7 @@ RGBSpectrum RGBSpectrum::scaled(const Color3f &rgb) {
 }
 
 Color3f RGBSpectrum::eval(const Wavelengths &lambda) const {
-    Color3f v = map(lambda, [this](float l) { return poly(l); }) * scale;
+    Color3f v = poly(lambda) * scale;
     if (illuminant) v *= cie_d65(lambda);
     return v;
 }

@@ -287,7 +287,7 @@ private:
         auto add = [&](int x, int y, float w) {
             const size_t i = size_t(y) * size_t(m_width + 1) + size_t(x);
             const SigmoidPolynomial &c = m_texels[i].curve;
-            curve += map(lambda, c) * w;
+            curve += c(lambda) * w;
             scale += m_scales[i] * w;
         };
         const int i = g.i, j = g.j;

@@ -298,7 +298,7 @@ private:
     Color3f lookup_spectral(const Point2f &uv, const Wavelengths &lambda) const {
         return filtered(uv, [&](int px, int py) {
             const SigmoidPolynomial &c = m_curves[size_t(py) * size_t(m_width) + size_t(px)];
-            return map(lambda, c);
+            return c(lambda);
         });
     }
 

@@ -71,7 +71,7 @@ public:
         if (is_spectral(m_mode)) {
             // The interpolated colour's spectrum (as a reflectance: clamped to [0, 1]).
             const SigmoidPolynomial c = rgb_to_sigmoid(Color3f(v[0], v[1], v[2]));
-            return map(si.wavelengths, c) * m_scale;
+            return c(si.wavelengths) * m_scale;
         }
         return in_mode(Color3f(v[0], v[1], v[2]) * m_scale, m_mode);
     }

@@ -33,6 +33,19 @@ struct SigmoidPolynomial {
                                     : x / std::sqrt(1.f + x * x);
         return 0.5f + 0.5f * t;
     }
+    /// The spectrum at each of `lambda`'s wavelengths: the scalar form's arithmetic, lane by
+    /// lane, written without branches so that the four lanes are computed side by side.
+    Color3f operator()(const Wavelengths &lambda) const {
+        const float l[Color3f::Channels] = {lambda.r, lambda.g, lambda.b, lambda.w};
+        float s[Color3f::Channels];
+        for (int i = 0; i < Color3f::Channels; ++i) {
+            const float x = (c0 * l[i] + c1) * l[i] + c2;
+            const float big = std::copysign(1.f / std::sqrt(1.f + 1.f / (x * x)), x);
+            const float small = x / std::sqrt(1.f + x * x);
+            s[i] = 0.5f + 0.5f * (std::abs(x) > 1.f ? big : small);
+        }
+        return {s[0], s[1], s[2], s[3]};
+    }
     std::string to_string() const;
 };
 

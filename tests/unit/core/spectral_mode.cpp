@@ -29,6 +29,7 @@
 #include <functional>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 using namespace facet;
 namespace fs = std::filesystem;
@@ -155,8 +156,26 @@ TEST(SpectralMode, PerWavelengthFormulasFillTheFourthChannel) {
         EXPECT_FLOAT_EQ(F[c], fresnel_conductor(0.6f, eta[c], k[c])) << "channel " << c;
         EXPECT_FLOAT_EQ(M.m[0][0][c], F[c]) << "channel " << c;
     }
-    // D65 and an upsampled colour at each wavelength.
+    // D65 and an upsampled colour at each wavelength; the four-lane curve is the one-lane one,
+    // to the bit, for curves small, steep (|x| > 1, x² overflowing) and constant (±infinity).
     const Wavelengths l(420.f, 530.f, 640.f, 700.f);
+    std::vector<SigmoidPolynomial> curves = {
+        SigmoidPolynomial{1e-4f, -0.1f, 24.f}, SigmoidPolynomial{1e18f, 1e18f, 0.f},
+        SigmoidPolynomial{0.f, 0.f, 0.f}, SigmoidPolynomial{0.f, 0.f, Infinity},
+        SigmoidPolynomial{0.f, 0.f, -Infinity}};
+    for (int i = 0; i < 12 * 12 * 12; ++i)
+        curves.push_back(rgb_to_sigmoid(
+            Color3f(float(i % 12) / 11.f, float(i / 12 % 12) / 11.f, float(i / 144) / 11.f)));
+    int differ = 0;
+    for (const SigmoidPolynomial &p : curves)
+        for (float shift = 0.f; shift < 100.f; shift += 7.f) {
+            const Wavelengths at = l - Color3f(shift);
+            const Color3f lanes = p(at);
+            for (int c = 0; c < Color3f::Channels; ++c) differ += lanes[c] != p(at[c]);
+        }
+    EXPECT_EQ(differ, 0);
+    const Color3f ends = SigmoidPolynomial{0.f, 0.f, Infinity}(l);
+    EXPECT_EQ(ends, Color3f(1.f));
     const RGBSpectrum s = RGBSpectrum::from_rgb(Color3f(0.8f, 0.3f, 0.1f), SpectrumKind::Emission);
     const Color3f v = s.eval(l);
     for (int c = 0; c < Color3f::Channels; ++c) {
