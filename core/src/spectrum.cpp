@@ -241,10 +241,21 @@ std::pair<Wavelengths, Color3f> sample_wavelengths(float u) {
     return {lambda, weight};
 }
 
-Color3f spectral_to_srgb(const Color3f &L, const Wavelengths &lambda, const Color3f &weight) {
+Color3f wavelength_weights(const Wavelengths &lambda) {
+    return map(lambda, [](float l) {
+        const float pdf = pdf_wavelength(l);
+        return pdf > 0.f ? 1.f / pdf : 0.f;
+    });
+}
+
+Color3f spectral_to_xyz(const Color3f &L, const Wavelengths &lambda, const Color3f &weight) {
     Color3f xyz(0.f);
     for (int i = 0; i < Color3f::Channels; ++i) xyz += cie1931_xyz(lambda[i]) * (L[i] * weight[i]);
-    return xyz_to_srgb(xyz * float(1.0 / (Color3f::Channels * CieYIntegral)));
+    return xyz * float(1.0 / (Color3f::Channels * CieYIntegral));
+}
+
+Color3f spectral_to_srgb(const Color3f &L, const Wavelengths &lambda, const Color3f &weight) {
+    return xyz_to_srgb(spectral_to_xyz(L, lambda, weight));
 }
 
 } // namespace facet

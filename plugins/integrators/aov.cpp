@@ -10,6 +10,9 @@ Used for denoisers (albedo, normals) and compositing (depth, position, ids).
 scalars. Types: `albedo`, `depth`, `position`, `uv`, `geo_normal`, `sh_normal`, `dp_du`,
 `dp_dv`, `prim_index`, `shape_index`. Escaped rays give zeros (and -1 for the indices).
 
+In the spectral modes the albedo (a reflectance at the path's wavelengths) is developed to
+linear Rec.709 as the image is, as in Mitsuba; the geometric channels are written as they are.
+
 | Parameter  | Type       | Default | Description                                     |
 |------------|------------|---------|-------------------------------------------------|
 | aovs       | string     | —       | The list of `name:type` pairs (required)        |
@@ -28,9 +31,11 @@ scalars. Types: `albedo`, `depth`, `position`, `uv`, `geo_normal`, `sh_normal`, 
 
 #include <facet/bsdf.h>
 #include <facet/integrator.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/scene.h>
 #include <facet/shape.h>
+#include <facet/spectrum.h>
 
 #include <sstream>
 
@@ -55,7 +60,8 @@ class AovIntegrator final : public SamplingIntegrator {
     };
 
 public:
-    explicit AovIntegrator(const Properties &props) : SamplingIntegrator(props) {
+    explicit AovIntegrator(const Properties &props)
+        : SamplingIntegrator(props), m_spectral(is_spectral(props.mode())) {
         std::string list = props.get_string("aovs");
         std::stringstream ss(list);
         std::string item;
@@ -164,6 +170,8 @@ private:
         switch (k) {
         case Kind::Albedo: {
             Color3f c = hit ? si.bsdf()->eval_diffuse_reflectance(si) : Color3f(0.f);
+            if (m_spectral && hit)
+                c = spectral_to_srgb(c, si.wavelengths, wavelength_weights(si.wavelengths));
             out[0] = c.r;
             out[1] = c.g;
             out[2] = c.b;
@@ -203,6 +211,7 @@ private:
         return -1;
     }
 
+    bool m_spectral; ///< the albedo is a spectral value to develop
     std::vector<Aov> m_aovs;
     std::shared_ptr<SamplingIntegrator> m_nested;
     size_t m_nested_aovs = 0;
@@ -210,6 +219,7 @@ private:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::AovIntegrator, Integrator, "aov",
-                    "Geometric and material AOVs (albedo, normals, depth, ...) as extra channels",
-                    DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::AovIntegrator, Integrator, "aov",
+                          "Geometric and material AOVs (albedo, normals, depth, ...) as extra "
+                          "channels",
+                          DOC, ::facet::AllModes)

@@ -4,6 +4,11 @@ static const char *DOC = R"DOC(
 Writes the distance along each camera ray to the first surface it hits (0 where the ray
 escapes) into all three channels. Useful for debugging scenes and as a depth pass.
 
+In the spectral modes the distance is a radiance like any other, flat over the wavelengths, and
+is developed as one (as in Mitsuba): a distance d becomes d times the equal-energy white
+(about 1.205, 0.948, 0.909 · d in R, G, B), up to the noise of the path's wavelengths. Use the
+`aov` integrator's `depth` for a raw distance channel in every mode.
+
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | timeout | float | -1 | Stop after this many seconds and develop what is done (like Ctrl-C); <= 0: no limit |
@@ -37,5 +42,5 @@ public:
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::DepthIntegrator, Integrator, "depth",
-                    "Distance from the sensor to the first surface", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::DepthIntegrator, Integrator, "depth",
+                          "Distance from the sensor to the first surface", DOC, ::facet::AllModes)

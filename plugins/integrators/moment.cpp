@@ -9,7 +9,9 @@ integrator called `<name>` (`_arg_0`, `_arg_1`, ... when it has no name attribut
 list with the prefix `m2_`.
 
 With a reconstruction filter wider than a pixel the moments are filter-weighted; use `box` for
-plain per-sample moments.
+plain per-sample moments. In the spectral modes a sample's XYZ is its spectral value's, the
+render loop's development (the mean over the path's wavelengths of L·(x̄, ȳ, z̄)/pdf, over ∫ȳ),
+so the moments are those of the XYZ samples the image averages, as in Mitsuba.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
@@ -28,6 +30,7 @@ plain per-sample moments.
 )DOC";
 
 #include <facet/integrator.h>
+#include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
 #include <facet/spectrum.h>
@@ -38,7 +41,8 @@ namespace facet {
 
 class MomentIntegrator final : public SamplingIntegrator {
 public:
-    explicit MomentIntegrator(const Properties &props) : SamplingIntegrator(props) {
+    explicit MomentIntegrator(const Properties &props)
+        : SamplingIntegrator(props), m_spectral(is_spectral(props.mode())) {
         for (const auto &[name, obj] : props.objects()) {
             auto integrator = std::dynamic_pointer_cast<SamplingIntegrator>(obj);
             if (!integrator)
@@ -68,7 +72,9 @@ public:
             // The nested AOVs go straight into their slots; the moments follow at half.
             Color3f L = n.integrator->sample(scene, sampler, ray, out);
             if (i == 0) result = L;
-            const Color3f xyz = srgb_to_xyz(L);
+            const Color3f xyz = m_spectral ? spectral_to_xyz(L, ray.wavelengths,
+                                                             wavelength_weights(ray.wavelengths))
+                                           : srgb_to_xyz(L);
             out[n.aovs + 0] = xyz.r;
             out[n.aovs + 1] = xyz.g;
             out[n.aovs + 2] = xyz.b;
@@ -97,11 +103,13 @@ private:
         std::shared_ptr<SamplingIntegrator> integrator;
         size_t aovs;
     };
+    bool m_spectral; ///< the nested integrators' values are spectral
     std::vector<Nested> m_nested;
     std::vector<std::string> m_names;
 };
 
 } // namespace facet
 
-FACET_EXPORT_PLUGIN(facet::MomentIntegrator, Integrator, "moment",
-                    "First and second moments of nested integrators as extra channels", DOC)
+FACET_EXPORT_PLUGIN_MODES(facet::MomentIntegrator, Integrator, "moment",
+                          "First and second moments of nested integrators as extra channels", DOC,
+                          ::facet::AllModes)

@@ -101,12 +101,8 @@ public:
         const Vector3f target = cross(ray.d, up);
         if (dot(target, target) > 0.f)
             s = mueller::rotate_stokes_basis(-ray.d, mueller::stokes_basis(-ray.d), target) * s;
-        Color3f weight(1.f);
-        if (is_spectral(m_mode))
-            for (int i = 0; i < Color3f::Channels; ++i) {
-                const float pdf = pdf_wavelength(ray.wavelengths[i]);
-                weight[i] = pdf > 0.f ? 1.f / pdf : 0.f;
-            }
+        const Color3f weight =
+            is_spectral(m_mode) ? wavelength_weights(ray.wavelengths) : Color3f(1.f);
         for (int k = 0; k < 4; ++k) {
             const Color3f c =
                 is_spectral(m_mode) ? spectral_to_srgb(s.s[k], ray.wavelengths, weight) : s.s[k];

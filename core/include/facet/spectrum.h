@@ -62,9 +62,15 @@ float pdf_wavelength(float lambda);
 /// `u`: stratified (u + i/4 modulo 1), each drawn from pdf_wavelength() by inversion, with their
 /// weights 1 / pdf.
 std::pair<Wavelengths, Color3f> sample_wavelengths(float u);
-/// The radiance of a path of the spectral mode (`L` at `lambda`, drawn with weights `weight`)
-/// as linear Rec.709: XYZ = the mean over the channels of L·weight·(x̄, ȳ, z̄)(λ) / ∫ȳ, an
-/// unbiased estimate of the spectrum's XYZ, then xyz_to_srgb.
+/// The weights sample_wavelengths() gives `lambda`: 1 / pdf_wavelength() per lane (0 where the
+/// density is 0).
+Color3f wavelength_weights(const Wavelengths &lambda);
+/// The CIE XYZ of a path's spectral value (`L` at `lambda`, drawn with weights `weight`): the
+/// mean over the channels of L·weight·(x̄, ȳ, z̄)(λ) / ∫ȳ, an unbiased estimate of the
+/// spectrum's XYZ.
+Color3f spectral_to_xyz(const Color3f &L, const Wavelengths &lambda, const Color3f &weight);
+/// The radiance of a path of the spectral mode as linear Rec.709: xyz_to_srgb of
+/// spectral_to_xyz().
 Color3f spectral_to_srgb(const Color3f &L, const Wavelengths &lambda, const Color3f &weight);
 
 } // namespace facet

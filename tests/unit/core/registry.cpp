@@ -1,6 +1,8 @@
 // PluginRegistry: loading checks, error messages, unqueried properties, static registration.
+#include <facet/mode.h>
 #include <facet/plugin.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -155,6 +157,30 @@ TEST_F(Registry, CreatesObjectsWithTheirId) {
 
     auto s = reg.create(ObjectType::BSDF, props_for("staticdiffuse"));
     EXPECT_EQ(s->type(), ObjectType::BSDF);
+}
+
+TEST_F(Registry, APluginIsRefusedInAModeItDoesNotRenderIn) {
+    // testgood is exported with the plain macro: rgb and mono only.
+    for (ColourMode mode : {ColourMode::Spectral, ColourMode::SpectralPolarized}) {
+        Properties p = props_for("testgood");
+        p.set_mode(mode);
+        try {
+            reg.create(ObjectType::BSDF, p);
+            ADD_FAILURE() << "testgood was accepted in " << mode_name(mode);
+        } catch (const Error &e) {
+            EXPECT_TRUE(contains(e.what(), fmt::format("the bsdf plugin \"testgood\" does not "
+                                                       "render in the mode {} (it renders in: "
+                                                       "scalar_rgb, scalar_mono)",
+                                                       mode_name(mode))))
+                << e.what();
+            EXPECT_EQ(e.location().to_string(), "scene.xml:10:3");
+        }
+    }
+    for (ColourMode mode : {ColourMode::RGB, ColourMode::Mono}) {
+        Properties p = props_for("testgood");
+        p.set_mode(mode);
+        EXPECT_NE(reg.create(ObjectType::BSDF, p), nullptr);
+    }
 }
 
 TEST_F(Registry, UnqueriedPropertiesAreAnErrorWithTheirLocation) {

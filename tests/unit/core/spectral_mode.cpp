@@ -27,6 +27,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -319,26 +320,86 @@ TEST(SpectralMode, ConductorPresetsUseTheMeasuredDataPerWavelength) {
     EXPECT_GT(e.r, 1.f);
 }
 
-TEST(SpectralMode, PluginsThatDoNotRenderTheModeAreRefusedByName) {
-    const std::string xml = R"(<scene version="3.0.0">
-        <integrator type="depth"/>
-        <shape type="sphere"/>
-    </scene>)";
+/// The mean of each channel of a render of `xml` in `mode`, by channel name.
+std::map<std::string, double> channel_means(const std::string &xml, const std::string &mode) {
     LoadOptions opts;
-    opts.mode = "scalar_spectral";
-    try {
-        load_string(xml, opts);
-        ADD_FAILURE() << "depth was accepted in the spectral mode";
-    } catch (const Error &e) {
-        EXPECT_NE(std::string(e.what()).find(
-                      "the integrator plugin \"depth\" does not render in the mode "
-                      "scalar_spectral (it renders in: scalar_rgb, scalar_mono)"),
-                  std::string::npos)
-            << e.what();
-        EXPECT_TRUE(e.location().valid()) << e.what();
+    opts.mode = mode;
+    auto scene = std::dynamic_pointer_cast<Scene>(load_string(xml, opts));
+    RenderOptions ro;
+    ro.progress = false;
+    const Image image = render(*scene, *scene->sensors().at(0), ro).image;
+    std::map<std::string, double> means;
+    for (int c = 0; c < image.channels; ++c) {
+        double sum = 0.0;
+        for (int y = 0; y < image.height; ++y)
+            for (int x = 0; x < image.width; ++x) sum += image.at(x, y, c);
+        means[image.channel_names.at(size_t(c))] = sum / double(image.width * image.height);
     }
-    opts.mode = "scalar_rgb";
-    EXPECT_NO_THROW(load_string(xml, opts));
+    return means;
+}
+
+/// A 16x16 orthographic view (box filter, `spp`) of a diffuse plane of reflectance `rgb` 3 units
+/// away, under `integrator`.
+std::string plane_view(const std::string &integrator, const std::string &rgb, int spp) {
+    return fmt::format(R"(<scene version="3.0.0">
+        {}
+        <sensor type="orthographic">
+            <transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+            <sampler type="independent"><integer name="sample_count" value="{}"/></sampler>
+            <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/>
+                <rfilter type="box"/></film>
+        </sensor>
+        <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+        <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="{}"/></bsdf></shape>
+    </scene>)",
+                       integrator, spp, rgb);
+}
+
+TEST(SpectralMode, DepthAovAndMomentRenderInTheSpectralModes) {
+    // depth: the distance is a flat spectrum developed like radiance (as Mitsuba's), i.e. the
+    // distance times the flat spectrum's development (the equal-energy white).
+    const Color3f flat = develop([](const Wavelengths &) { return Color3f(1.f); });
+    for (const char *mode : {"scalar_spectral", "scalar_spectral_polarized"}) {
+        auto depth = channel_means(plane_view("<integrator type=\"depth\"/>", "0.5", 64), mode);
+        EXPECT_NEAR(depth["R"] / 3.0, flat.r, 0.01 * flat.r) << mode;
+        EXPECT_NEAR(depth["G"] / 3.0, flat.g, 0.01 * flat.g) << mode;
+        EXPECT_NEAR(depth["B"] / 3.0, flat.b, 0.01 * flat.b) << mode;
+    }
+    // aov: the depth channel raw; the albedo (a reflectance curve at the path's wavelengths)
+    // developed, i.e. the curve's development under a flat spectrum, not under D65.
+    const Color3f rho(0.7f, 0.35f, 0.1f);
+    const RGBSpectrum curve = RGBSpectrum::from_rgb(rho, SpectrumKind::Reflectance);
+    const Color3f albedo = develop([&](const Wavelengths &l) { return curve.eval(l); });
+    auto aov = channel_means(plane_view(R"(<integrator type="aov">
+            <string name="aovs" value="a:albedo, d:depth"/><integrator type="path"/>
+        </integrator>)",
+                                        "0.7, 0.35, 0.1", 64),
+                             "scalar_spectral");
+    EXPECT_NEAR(aov["d"], 3.0, 1e-5);
+    EXPECT_NEAR(aov["a.R"], albedo.r, 0.01 * albedo.r);
+    EXPECT_NEAR(aov["a.G"], albedo.g, 0.01 * albedo.g);
+    EXPECT_NEAR(aov["a.B"], albedo.b, 0.01 * albedo.b);
+    // ... which differs from the rgb mode's albedo by more than that tolerance in some channel.
+    EXPECT_GT((albedo - rho).max(), 0.02f * rho.max()) << albedo;
+    // moment: the XYZ channels are the samples' spectral XYZ, whose mean is the image's XYZ;
+    // their second moments are at least their squared means.
+    auto moment = channel_means(plane_view(R"(<integrator type="moment">
+            <integrator name="p" type="path"/></integrator>)",
+                                           "0.7, 0.35, 0.1", 64),
+                                "scalar_spectral");
+    const Color3f xyz =
+        srgb_to_xyz(Color3f(float(moment["R"]), float(moment["G"]), float(moment["B"])));
+    EXPECT_NEAR(moment["p.X"], xyz.r, 1e-4 * xyz.r);
+    EXPECT_NEAR(moment["p.Y"], xyz.g, 1e-4 * xyz.g);
+    EXPECT_NEAR(moment["p.Z"], xyz.b, 1e-4 * xyz.b);
+    for (const char *c : {"X", "Y", "Z"}) {
+        const double m1 = moment[std::string("p.") + c], m2 = moment[std::string("m2_p.") + c];
+        EXPECT_GT(m2, m1 * m1) << c;
+    }
+    // The plane under a unit white sky is its colour (rgb 0.7, 0.35, 0.1 within the noise).
+    EXPECT_NEAR(moment["R"], 0.7, 0.02);
+    EXPECT_NEAR(moment["B"], 0.1, 0.01);
 }
 
 TEST(SpectralMode, AWhiteSphereInAUniformSkyIsTheSky) {
