@@ -13,4 +13,10 @@ if(TARGET unit_registry)
     target_compile_definitions(unit_registry PRIVATE
         FACET_TEST_PLUGIN_DIR="${FACET_TEST_PLUGIN_DIR}")
     target_link_libraries(unit_registry PRIVATE ${CMAKE_DL_LIBS})
+    # The CLI tests list testgood, a plugin of the rgb and mono modes only.
+    if(TARGET render_cli)
+        add_dependencies(render_cli test_plugin_testgood)
+        target_compile_definitions(render_cli PRIVATE
+            FACET_TEST_PLUGIN_DIR="${FACET_TEST_PLUGIN_DIR}")
+    endif()
 endif()
