@@ -203,7 +203,7 @@ Color3f spectrum_to_rgb(const SpectrumData &s, SpectrumKind kind) {
 namespace {
 
 /// The wavelength density's shape 1 / cosh²(a (λ - c)) and its integral tanh(a (λ - c)) / a.
-/// Float arithmetic: every camera ray draws three (a wavelength is good to 1e-4 nm).
+/// Float arithmetic: every camera ray draws four (a wavelength is good to 1e-4 nm).
 constexpr float WavelengthA = 0.0072f, WavelengthCentre = 538.f;
 const float TanhLo = std::tanh(WavelengthA * (SpectralMinNm - WavelengthCentre));
 const float TanhHi = std::tanh(WavelengthA * (SpectralMaxNm - WavelengthCentre));

@@ -219,10 +219,10 @@ Chi2Sample BSDFAdapter::sample(const float *u) const {
         value_differs = value_differs || differs(value2[c], s.value[c]);
     if (differs(pdf2, s.pdf) || value_differs)
         s.problem =
-            fmt::format("eval_pdf() = ({}, {}, {}; {}) but eval() = ({}, {}, {}), pdf() = {} "
-                        "at {}",
-                        value2.r, value2.g, value2.b, pdf2, s.value.r, s.value.g, s.value.b, s.pdf,
-                        vec_str(bs.wo));
+            fmt::format("eval_pdf() = ({}, {}, {}, {}; {}) but eval() = ({}, {}, {}, {}), pdf() "
+                        "= {} at {}",
+                        value2.r, value2.g, value2.b, value2.w, pdf2, s.value.r, s.value.g,
+                        s.value.b, s.value.w, s.pdf, vec_str(bs.wo));
     return s;
 }
 

@@ -135,7 +135,7 @@ TEST(PPlastic, TheDiffuseBasePolarisesLightLeavingAtGrazingAngles) {
     // light from wo to wi; here wi is the grazing direction). The base's light is transmitted
     // out of the coating with t_s < t_p: more p (in the plane of incidence) than s light.
     SurfaceInteraction si;
-    si.wavelengths = Wavelengths(450.f, 550.f, 650.f);
+    si.wavelengths = Wavelengths(450.f, 550.f, 650.f, 500.f);
     const float t = 80.f * Pi / 180.f;
     si.wi = Vector3f(std::sin(t), 0.f, std::cos(t));
     const Vector3f wo(0.f, 0.f, 1.f);

@@ -50,7 +50,7 @@ void expect_matrix(const Mueller &M, const double (&expected)[4][4], double tol,
                    const std::string &what) {
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
-            for (int lane = 0; lane < 3; ++lane)
+            for (int lane = 0; lane < Color3f::Channels; ++lane)
                 EXPECT_NEAR(M.m[i][j][lane], expected[i][j], tol)
                     << what << " entry (" << i << ", " << j << ") lane " << lane;
 }
@@ -474,7 +474,7 @@ TEST(Polarization, BSDFMatricesAgreeWithTheirColoursAndTheirDensities) {
         int glossy = 0;
         for (int i = 0; i < 400; ++i) {
             SurfaceInteraction si;
-            si.wavelengths = Wavelengths(450.f, 550.f, 650.f);
+            si.wavelengths = Wavelengths(450.f, 550.f, 650.f, 500.f);
             const float z = 0.05f + 0.95f * rng.next_float(), phi = 2.f * Pi * rng.next_float();
             const float r = std::sqrt(1.f - z * z);
             si.wi = Vector3f(r * std::cos(phi), r * std::sin(phi), i % 5 == 4 ? -z : z);
@@ -486,7 +486,7 @@ TEST(Polarization, BSDFMatricesAgreeWithTheirColoursAndTheirDensities) {
             EXPECT_EQ(bs.wo, pbs.wo) << xml;
             EXPECT_EQ(bs.sampled_type, pbs.sampled_type) << xml;
             EXPECT_NEAR(bs.pdf, pbs.pdf, 1e-5f * bs.pdf) << xml;
-            for (int c = 0; c < 3; ++c)
+            for (int c = 0; c < Color3f::Channels; ++c)
                 EXPECT_LT(relative_error(pweight.m[0][0][c], weight[c]), 2e-4)
                     << xml << " sample " << i << " lane " << c;
             if (weight.is_black() || has_flag(bs.sampled_type, BSDFFlags::Delta)) continue;
@@ -494,7 +494,7 @@ TEST(Polarization, BSDFMatricesAgreeWithTheirColoursAndTheirDensities) {
             const auto [value, pdf] = bsdf->eval_pdf(ctx, si, bs.wo);
             const auto [pvalue, ppdf] = bsdf->eval_pdf_polarized(ctx, si, bs.wo);
             EXPECT_NEAR(pdf, ppdf, 1e-5f * pdf) << xml;
-            for (int c = 0; c < 3; ++c)
+            for (int c = 0; c < Color3f::Channels; ++c)
                 EXPECT_LT(relative_error(pvalue.m[0][0][c], value[c]), 2e-4) << xml;
             for (int a = 0; a < 4; ++a)
                 for (int b = 0; b < 4; ++b)
@@ -537,7 +537,7 @@ TEST(Polarization, EachMicrofacetReflectsAsASmoothInterfaceInItsOwnFrame) {
                 return Vector3f(r * std::cos(phi), r * std::sin(phi), z);
             };
             SurfaceInteraction si;
-            si.wavelengths = Wavelengths(450.f, 550.f, 650.f);
+            si.wavelengths = Wavelengths(450.f, 550.f, 650.f, 500.f);
             si.wi = upper();
             const Vector3f wo = upper();
             const auto [M, pdf] = rough->eval_pdf_polarized(ctx, si, wo);
@@ -550,7 +550,7 @@ TEST(Polarization, EachMicrofacetReflectsAsASmoothInterfaceInItsOwnFrame) {
             const Mueller expected = mueller::to_world(fh, S, -bs.wo, hi.wi);
             for (int a = 0; a < 4; ++a)
                 for (int b = 0; b < 4; ++b)
-                    for (int lane = 0; lane < 3; ++lane)
+                    for (int lane = 0; lane < Color3f::Channels; ++lane)
                         EXPECT_NEAR(M.m[a][b][lane] / M.m[0][0][lane],
                                     expected.m[a][b][lane] / expected.m[0][0][lane], 2e-4)
                             << rough_xml << " entry " << a << ", " << b << " sample " << i;

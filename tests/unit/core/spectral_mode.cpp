@@ -450,7 +450,7 @@ TEST(SpectralMode, ColoursAreClampedAlikeAndScalarsStayScalars) {
     EXPECT_EQ(eval_at(*props.texture("grey", SpectrumKind::Unbounded), l), Color3f(1.f));
     const Color3f colour = eval_at(*props.texture("colour", SpectrumKind::Unbounded), l);
     EXPECT_LE(colour.max(), 1.f);
-    EXPECT_GT(std::min(colour.r, std::min(colour.g, colour.b)), 0.9f);
+    EXPECT_GT(std::min(std::min(colour.r, colour.g), std::min(colour.b, colour.w)), 0.9f);
     EXPECT_EQ(eval_at(*props.texture("number", SpectrumKind::Unbounded), l), Color3f(1.5f));
     // A scalar parameter given as a colour (a blend weight, an opacity) is one number for every
     // path, the rgb mode's mean, not the mean of the path's wavelengths.
