@@ -104,20 +104,25 @@ Color3f render_mean(const std::string &xml, const std::string &mode, const fs::p
     return sum / float(image.width * image.height);
 }
 
-/// A 16x16 render (orthographic, box filter, 256 spp) of `content` lit by `emitter`.
-std::string furnace(const std::string &emitter, const std::string &content) {
+/// A 16x16 render (orthographic from z = 5 towards -z, box filter, `spp`) of `content` lit by
+/// `emitter`, under `integrator`.
+std::string
+furnace(const std::string &emitter, const std::string &content,
+        const std::string &integrator =
+            R"(<integrator type="path"><integer name="max_depth" value="4"/></integrator>)",
+        int spp = 256) {
     return fmt::format(R"(<scene version="3.0.0">
-        <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+        {}
         <sensor type="orthographic">
             <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-            <sampler type="independent"><integer name="sample_count" value="256"/></sampler>
+            <sampler type="independent"><integer name="sample_count" value="{}"/></sampler>
             <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/>
                 <rfilter type="box"/></film>
         </sensor>
         {}
         {}
     </scene>)",
-                       emitter, content);
+                       integrator, spp, emitter, content);
 }
 
 } // namespace
@@ -338,22 +343,15 @@ std::map<std::string, double> channel_means(const std::string &xml, const std::s
     return means;
 }
 
-/// A 16x16 orthographic view (box filter, `spp`) of a diffuse plane of reflectance `rgb` 3 units
-/// away, under `integrator`.
+/// A diffuse plane of reflectance `rgb` 5 units away (furnace()'s view), under a white sky and
+/// `integrator`.
 std::string plane_view(const std::string &integrator, const std::string &rgb, int spp) {
-    return fmt::format(R"(<scene version="3.0.0">
-        {}
-        <sensor type="orthographic">
-            <transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
-            <sampler type="independent"><integer name="sample_count" value="{}"/></sampler>
-            <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/>
-                <rfilter type="box"/></film>
-        </sensor>
-        <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
-        <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
-            <bsdf type="diffuse"><rgb name="reflectance" value="{}"/></bsdf></shape>
-    </scene>)",
-                       integrator, spp, rgb);
+    return furnace(
+        R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)",
+        fmt::format(R"(<shape type="rectangle"><transform name="to_world"><scale value="10"/>
+                       </transform><bsdf type="diffuse"><rgb name="reflectance" value="{}"/></bsdf></shape>)",
+                    rgb),
+        integrator, spp);
 }
 
 TEST(SpectralMode, DepthAovAndMomentRenderInTheSpectralModes) {
@@ -362,9 +360,9 @@ TEST(SpectralMode, DepthAovAndMomentRenderInTheSpectralModes) {
     const Color3f flat = develop([](const Wavelengths &) { return Color3f(1.f); });
     for (const char *mode : {"scalar_spectral", "scalar_spectral_polarized"}) {
         auto depth = channel_means(plane_view("<integrator type=\"depth\"/>", "0.5", 64), mode);
-        EXPECT_NEAR(depth["R"] / 3.0, flat.r, 0.01 * flat.r) << mode;
-        EXPECT_NEAR(depth["G"] / 3.0, flat.g, 0.01 * flat.g) << mode;
-        EXPECT_NEAR(depth["B"] / 3.0, flat.b, 0.01 * flat.b) << mode;
+        EXPECT_NEAR(depth["R"] / 5.0, flat.r, 0.01 * flat.r) << mode;
+        EXPECT_NEAR(depth["G"] / 5.0, flat.g, 0.01 * flat.g) << mode;
+        EXPECT_NEAR(depth["B"] / 5.0, flat.b, 0.01 * flat.b) << mode;
     }
     // aov: the depth channel raw; the albedo (a reflectance curve at the path's wavelengths)
     // developed, i.e. the curve's development under a flat spectrum, not under D65.
@@ -376,7 +374,7 @@ TEST(SpectralMode, DepthAovAndMomentRenderInTheSpectralModes) {
         </integrator>)",
                                         "0.7, 0.35, 0.1", 64),
                              "scalar_spectral");
-    EXPECT_NEAR(aov["d"], 3.0, 1e-5);
+    EXPECT_NEAR(aov["d"], 5.0, 1e-5);
     EXPECT_NEAR(aov["a.R"], albedo.r, 0.01 * albedo.r);
     EXPECT_NEAR(aov["a.G"], albedo.g, 0.01 * albedo.g);
     EXPECT_NEAR(aov["a.B"], albedo.b, 0.01 * albedo.b);
