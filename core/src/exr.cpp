@@ -74,7 +74,8 @@ std::string channel_name(const Image &image, int c) {
 
 /// The header: windows, ZIP compression, the channels (half for the leading colour channels
 /// when `opts.half`; AOVs after them always float32, see ImageWriteOptions::half), the
-/// caller's attributes, the date and, but for XYZ pixels, the chromaticities of linear Rec.709.
+/// caller's attributes, the date and, for R, G, B or Y pixels, the chromaticities of linear
+/// Rec.709.
 Imf::Header exr_header(const Image &image, const std::vector<std::string> &names,
                        const std::vector<Imf::PixelType> &types, const ImageWriteOptions &opts) {
     // A crop window: the data window at (x, y) inside the full display window.
@@ -104,8 +105,10 @@ Imf::Header exr_header(const Image &image, const std::vector<std::string> &names
     char date[32];
     if (localtime_r(&now, &local) && std::strftime(date, sizeof date, "%Y:%m:%d %H:%M:%S", &local))
         Imf::addCapDate(header, date);
-    const bool xyz = names.size() >= 3 && names[0] == "X" && names[1] == "Y" && names[2] == "Z";
-    if (!xyz) // red, green, blue and white (D65) xy of Rec.709, the space facet renders in
+    // Pixels of Rec.709 colours (R, G, B, or a luminance Y), not XYZ nor a film's spectral
+    // bands.
+    const bool rec709 = !names.empty() && (names[0] == "R" || names[0] == "Y");
+    if (rec709) // red, green, blue and white (D65) xy of Rec.709, the space facet renders in
         Imf::addChromaticities(
             header, Imf::Chromaticities(Imath::V2f(0.64f, 0.33f), Imath::V2f(0.30f, 0.60f),
                                         Imath::V2f(0.15f, 0.06f), Imath::V2f(0.3127f, 0.3290f)));
