@@ -147,7 +147,7 @@ ChannelsProbe output_channels_probe(const Scene &scene, const Sensor &sensor, bo
     if (auto sampling = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator()))
         aovs = sampling->aov_names();
     const bool splats = bool(std::dynamic_pointer_cast<LightTracer>(scene.integrator()));
-    const FilmBuffer buffer(Point2i(0, 0), Point2i(1, 1), aovs, splats);
+    const FilmBuffer buffer(Point2i(0, 0), Point2i(1, 1), film.colour_channels(), aovs, splats);
     ChannelsProbe probe;
     probe.image = film.develop(buffer);
     probe.aovs = aovs.size();

@@ -15,14 +15,17 @@ int ImageBlock::border_for(const ReconstructionFilter &filter) {
     return int(std::floor(filter.radius() + 0.5f));
 }
 
-void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, int aov_count) {
-    if (size.x < 0 || size.y < 0 || border < 0 || aov_count < 0)
-        FACET_THROW("ImageBlock::reset: invalid size {}x{}, border {} or AOV count {}", size.x,
-                    size.y, border, aov_count);
+void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, int aov_count,
+                       int colour_count) {
+    if (size.x < 0 || size.y < 0 || border < 0 || aov_count < 0 || colour_count < 0)
+        FACET_THROW("ImageBlock::reset: invalid size {}x{}, border {}, AOV count {} or colour "
+                    "count {}",
+                    size.x, size.y, border, aov_count, colour_count);
     m_offset = offset;
     m_size = size;
     m_border = border;
     m_aov_count = aov_count;
+    m_colour_count = colour_count;
     Point2i s = storage_size();
     // assign() keeps the capacity, so a block reused for equally sized tiles allocates nothing.
     m_data.assign(size_t(s.x) * size_t(s.y) * size_t(channel_count()), 0.f);
@@ -79,10 +82,17 @@ inline void add_sample(float *p, float w, const Color3f &L, const float *aovs, i
     p[3 + aov_count] += w;
 }
 
+/// Adds a sample of weight w and `n` values to pixel p, then the weight.
+inline void add_values(float *p, float w, const float *values, int n) {
+    for (int k = 0; k < n; ++k) p[k] += w * values[k];
+    p[n] += w;
+}
+
 } // namespace
 
 void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
                      const ReconstructionFilter &filter) {
+    FACET_ASSERT(m_colour_count == 3);
     // A filter whose weight is a constant c on [-1/2, 1/2) and 0 elsewhere (the box), at film
     // positions in [0, 2^22) (every sample of a film, short of absurd sizes): there pos - 0.5
     // and its offset from any pixel are exact in float, so the one pixel of the footprint with
@@ -120,7 +130,43 @@ __attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, con
     }
 }
 
+void ImageBlock::put_values(const Point2f &pos, const float *values,
+                            const ReconstructionFilter &filter) {
+    const int n = m_colour_count + m_aov_count;
+    // The box's one pixel, as put() finds it.
+    const float c = filter.table().single_pixel_weight();
+    if (c != 0.f && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
+        const Point2i s = storage_size();
+        const int x = int(pos.x) - (m_offset.x - m_border),
+                  y = int(pos.y) - (m_offset.y - m_border);
+        if (x >= 0 && x < s.x && y >= 0 && y < s.y)
+            add_values(m_data.data() +
+                           (size_t(y) * size_t(s.x) + size_t(x)) * size_t(channel_count()),
+                       c * c, values, n);
+        return;
+    }
+    put_values_footprint(pos, values, filter);
+}
+
+void ImageBlock::put_values_footprint(const Point2f &pos, const float *values,
+                                      const ReconstructionFilter &filter) {
+    const Point2i s = storage_size();
+    const int nc = channel_count(), n = m_colour_count + m_aov_count;
+    Footprint fp;
+    if (!footprint(pos, filter, fp)) return;
+    for (size_t j = 0; j < fp.ny; ++j) {
+        const float wy = m_wy[j];
+        if (wy == 0.f) continue;
+        float *row = m_data.data() + (size_t(fp.y0) + j) * size_t(s.x) * nc;
+        for (size_t i = 0; i < fp.nx; ++i) {
+            const float w = m_wx[i] * wy;
+            if (w != 0.f) add_values(row + (size_t(fp.x0) + i) * nc, w, values, n);
+        }
+    }
+}
+
 void ImageBlock::splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter) {
+    FACET_ASSERT(m_colour_count == 3);
     Footprint fp;
     if (!footprint(pos, filter, fp)) return;
     const Point2i s = storage_size();
@@ -220,11 +266,20 @@ void Film::check_crop_window(const Point2i &offset, const Point2i &size) const {
 
 FilmBuffer::FilmBuffer(const Point2i &offset, const Point2i &size,
                        std::vector<std::string> aov_names, bool splats)
-    : m_offset(offset), m_size(size), m_aov_names(std::move(aov_names)) {
+    : FilmBuffer(offset, size, {"R", "G", "B"}, std::move(aov_names), splats) {}
+
+FilmBuffer::FilmBuffer(const Point2i &offset, const Point2i &size,
+                       std::vector<std::string> colour_names, std::vector<std::string> aov_names,
+                       bool splats)
+    : m_offset(offset), m_size(size), m_colour_names(std::move(colour_names)),
+      m_aov_names(std::move(aov_names)) {
+    if (splats && m_colour_names != std::vector<std::string>{"R", "G", "B"})
+        FACET_THROW("a light tracer splats R, G, B: it cannot fill the colour channels {}",
+                    fmt::join(m_colour_names, ", "));
     // The accumulation buffer (doubles) and the developed image (floats) of every channel.
     constexpr uint64_t BudgetBytes = uint64_t(8) << 30;
     const uint64_t pixels = uint64_t(std::max(size.x, 0)) * uint64_t(std::max(size.y, 0));
-    const uint64_t channels = 4 + uint64_t(m_aov_names.size()) + (splats ? 3 : 0);
+    const uint64_t channels = channel_count() + (splats ? 3 : 0);
     uint64_t bytes = 0;
     if (__builtin_mul_overflow(pixels, channels * 12, &bytes) || bytes > BudgetBytes)
         FACET_THROW("a {}x{} film with {} AOV channels needs {:.1f} GiB for its buffers, more "
@@ -281,7 +336,7 @@ void FilmBuffer::put_block(const ImageBlock &block) {
 std::vector<std::string> FilmBuffer::raw_channel_names() const {
     std::vector<std::string> names;
     const std::string p = RawChannelPrefix;
-    for (const char *c : {"R", "G", "B"}) names.push_back(p + "sum." + c);
+    for (const auto &n : m_colour_names) names.push_back(p + "sum." + n);
     for (const auto &n : m_aov_names) names.push_back(p + "sum." + n);
     names.push_back(p + "weight");
     if (!m_splats.empty())
@@ -315,54 +370,44 @@ void FilmBuffer::set_raw_sums(const std::vector<double> &raw) {
 // ---------------------------------------------------------------------------------------------
 // Development
 
-void develop_pixel(const double *storage, int aov_count, const double *splat, double splat_scale,
-                   bool alpha, float *dst) {
+void develop_pixel(const double *storage, int values, const double *splat, double splat_scale,
+                   int alpha_at, float *dst) {
     const bool splatted = splat && (splat[0] != 0.0 || splat[1] != 0.0 || splat[2] != 0.0);
-    int o = 0;
-    if (!storage) {
-        for (int c = 0; c < 3; ++c) dst[o++] = splat ? float(splat[c] * splat_scale) : 0.f;
-        if (alpha) dst[o++] = splatted ? 1.f : 0.f;
-        for (int k = 0; k < aov_count; ++k) dst[o++] = 0.f;
-        return;
-    }
-    const double w = storage[3 + aov_count];
+    const double w = storage ? storage[values] : 0.0;
     // Filters with negative lobes can give a negative sum: divide by it all the same (as
     // Mitsuba does); only a pixel without any weight stays 0.
     const double inv = w != 0.0 ? 1.0 / w : 0.0;
-    for (int c = 0; c < 3; ++c)
-        dst[o++] = float(storage[c] * inv + (splat ? splat[c] * splat_scale : 0.0));
-    if (alpha) dst[o++] = w > 0.0 || splatted ? 1.f : 0.f;
-    for (int k = 0; k < aov_count; ++k) dst[o++] = float(storage[3 + k] * inv);
+    int o = 0;
+    for (int c = 0; c < values; ++c) {
+        if (c == alpha_at) dst[o++] = w > 0.0 || splatted ? 1.f : 0.f;
+        const double s = c < 3 && splat ? splat[c] * splat_scale : 0.0;
+        dst[o++] = float((storage ? storage[c] * inv : 0.0) + s);
+    }
+    if (alpha_at >= values) dst[o] = w > 0.0 || splatted ? 1.f : 0.f;
 }
 
-namespace {
-
-/// The developed image of a crop window, channels named, pixels zero.
-Image developed_image(const Point2i &crop_offset, const Point2i &crop_size, const Point2i &size,
-                      bool alpha, const std::vector<std::string> &aov_names) {
-    const int out_c = 3 + (alpha ? 1 : 0) + int(aov_names.size());
-    Image img(crop_size.x, crop_size.y, out_c);
-    img.x = crop_offset.x;
-    img.y = crop_offset.y;
-    img.full_width = size.x;
-    img.full_height = size.y;
-    img.channel_names = {"R", "G", "B"};
-    if (alpha) img.channel_names.push_back("A");
-    for (const auto &n : aov_names) img.channel_names.push_back(n);
-    return img;
+std::vector<std::string> Film::colour_channels() const {
+    return m_bands ? m_bands->names() : std::vector<std::string>{"R", "G", "B"};
 }
-
-} // namespace
 
 Image Film::develop(const FilmBuffer &buffer) const {
-    const int naov = int(buffer.aov_names().size());
+    const std::vector<std::string> &colours = buffer.colour_names(), &aovs = buffer.aov_names();
+    const int values = int(colours.size() + aovs.size());
     const size_t nc = buffer.channel_count();
-    Image img =
-        developed_image(buffer.offset(), buffer.size(), m_size, m_alpha, buffer.aov_names());
+    Image img(buffer.size().x, buffer.size().y, values + (m_alpha ? 1 : 0));
+    img.x = buffer.offset().x;
+    img.y = buffer.offset().y;
+    img.full_width = m_size.x;
+    img.full_height = m_size.y;
+    img.channel_names = colours;
+    if (m_alpha) img.channel_names.push_back("A");
+    img.channel_names.insert(img.channel_names.end(), aovs.begin(), aovs.end());
     const std::vector<double> &sums = buffer.sums(), &splats = buffer.splats();
+    const int alpha_at = m_alpha ? int(colours.size()) : -1;
     for (size_t i = 0, n = size_t(buffer.size().x) * size_t(buffer.size().y); i < n; ++i)
-        develop_pixel(sums.data() + i * nc, naov, splats.empty() ? nullptr : splats.data() + i * 3,
-                      buffer.splat_scale(), m_alpha, img.data.data() + i * size_t(img.channels));
+        develop_pixel(sums.data() + i * nc, values,
+                      splats.empty() ? nullptr : splats.data() + i * 3, buffer.splat_scale(),
+                      alpha_at, img.data.data() + i * size_t(img.channels));
     return img;
 }
 

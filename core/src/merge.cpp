@@ -53,11 +53,12 @@ std::string join(const std::vector<std::string> &v) {
 /// Where a part's developed and raw channels (Film::raw_channel_names) are. Found by name: an EXR
 /// file may list its channels in another order than they were written in.
 struct RawLayout {
-    std::vector<int> developed; ///< R, G, B, A?, AOVs (in the part's order)
-    int aovs = 0;               ///< AOV channels among them
-    bool alpha = false;         ///< developed[3] is A
+    std::vector<int> developed; ///< colours (R, G, B or bands), A?, AOVs (in the part's order)
+    int values = 0;             ///< the developed channels but alpha (each has its sum)
+    int alpha_at = -1;          ///< A's place among the developed channels (none: -1)
     bool sums = false, splats = false;
-    /// The raw channels in develop_pixel's order: Σ w·R, G, B, Σ w·AOVs, Σ w, then the splats.
+    /// The raw channels in develop_pixel's order: Σ w·value for each developed channel but A,
+    /// Σ w, then the splats.
     std::vector<int> raw;
     std::vector<std::string> raw_names;
 };
@@ -92,24 +93,29 @@ RawLayout raw_layout(const Part &p) {
         FACET_THROW("{} has no raw channels ({}sum.R ..., {}weight): passes merge by their "
                     "sums; render the parts with --pass/--passes of this facet",
                     p.name, prefix, prefix);
-    if (developed_names.size() < 3 || developed_names[0] != "R" || developed_names[1] != "G" ||
-        developed_names[2] != "B")
-        FACET_THROW("{} has the colour channels {}: passes merge into R, G, B only (render them "
-                    "with the pixel format rgb or rgba)",
-                    p.name, join(developed_names));
-    l.alpha = developed_names.size() > 3 && developed_names[3] == "A";
-    l.aovs = int(developed_names.size()) - 3 - (l.alpha ? 1 : 0);
     auto find = [&](const std::string &name) {
         auto it = std::find(names.begin(), names.end(), name);
         return it == names.end() ? -1 : int(it - names.begin());
     };
     l.sums = find(prefix + "weight") >= 0;
     l.splats = find(prefix + "splat.R") >= 0;
+    // Every developed channel is a sum divided by the weight (the film's colours: R, G, B or
+    // its bands, then the AOVs), but the alpha, which has no sum of its own.
+    for (size_t d = 0; d < developed_names.size(); ++d)
+        if (developed_names[d] == "A" && l.alpha_at < 0 && find(prefix + "sum.A") < 0)
+            l.alpha_at = int(d);
+    l.values = int(developed_names.size()) - (l.alpha_at >= 0 ? 1 : 0);
+    const bool rgb = developed_names.size() >= 3 && developed_names[0] == "R" &&
+                     developed_names[1] == "G" && developed_names[2] == "B";
+    if (developed_names.empty() || (l.sums && find(prefix + "sum." + developed_names[0]) < 0) ||
+        (l.splats && !rgb))
+        FACET_THROW("{} has the colour channels {}: passes merge the channels a film sums (R, G, "
+                    "B or its spectral bands; render them with the pixel format rgb or rgba)",
+                    p.name, join(developed_names));
     std::vector<std::string> expect;
     if (l.sums) {
-        for (const char *c : {"R", "G", "B"}) expect.push_back(prefix + "sum." + c);
-        for (int a = 0; a < l.aovs; ++a)
-            expect.push_back(prefix + "sum." + developed_names[size_t(3 + (l.alpha ? 1 : 0) + a)]);
+        for (size_t d = 0; d < developed_names.size(); ++d)
+            if (int(d) != l.alpha_at) expect.push_back(prefix + "sum." + developed_names[d]);
         expect.push_back(prefix + "weight");
     }
     if (l.splats)
@@ -488,9 +494,9 @@ Merged merge_parts(const std::vector<Part> &parts) {
         const double splat_scale = total_spp > 0 ? 1.0 / double(total_spp) : 1.0;
         for (size_t i = 0; i < size_t(W) * H; ++i) {
             const double *s = sum.data() + i * size_t(nraw);
-            develop_pixel(raw.sums ? s : nullptr, raw.aovs,
-                          raw.splats ? s + (raw.sums ? 4 + raw.aovs : 0) : nullptr, splat_scale,
-                          raw.alpha, out.image.data.data() + i * size_t(out_channels));
+            develop_pixel(raw.sums ? s : nullptr, raw.values,
+                          raw.splats ? s + (raw.sums ? raw.values + 1 : 0) : nullptr, splat_scale,
+                          raw.alpha_at, out.image.data.data() + i * size_t(out_channels));
         }
     }
 

@@ -268,7 +268,25 @@ std::shared_ptr<Object> Properties::object_entry(const std::string &name) const 
 }
 
 std::shared_ptr<Texture> Properties::texture(const std::string &name, SpectrumKind kind) const {
-    const Entry &e = require(name);
+    return entry_texture(require(name), kind);
+}
+
+std::vector<std::pair<std::string, std::shared_ptr<Texture>>>
+Properties::spectra(SpectrumKind kind) const {
+    std::vector<std::pair<std::string, std::shared_ptr<Texture>>> out;
+    for (const Entry &e : m_entries) {
+        const auto *obj = std::get_if<std::shared_ptr<Object>>(&e.value);
+        if (!std::holds_alternative<SpectrumData>(e.value) &&
+            !(obj && std::dynamic_pointer_cast<SpectrumTexture>(*obj)))
+            continue;
+        e.queried = true;
+        out.emplace_back(e.name, entry_texture(e, kind));
+    }
+    return out;
+}
+
+std::shared_ptr<Texture> Properties::entry_texture(const Entry &e, SpectrumKind kind) const {
+    const std::string &name = e.name;
     if (auto obj = std::get_if<std::shared_ptr<Object>>(&e.value)) {
         // A spectrum plugin becomes the constant its use calls for (reflectance, emission, ...).
         if (auto spectrum = std::dynamic_pointer_cast<SpectrumTexture>(*obj)) {

@@ -288,7 +288,10 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     plan(integrator, cap, "samples");
     integrator.begin_render(m_sensor);
     const std::vector<std::string> aov_names = integrator.aov_names();
-    m_buffer = std::make_unique<FilmBuffer>(m_window.offset, m_window.size, aov_names);
+    m_buffer = std::make_unique<FilmBuffer>(m_window.offset, m_window.size,
+                                            m_film.colour_channels(), aov_names, false);
+    // A film's bands come before the AOVs in each sample's values.
+    const size_t bands = m_film.bands() ? m_film.bands()->size() : 0;
 
     const BlockGrid grid(m_film, m_window, bs);
     const size_t blocks = grid.blocks(), passes = m_pass_start.size() - 1;
@@ -301,7 +304,7 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     // Unit `index` is block index % blocks of pass index / blocks.
     auto make_worker = [&]() -> std::function<void(size_t)> {
         auto sampler = std::shared_ptr<Sampler>(m_sampler->clone());
-        auto aovs = std::make_shared<std::vector<float>>(aov_names.size() + 1, 0.f);
+        auto aovs = std::make_shared<std::vector<float>>(bands + aov_names.size() + 1, 0.f);
         return [&, sampler, aovs](size_t index) {
             const size_t pass = index / blocks;
             const uint32_t first = m_range.first + m_pass_start[pass],
@@ -341,8 +344,15 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     const Point2i film_size = m_film.size(), offset = grid.block_offset(index);
     const Point2i size(std::min(grid.bs, film_size.x - offset.x),
                        std::min(grid.bs, film_size.y - offset.y));
-    const int aov_count = int(aovs.size()) - 1; // (the extra float keeps data() valid)
-    block.reset(offset, size, grid.border, aov_count);
+    // A film's bands, then the AOVs (the extra float keeps data() valid).
+    const SpectralBands *bands = m_film.bands();
+    const int band_count = bands ? int(bands->size()) : 0;
+    const int aov_count = int(aovs.size()) - 1 - band_count;
+    float *const aov_values = aovs.data() + band_count;
+    if (bands)
+        block.reset(offset, size, grid.border, aov_count, band_count);
+    else
+        block.reset(offset, size, grid.border, aov_count);
     const int x0 = std::max(offset.x, grid.x0), x1 = std::min(offset.x + size.x, grid.x1);
     const int y0 = std::max(offset.y, grid.y0), y1 = std::min(offset.y + size.y, grid.y1);
     const ReconstructionFilter &filter = m_film.rfilter();
@@ -370,23 +380,35 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                 const Point2f aperture = needs_aperture ? sampler.draw_2d() : Point2f(0.5f, 0.5f);
                 auto [ray, weight] = m_sensor.sample_ray(0.f, pos * inv_film_size, aperture);
                 // The spectral mode's wavelengths come with the camera ray (the sample's next
-                // dimension); its radiance at them becomes the film's RGB through XYZ.
+                // dimension), drawn by the film's bands if it has any; its radiance at them
+                // becomes the film's RGB through XYZ, or the bands.
                 Color3f wavelength_weight;
                 if (spectral)
                     std::tie(ray.wavelengths, wavelength_weight) =
-                        sample_wavelengths(sampler.draw_1d());
+                        bands ? bands->sample_wavelengths(sampler.draw_1d())
+                              : sample_wavelengths(sampler.draw_1d());
                 // Integrators need not write every AOV for every sample (e.g. on a miss).
-                if (aov_count > 0) std::fill_n(aovs.data(), aov_count, 0.f);
-                Color3f L = integrator.sample(m_scene, sampler, ray, aovs.data()) * weight;
-                if (spectral) L = spectral_to_srgb(L, ray.wavelengths, wavelength_weight);
-                bool valid = L.is_finite();
-                for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
+                if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
+                Color3f L = integrator.sample(m_scene, sampler, ray, aov_values) * weight;
+                bool valid = true;
+                if (bands) {
+                    bands->develop(L, ray.wavelengths, wavelength_weight, aovs.data());
+                    for (int k = 0; k < band_count; ++k)
+                        valid = valid && std::isfinite(aovs[size_t(k)]);
+                } else {
+                    if (spectral) L = spectral_to_srgb(L, ray.wavelengths, wavelength_weight);
+                    valid = L.is_finite();
+                }
+                for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aov_values[k]);
                 if (!valid) {
                     // One bad sample must not turn the whole pixel into NaN: drop it.
                     if (bad++ == 0) first_bad_pixel = pixel_index;
                     continue;
                 }
-                block.put(pos, L, aovs.data(), filter);
+                if (bands)
+                    block.put_values(pos, aovs.data(), filter);
+                else
+                    block.put(pos, L, aov_values, filter);
             }
         }
     }
@@ -398,6 +420,10 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
 }
 
 RenderResult RenderJob::run_light_tracing(const LightTracer &tracer) {
+    if (m_film.bands())
+        FACET_THROW("a light tracer splats R, G, B: it cannot render into the spectral bands of "
+                    "the film {} (use a sampling integrator such as path)",
+                    m_film.to_string());
     if (!m_sensor.supports_direction_sampling())
         FACET_THROW("a light tracer cannot connect to the sensor {} (it does not support "
                     "sampling a direction towards it)",
@@ -535,12 +561,16 @@ RenderResult render_all_passes(const Scene &scene, const Sensor &sensor, const R
         auto [r, buffer] = render_job(scene, sensor, part, window, integrator);
         const std::vector<std::string> names = buffer->raw_channel_names();
         const std::vector<float> raw = buffer->raw_sums();
-        const std::vector<std::string> &channels = r.image.channel_names;
-        if (channels.size() < 3 || channels[0] != "R" || channels[1] != "G" || channels[2] != "B")
-            FACET_THROW("a render of {} passes in one process develops R, G, B: the film {} "
+        // The passes are developed as a merge develops them: the film's colour channels (R, G,
+        // B or its bands) as they are summed.
+        const std::vector<std::string> &channels = r.image.channel_names,
+                                       colours = buffer->colour_names();
+        if (channels.size() < colours.size() ||
+            !std::equal(colours.begin(), colours.end(), channels.begin()))
+            FACET_THROW("a render of {} passes in one process develops {}: the film {} "
                         "develops into {} (use the pixel format rgb or rgba, or render the passes "
                         "apart)",
-                        opts.pass_count, film.to_string(),
+                        opts.pass_count, fmt::join(colours, ", "), film.to_string(),
                         channels.empty() ? "nothing" : channels[0]);
         if (i == 0) {
             raw_names = names;

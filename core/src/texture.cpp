@@ -42,6 +42,7 @@ public:
     std::string to_string() const override {
         return fmt::format("DataSpectrumTexture[{}]", m_data.to_string());
     }
+    const SpectrumData &data() const { return m_data; }
 
 private:
     SpectrumData m_data;
@@ -56,6 +57,17 @@ std::shared_ptr<Texture> rgb_spectrum_texture(const Color3f &rgb, SpectrumKind k
 std::shared_ptr<Texture> data_spectrum_texture(const SpectrumData &data, SpectrumKind kind) {
     if (data.uniform) return std::make_shared<ConstantTexture>(Color3f(float(data.value)));
     return std::make_shared<DataSpectrumTexture>(data, kind);
+}
+
+std::optional<TabulatedRange> tabulated_range(const Texture &texture) {
+    const auto *t = dynamic_cast<const DataSpectrumTexture *>(&texture);
+    if (!t) return std::nullopt;
+    const std::vector<double> &l = t->data().wavelengths;
+    if (l.size() < 2) return std::nullopt;
+    TabulatedRange r{l.front(), l.back(), l.back() - l.front()};
+    for (size_t i = 1; i < l.size(); ++i)
+        if (l[i] > l[i - 1]) r.resolution = std::min(r.resolution, l[i] - l[i - 1]);
+    return r;
 }
 
 } // namespace facet

@@ -30,10 +30,12 @@ linear Rec.709 as the image is, as in Mitsuba; the geometric channels are writte
 )DOC";
 
 #include <facet/bsdf.h>
+#include <facet/film.h>
 #include <facet/integrator.h>
 #include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/scene.h>
+#include <facet/sensor.h>
 #include <facet/shape.h>
 #include <facet/spectrum.h>
 
@@ -102,6 +104,15 @@ public:
     }
 
     void begin_render(const Sensor &sensor) const override {
+        // The albedo is developed to RGB from the visible range's wavelengths; a film's bands
+        // draw others.
+        if (m_spectral && sensor.film().bands())
+            for (const Aov &a : m_aovs)
+                if (a.kind == Kind::Albedo)
+                    FACET_THROW("aov: the albedo AOV \"{}\" is developed to RGB and cannot be "
+                                "rendered with the spectral bands of {} (the geometric AOVs "
+                                "can)",
+                                a.name, sensor.film().to_string());
         if (m_nested) m_nested->begin_render(sensor);
     }
 

@@ -29,10 +29,12 @@ so the moments are those of the XYZ samples the image averages, as in Mitsuba.
 ```
 )DOC";
 
+#include <facet/film.h>
 #include <facet/integrator.h>
 #include <facet/mode.h>
 #include <facet/plugin.h>
 #include <facet/properties.h>
+#include <facet/sensor.h>
 #include <facet/spectrum.h>
 
 #include <fmt/format.h>
@@ -85,6 +87,10 @@ public:
     }
 
     void begin_render(const Sensor &sensor) const override {
+        if (sensor.film().bands())
+            FACET_THROW("moment: its channels are the XYZ of the visible range's wavelengths and "
+                        "cannot be rendered with the spectral bands of {}",
+                        sensor.film().to_string());
         for (const Nested &n : m_nested) n.integrator->begin_render(sensor);
     }
 

@@ -29,6 +29,7 @@ a warning says so.
 ```
 )DOC";
 
+#include <facet/film.h>
 #include <facet/integrator.h>
 #include <facet/mode.h>
 #include <facet/mueller.h>
@@ -84,6 +85,10 @@ public:
     }
 
     void begin_render(const Sensor &sensor) const override {
+        if (sensor.film().bands())
+            FACET_THROW("stokes: its S0-S3 channels are developed to RGB and cannot be rendered "
+                        "with the spectral bands of {}",
+                        sensor.film().to_string());
         const Vector3f up = normalize(sensor.to_world().apply_vector(Vector3f(0.f, 1.f, 0.f)));
         m_up_x.store(up.x);
         m_up_y.store(up.y);

@@ -136,3 +136,26 @@ def test_chi2_builds_the_plugin_in_a_colour_mode():
         facet.chi2("bsdf", "diffuse", colour_mode="scalar_rgb_polarized")
     with pytest.raises(TypeError, match="mode=2"):
         facet.chi2("emitter", "point", colour_mode=2)
+
+
+def test_a_spectral_film_renders_its_bands_from_python():
+    # specfilm's channels are its bands (sorted by name), each ∫ s(λ) L(λ) dλ: under a sky of
+    # radiance 2 at every wavelength, 2·50 for a triangle of height 1 and width 100 nm.
+    scene = facet.load_dict({
+        "type": "scene",
+        "sensor": {"type": "perspective",
+                   "film": {"type": "specfilm", "width": 4, "height": 4,
+                            "tri": {"type": "spectrum", "value": [(500, 0), (550, 1), (600, 0)]},
+                            "flat": {"type": "spectrum", "value": 1.0}},
+                   "sampler": {"type": "independent", "sample_count": 32}},
+        "emitter": {"type": "constant",
+                    "radiance": {"type": "spectrum", "value": [(360, 2), (830, 2)]}},
+    }, mode="scalar_spectral")
+    image = facet.render(scene, progress=False)
+    assert image.channels == ["flat", "tri"]
+    mean = np.asarray(image).reshape(-1, 2).mean(axis=0)
+    assert mean == pytest.approx([2 * 470, 2 * 50], rel=0.02)
+    with pytest.raises(facet.Error, match="specfilm"):
+        facet.load_dict({"type": "scene", "sensor": {"type": "perspective",
+                                                     "film": {"type": "specfilm"}}},
+                        mode="scalar_spectral")

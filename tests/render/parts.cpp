@@ -33,10 +33,13 @@ fs::path temp_dir() {
     return dir;
 }
 
-std::shared_ptr<Scene> load_temp_scene(const std::string &xml) {
+std::shared_ptr<Scene> load_temp_scene(const std::string &xml,
+                                       const std::string &mode = "scalar_rgb") {
     fs::path file = temp_dir() / "scene.xml";
     std::ofstream(file) << xml;
-    return load_scene(file.string());
+    LoadOptions lo;
+    lo.mode = mode;
+    return load_scene(file.string(), lo);
 }
 
 /// A sphere on a plane under a sky and a point light; `film_extra` goes inside the film.
@@ -202,9 +205,10 @@ std::vector<std::array<int, 4>> split_of_pass(int i) {
 /// and checks the merge is bit-identical to the render of all the passes in one process. Prints
 /// how far the earlier merge (the parts' developed pixels averaged with their spp as weights) was
 /// from it, and how far both are from one render of all the samples (other float rounding).
-void expect_exact_pass_merge(const std::string &what, const std::string &xml, int passes) {
+void expect_exact_pass_merge(const std::string &what, const std::string &xml, int passes,
+                             const std::string &mode = "scalar_rgb") {
     SCOPED_TRACE(what);
-    auto scene = load_temp_scene(xml);
+    auto scene = load_temp_scene(xml, mode);
     const Sensor &sensor = *scene->sensors().at(0);
     std::vector<merge::Part> parts;
     std::vector<RenderResult> whole_passes;
@@ -289,6 +293,21 @@ TEST(RenderParts, PassesMergeExactlyWithOtherSamplersAndAovs) {
                      <integrator type="path"><integer name="max_depth" value="4"/></integrator>
                      </integrator>)"),
         2);
+}
+
+TEST(RenderParts, SpectralBandPassesMergeExactly) {
+    // A film of spectral bands (no R, G, B) with AOVs: the bands' sums merge like colours.
+    std::string xml = scene_xml("independent", 2,
+                                R"(<spectrum name="short" value="400:0, 450:1, 500:0"/>
+           <spectrum name="long" value="550:0, 650:1, 750:0"/><rfilter type="tent"/>)",
+                                29, 21,
+                                R"(<integrator type="aov"><string name="aovs" value="dd:depth"/>
+           <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+           </integrator>)");
+    const size_t at = xml.find("\"hdrfilm\"");
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at, 9, "\"specfilm\"");
+    expect_exact_pass_merge("specfilm + aov", xml, 3, "scalar_spectral");
 }
 
 TEST(RenderParts, LightTracerPassesMergeExactly) {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -87,6 +88,12 @@ public:
     std::shared_ptr<Texture> texture(const std::string &name, const Color3f &def,
                                      SpectrumKind kind = SpectrumKind::Reflectance) const;
 
+    /// Every spectrum among the entries, whatever its name (a `<spectrum>` value or a spectrum
+    /// plugin), in declaration order, each as texture(name, kind) gives it: for a plugin that
+    /// takes any number of them (specfilm's bands). Marks them queried; their names are not
+    /// parameters the plugin asks for by name (requested_names()).
+    std::vector<std::pair<std::string, std::shared_ptr<Texture>>> spectra(SpectrumKind kind) const;
+
     /// A named child object of kind T, or nullptr when absent; wrong kinds are errors.
     template <typename T> std::shared_ptr<T> get_object(const std::string &name) const {
         if (!has(name)) return nullptr;
@@ -121,6 +128,7 @@ private:
     };
     const Entry *find(const std::string &name) const;
     const Entry &require(const std::string &name) const;
+    std::shared_ptr<Texture> entry_texture(const Entry &e, SpectrumKind kind) const;
     std::shared_ptr<Object> object_entry(const std::string &name) const;
     [[noreturn]] void type_error(const std::string &name, const char *expected) const;
     /// A spectrum plugin's value for a parameter of kind `kind`; errors name the parameter.

@@ -8,6 +8,7 @@
 #include <facet/spectrum.h>
 
 #include <memory>
+#include <optional>
 #include <utility>
 
 namespace facet {
@@ -161,6 +162,15 @@ std::shared_ptr<Texture> rgb_spectrum_texture(const Color3f &rgb, SpectrumKind k
 /// between the pairs, 0 outside them); a uniform spectrum is a ConstantTexture. `kind` only
 /// chooses mean()'s colour.
 std::shared_ptr<Texture> data_spectrum_texture(const SpectrumData &data, SpectrumKind kind);
+
+/// The wavelengths (nm) a tabulated spectrum is given at: its first and last, and the smallest
+/// spacing between two of them.
+struct TabulatedRange {
+    double min = 0.0, max = 0.0, resolution = 0.0;
+};
+/// The range of a texture of the spectral modes made from (wavelength, value) pairs (a value
+/// list, an .spd file, `regular`, `irregular`); none for any other texture.
+std::optional<TabulatedRange> tabulated_range(const Texture &texture);
 
 /**
  * A spectrum plugin (`<spectrum type="d65">`, uniform, regular, irregular, srgb, blackbody): a

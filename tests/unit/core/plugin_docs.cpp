@@ -53,6 +53,10 @@ Properties valid_properties(const std::string &name) {
         p.set_object("ball", make(ObjectType::Shape, Properties("sphere")));
     } else if (name == "aov") {
         p.set_string("aovs", "dd:depth");
+    } else if (name == "specfilm") {
+        // A film of the spectral modes; its bands are spectra of any name (not parameters).
+        p.set_mode(ColourMode::Spectral);
+        p.set("band", parse_spectrum_pairs("400:0, 500:1, 600:0"));
     } else if (name == "thinlens") {
         p.set_float("aperture_radius", 0.1);
         p.set_float("focus_distance", 2.0);
