@@ -730,6 +730,7 @@ Describe the camera here. Until you change it this is a pinhole camera at the or
 | to_world | transform | identity | Camera-to-world transform |
 | shutter_open | float | 0 | Accepted for compatibility (still images) |
 | shutter_close | float | 0 | Accepted for compatibility (>= shutter_open) |
+| srf | spectrum | none | Spectral response (spectral modes; read by the Sensor base class) |
 | (film) | film | hdrfilm | Nested film |
 | (sampler) | sampler | independent | Nested sampler |
 

@@ -146,7 +146,9 @@ ChannelsProbe output_channels_probe(const Scene &scene, const Sensor &sensor, bo
     std::vector<std::string> aovs;
     if (auto sampling = std::dynamic_pointer_cast<SamplingIntegrator>(scene.integrator()))
         aovs = sampling->aov_names();
-    const bool splats = bool(std::dynamic_pointer_cast<LightTracer>(scene.integrator()));
+    // (A light tracer refuses a film of spectral bands when it renders, with its reasons.)
+    const bool splats =
+        bool(std::dynamic_pointer_cast<LightTracer>(scene.integrator())) && !film.bands();
     const FilmBuffer buffer(Point2i(0, 0), Point2i(1, 1), film.colour_channels(), aovs, splats);
     ChannelsProbe probe;
     probe.image = film.develop(buffer);

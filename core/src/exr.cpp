@@ -74,8 +74,8 @@ std::string channel_name(const Image &image, int c) {
 
 /// The header: windows, ZIP compression, the channels (half for the leading colour channels
 /// when `opts.half`; AOVs after them always float32, see ImageWriteOptions::half), the
-/// caller's attributes, the date and, for R, G, B or Y pixels, the chromaticities of linear
-/// Rec.709.
+/// caller's attributes, the date and, for Rec.709 pixels (opts.rec709, not XYZ), the
+/// chromaticities of linear Rec.709.
 Imf::Header exr_header(const Image &image, const std::vector<std::string> &names,
                        const std::vector<Imf::PixelType> &types, const ImageWriteOptions &opts) {
     // A crop window: the data window at (x, y) inside the full display window.
@@ -105,10 +105,9 @@ Imf::Header exr_header(const Image &image, const std::vector<std::string> &names
     char date[32];
     if (localtime_r(&now, &local) && std::strftime(date, sizeof date, "%Y:%m:%d %H:%M:%S", &local))
         Imf::addCapDate(header, date);
-    // Pixels of Rec.709 colours (R, G, B, or a luminance Y), not XYZ nor a film's spectral
-    // bands.
-    const bool rec709 = !names.empty() && (names[0] == "R" || names[0] == "Y");
-    if (rec709) // red, green, blue and white (D65) xy of Rec.709, the space facet renders in
+    const bool xyz = names.size() >= 3 && names[0] == "X" && names[1] == "Y" && names[2] == "Z";
+    if (opts.rec709 &&
+        !xyz) // red, green, blue and white (D65) xy of Rec.709, the space facet renders in
         Imf::addChromaticities(
             header, Imf::Chromaticities(Imath::V2f(0.64f, 0.33f), Imath::V2f(0.30f, 0.60f),
                                         Imath::V2f(0.15f, 0.06f), Imath::V2f(0.3127f, 0.3290f)));
@@ -180,8 +179,15 @@ void write_exr(const std::string &path, const Image &image, const ImageWriteOpti
                         names.back());
     }
     std::vector<Imf::PixelType> types(names.size(), Imf::FLOAT);
-    for (size_t c = 0; opts.half && c < names.size() && is_colour_channel(names[c]); ++c)
-        types[c] = Imf::HALF;
+    if (!opts.half_channels.empty()) {
+        for (size_t c = 0; c < names.size(); ++c)
+            if (std::find(opts.half_channels.begin(), opts.half_channels.end(), names[c]) !=
+                opts.half_channels.end())
+                types[c] = Imf::HALF;
+    } else {
+        for (size_t c = 0; opts.half && c < names.size() && is_colour_channel(names[c]); ++c)
+            types[c] = Imf::HALF;
+    }
 
     std::vector<unsigned char> bytes;
     try {
@@ -191,18 +197,22 @@ void write_exr(const std::string &path, const Image &image, const ImageWriteOpti
             return true;
         }();
         (void)threads;
-        // OpenEXR writes slices of the channel's own type: the half channels (the leading ones)
-        // are rounded here, interleaved like the image.
+        // OpenEXR writes slices of the channel's own type: the half channels are rounded here,
+        // interleaved like the image.
         const size_t npix = size_t(image.width) * size_t(image.height);
-        const size_t nhalf = size_t(std::count(types.begin(), types.end(), Imf::HALF));
+        std::vector<size_t> half_of; // the image channel of each half one
+        for (size_t c = 0; c < types.size(); ++c)
+            if (types[c] == Imf::HALF) half_of.push_back(c);
+        const size_t nhalf = half_of.size();
         std::vector<Imath::half> halves(npix * nhalf);
         for (size_t i = 0; i < npix; ++i)
-            for (size_t c = 0; c < nhalf; ++c)
-                halves[i * nhalf + c] = Imath::half(image.data[i * size_t(image.channels) + c]);
+            for (size_t h = 0; h < nhalf; ++h)
+                halves[i * nhalf + h] =
+                    Imath::half(image.data[i * size_t(image.channels) + half_of[h]]);
         Imf::FrameBuffer fb = frame_buffer(image, names, image.data.data(), image.y, image.height);
-        for (size_t c = 0; c < nhalf; ++c)
-            fb.insert(names[c],
-                      Imf::Slice::Make(Imf::HALF, halves.data() + c, Imath::V2i(image.x, image.y),
+        for (size_t h = 0; h < nhalf; ++h)
+            fb.insert(names[half_of[h]],
+                      Imf::Slice::Make(Imf::HALF, halves.data() + h, Imath::V2i(image.x, image.y),
                                        image.width, image.height, sizeof(Imath::half) * nhalf,
                                        sizeof(Imath::half) * nhalf * image.width));
         MemoryStream stream(bytes);

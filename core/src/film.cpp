@@ -313,8 +313,10 @@ void FilmBuffer::put_splats(const ImageBlock &block) {
 void FilmBuffer::put_block(const ImageBlock &block) {
     const int nc = block.channel_count();
     if (size_t(nc) != channel_count())
-        FACET_THROW("FilmBuffer::put_block: the block has {} AOV channels, the buffer expects {}",
-                    block.aov_count(), m_aov_names.size());
+        FACET_THROW("FilmBuffer::put_block: the block has {} colour and {} AOV channels, the "
+                    "buffer expects {} and {}",
+                    block.colour_count(), block.aov_count(), m_colour_names.size(),
+                    m_aov_names.size());
     const Point2i s = block.storage_size();
     const float *data = block.data().data();
     // Block storage pixel (0, 0) is film pixel offset - border; map it to the window.

@@ -311,6 +311,7 @@ Part read_part(const std::string &path) {
     part.x = file.image.x;
     part.y = file.image.y;
     part.half = file.half;
+    part.half_channels = file.half_channels;
     part.image = std::move(file.image);
     for (auto &[name, value] : file.attributes) {
         if (name.rfind("facet:", 0) == 0) part.metadata.strings[name] = value;
@@ -452,6 +453,12 @@ Merged merge_parts(const std::vector<Part> &parts) {
         return channel_indices(p, passes > 1 ? raw.raw_names : out.image.channel_names);
     };
     out.half = std::all_of(parts.begin(), parts.end(), [](const Part &p) { return p.half; });
+    for (const std::string &name : out.image.channel_names)
+        if (std::all_of(parts.begin(), parts.end(), [&name](const Part &p) {
+                return std::find(p.half_channels.begin(), p.half_channels.end(), name) !=
+                       p.half_channels.end();
+            }))
+            out.half_channels.push_back(name);
 
     // Σ of every raw channel over the passes, in pass order (the order a render of all the
     // passes in one process adds them in).
@@ -507,6 +514,11 @@ Merged merge_parts(const std::vector<Part> &parts) {
 void write_merged(const Merged &merged, const std::string &path) {
     ImageWriteOptions opts;
     opts.half = merged.half;
+    // Each channel as the parts store it (a film's bands are float16 like R, G, B), and Rec.709
+    // chromaticities where the parts' colour is R, G, B or Y.
+    opts.half_channels = merged.half_channels;
+    const std::vector<std::string> &names = merged.image.channel_names;
+    opts.rec709 = !names.empty() && (names[0] == "R" || names[0] == "Y");
     add_metadata(opts, merged.metadata);
     write_image(path, merged.image, opts);
 }

@@ -292,6 +292,11 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
                                             m_film.colour_channels(), aov_names, false);
     // A film's bands come before the AOVs in each sample's values.
     const size_t bands = m_film.bands() ? m_film.bands()->size() : 0;
+    for (const std::string &colour : m_buffer->colour_names())
+        if (std::find(aov_names.begin(), aov_names.end(), colour) != aov_names.end())
+            FACET_THROW("the integrator's AOV \"{}\" has the name of a colour channel of the "
+                        "film {}: channel names must be unique, rename the AOV or the band",
+                        colour, m_film.to_string());
 
     const BlockGrid grid(m_film, m_window, bs);
     const size_t blocks = grid.blocks(), passes = m_pass_start.size() - 1;
@@ -346,6 +351,8 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                        std::min(grid.bs, film_size.y - offset.y));
     // A film's bands, then the AOVs (the extra float keeps data() valid).
     const SpectralBands *bands = m_film.bands();
+    // A sensor's spectral response draws the wavelengths and weighs the radiance.
+    const SpectralBands *srf = m_sensor.srf();
     const int band_count = bands ? int(bands->size()) : 0;
     const int aov_count = int(aovs.size()) - 1 - band_count;
     float *const aov_values = aovs.data() + band_count;
@@ -380,13 +387,21 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                 const Point2f aperture = needs_aperture ? sampler.draw_2d() : Point2f(0.5f, 0.5f);
                 auto [ray, weight] = m_sensor.sample_ray(0.f, pos * inv_film_size, aperture);
                 // The spectral mode's wavelengths come with the camera ray (the sample's next
-                // dimension), drawn by the film's bands if it has any; its radiance at them
-                // becomes the film's RGB through XYZ, or the bands.
+                // dimension), drawn from the film's bands or the sensor's response if there is
+                // one; its radiance at them becomes the film's RGB through XYZ (times the
+                // sensor's response), or the bands.
                 Color3f wavelength_weight;
-                if (spectral)
-                    std::tie(ray.wavelengths, wavelength_weight) =
-                        bands ? bands->sample_wavelengths(sampler.draw_1d())
-                              : sample_wavelengths(sampler.draw_1d());
+                if (spectral) {
+                    const float u = sampler.draw_1d();
+                    if (bands) {
+                        std::tie(ray.wavelengths, wavelength_weight) = bands->sample_wavelengths(u);
+                    } else if (srf) {
+                        std::tie(ray.wavelengths, wavelength_weight) = srf->sample_wavelengths(u);
+                        wavelength_weight = wavelength_weight * srf->eval(0, ray.wavelengths);
+                    } else {
+                        std::tie(ray.wavelengths, wavelength_weight) = sample_wavelengths(u);
+                    }
+                }
                 // Integrators need not write every AOV for every sample (e.g. on a miss).
                 if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
                 Color3f L = integrator.sample(m_scene, sampler, ray, aov_values) * weight;
@@ -424,6 +439,10 @@ RenderResult RenderJob::run_light_tracing(const LightTracer &tracer) {
         FACET_THROW("a light tracer splats R, G, B: it cannot render into the spectral bands of "
                     "the film {} (use a sampling integrator such as path)",
                     m_film.to_string());
+    if (m_sensor.srf())
+        FACET_THROW("a light tracer draws its wavelengths at the emitters: it cannot render "
+                    "through the sensor's spectral response (srf; use a sampling integrator "
+                    "such as path)");
     if (!m_sensor.supports_direction_sampling())
         FACET_THROW("a light tracer cannot connect to the sensor {} (it does not support "
                     "sampling a direction towards it)",

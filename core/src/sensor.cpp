@@ -34,6 +34,24 @@ Sensor::Sensor(const Properties &props) {
     if (!m_film) m_film = registry.create_as<Film>(ObjectType::Film, Properties("hdrfilm"));
     if (!m_sampler)
         m_sampler = registry.create_as<Sampler>(ObjectType::Sampler, Properties("independent"));
+
+    // A spectral response (Mitsuba's sensor `srf`): the spectral modes only, and not with a
+    // film's own bands.
+    if (props.has("srf")) {
+        const Location &at = props.location("srf");
+        if (!is_spectral(props.mode()))
+            FACET_THROW_AT(at, "the sensor's srf (a spectral response function) needs a spectral "
+                               "mode (scalar_spectral or scalar_spectral_polarized)");
+        if (m_film->bands())
+            FACET_THROW_AT(at, "the sensor's srf and the film's spectral bands both set the "
+                               "spectral response: give only one");
+        try {
+            m_srf = SpectralBands::fit({{"srf", props.texture("srf", SpectrumKind::Measured)}});
+        } catch (const Error &e) {
+            if (e.location().valid()) throw;
+            FACET_THROW_AT(at, "the sensor's srf: {}", e.message());
+        }
+    }
 }
 
 std::pair<DirectionSample, Color3f> Sensor::sample_direction(const Interaction &,

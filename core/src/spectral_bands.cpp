@@ -1,4 +1,5 @@
 #include <facet/film.h>
+#include <facet/logger.h>
 #include <facet/spectrum.h>
 #include <facet/texture.h>
 
@@ -40,6 +41,7 @@ SpectralBands::SpectralBands(std::vector<Band> bands, float lambda_min, float la
     }
     m_step = (lambda_max - lambda_min) / float(points - 1);
     m_values.assign(points, 0.f);
+    float negative = 0.f; // the first wavelength where S < 0
     // S at the grid points, four at a time.
     for (size_t k = 0; k < points; k += 4) {
         float l[4];
@@ -50,9 +52,16 @@ SpectralBands::SpectralBands(std::vector<Band> bands, float lambda_min, float la
         for (size_t j = 0; j < m_bands.size(); ++j)
             sum += eval_srf(*m_bands[j].srf, m_spectral[j], lambda);
         const float v[4] = {sum.r, sum.g, sum.b, sum.w};
-        for (size_t i = 0; i < 4 && k + i < points; ++i)
+        for (size_t i = 0; i < 4 && k + i < points; ++i) {
+            if (v[i] < 0.f && !negative) negative = l[i];
             m_values[k + i] = std::isfinite(v[i]) ? std::max(v[i], 0.f) : 0.f;
+        }
     }
+    if (negative)
+        FACET_LOG(Warn,
+                  "the responses of the bands {} sum to a negative value at {} nm: no wavelength "
+                  "is drawn where the sum is not positive, so a band loses its response there",
+                  fmt::join(m_names, ", "), negative);
     // The CDF of the piecewise linear S over the grid's segments.
     m_cdf.assign(points, 0.0);
     for (size_t k = 1; k < points; ++k)
@@ -82,13 +91,50 @@ std::pair<Wavelengths, Color3f> SpectralBands::sample_wavelengths(float u) const
         const double disc = std::max(a * a + 2.0 * (b - a) * m, 0.0);
         const double den = a + std::sqrt(disc);
         const double t = den > 0.0 ? std::clamp(2.0 * m / den, 0.0, 1.0) : 0.0;
-        lambda[i] = std::clamp(float(double(m_min) + (double(k) + t) * double(m_step)), m_min,
-                               m_max);
+        lambda[i] =
+            std::clamp(float(double(m_min) + (double(k) + t) * double(m_step)), m_min, m_max);
         const float p = pdf(lambda[i]);
         weight[i] = p > 0.f ? 1.f / p : 0.f;
     }
     return {Wavelengths(lambda[0], lambda[1], lambda[2], lambda[3]),
             Color3f(weight[0], weight[1], weight[2], weight[3])};
+}
+
+std::shared_ptr<const SpectralBands> SpectralBands::fit(std::vector<Band> bands) {
+    double lo = INFINITY, hi = -INFINITY, resolution = 1.0;
+    for (const Band &b : bands) {
+        if (!b.srf) FACET_THROW("spectral band \"{}\" has no response function", b.name);
+        const std::optional<TabulatedRange> r = tabulated_range(*b.srf);
+        if (!r) {
+            lo = SpectralMinNm;
+            hi = SpectralMaxNm;
+            continue;
+        }
+        if (r->max <= SpectralMinNm || r->min >= SpectralMaxNm)
+            FACET_THROW("the spectrum \"{}\" is given over [{}, {}] nm, outside the {}-{} nm "
+                        "facet renders",
+                        b.name, r->min, r->max, SpectralMinNm, SpectralMaxNm);
+        if (r->min < SpectralMinNm || r->max > SpectralMaxNm)
+            FACET_LOG(Warn,
+                      "the spectrum \"{}\" is given over [{}, {}] nm: its parts outside {}-{} nm "
+                      "are not rendered",
+                      b.name, r->min, r->max, SpectralMinNm, SpectralMaxNm);
+        lo = std::min(lo, r->min);
+        hi = std::max(hi, r->max);
+        resolution = std::min(resolution, r->resolution);
+    }
+    lo = std::max(lo, double(SpectralMinNm));
+    hi = std::min(hi, double(SpectralMaxNm));
+    if (!(lo < hi)) FACET_THROW("spectral bands need at least one response function");
+    // Steps of at most `resolution` (2^20 points at most).
+    const double span = hi - lo;
+    const double steps = std::ceil(span / std::max(resolution, span / double(1 << 20)) - 1e-6);
+    const size_t points = size_t(std::clamp(steps, 1.0, double(1 << 20) - 1.0)) + 1;
+    return std::make_shared<SpectralBands>(std::move(bands), float(lo), float(hi), points);
+}
+
+Color3f SpectralBands::eval(size_t j, const Wavelengths &lambda) const {
+    return eval_srf(*m_bands[j].srf, m_spectral[j], lambda);
 }
 
 float SpectralBands::pdf(float lambda) const {

@@ -15,7 +15,7 @@ spacing of their wavelengths and at least every nanometre, so every band gets sa
 wavelength outside all bands is traced. Parts of
 an SRF outside 360-830 nm are not rendered (facet's spectral range). Light tracers (`ptracer`)
 cannot render into bands; the `aov` integrator's albedo, `moment` and `stokes` develop their own
-RGB and are refused with it.
+RGB and are refused with it, and so is a sensor's own `srf`.
 
 | Parameter | Type | Default | Description |
 |---|---|---|---|
@@ -91,10 +91,16 @@ public:
                const ImageWriteOptions &opts) const override {
         std::string ext = lower(std::filesystem::path(path).extension().string());
         if (ext != ".exr")
-            FACET_THROW("{}: specfilm writes OpenEXR only (its channels are the spectral bands {}): "
-                        "name the output .exr",
-                        path, fmt::join(m_bands->names(), ", "));
-        Film::write(image, path, opts);
+            FACET_THROW(
+                "{}: specfilm writes OpenEXR only (its channels are the spectral bands {}): "
+                "name the output .exr",
+                path, fmt::join(m_bands->names(), ", "));
+        // The bands in the component format; the AOVs after them stay float32 (as hdrfilm's).
+        ImageWriteOptions o = opts;
+        o.half = m_half;
+        if (m_half) o.half_channels = m_bands->names();
+        o.rec709 = false;
+        write_image(path, image, o);
     }
 
     std::string to_string() const override {
@@ -110,12 +116,9 @@ private:
         return s;
     }
 
-    /// The nested spectra, sorted by name, and the grid of their sum: from the smallest to the
-    /// largest tabulated wavelength, at the finest spacing (the whole range at 1 nm for a
-    /// spectrum without wavelengths).
+    /// The nested spectra, sorted by name, on the grid of their sum (SpectralBands::fit).
     static std::shared_ptr<const SpectralBands> read_bands(const Properties &props) {
         std::vector<SpectralBands::Band> bands;
-        double lo = INFINITY, hi = -INFINITY, resolution = 1.0;
         for (const auto &[name, obj] : props.objects())
             if (obj && obj->type() != ObjectType::ReconstructionFilter &&
                 !std::dynamic_pointer_cast<SpectrumTexture>(obj))
@@ -124,25 +127,11 @@ private:
                                "(sensor response functions) and a reconstruction filter",
                                name, object_type_name(obj->type()));
         for (auto &[name, srf] : props.spectra(SpectrumKind::Measured)) {
-            if (const std::optional<TabulatedRange> r = tabulated_range(*srf)) {
-                if (r->max <= SpectralMinNm || r->min >= SpectralMaxNm)
-                    FACET_THROW_AT(props.location(name),
-                                   "specfilm: the spectrum \"{}\" is given over [{}, {}] nm, "
-                                   "outside the {}-{} nm facet renders",
-                                   name, r->min, r->max, SpectralMinNm, SpectralMaxNm);
-                if (r->min < SpectralMinNm || r->max > SpectralMaxNm)
-                    FACET_LOG(Warn,
-                              "{}: specfilm: the spectrum \"{}\" is given over [{}, {}] nm: its "
-                              "parts outside {}-{} nm are not rendered",
-                              props.location(name).to_string(), name, r->min, r->max,
-                              SpectralMinNm, SpectralMaxNm);
-                lo = std::min(lo, r->min);
-                hi = std::max(hi, r->max);
-                resolution = std::min(resolution, r->resolution);
-            } else {
-                lo = SpectralMinNm;
-                hi = SpectralMaxNm;
-            }
+            if (name.rfind(RawChannelPrefix, 0) == 0)
+                FACET_THROW_AT(props.location(name),
+                               "specfilm: the band \"{}\" has the prefix of facet's raw channels "
+                               "(\"{}\"): rename it",
+                               name, RawChannelPrefix);
             bands.push_back({name, std::move(srf)});
         }
         if (bands.empty())
@@ -151,14 +140,8 @@ private:
                            "e.g. <spectrum name=\"band\" value=\"400:0, 550:1, 700:0\"/>");
         std::sort(bands.begin(), bands.end(),
                   [](const auto &a, const auto &b) { return a.name < b.name; });
-        lo = std::max(lo, double(SpectralMinNm));
-        hi = std::min(hi, double(SpectralMaxNm));
-        // At least the finest spacing's resolution (bounded: 2^20 points at most).
-        const double span = hi - lo;
-        const double steps = std::ceil(span / std::max(resolution, span / double(1 << 20)) - 1e-6);
-        const size_t points = size_t(std::clamp(steps, 1.0, double(1 << 20) - 1.0)) + 1;
         try {
-            return std::make_shared<SpectralBands>(std::move(bands), float(lo), float(hi), points);
+            return SpectralBands::fit(std::move(bands));
         } catch (const Error &e) {
             if (e.location().valid()) throw;
             FACET_THROW_AT(props.location(), "specfilm: {}", e.message());

@@ -106,13 +106,14 @@ public:
     void begin_render(const Sensor &sensor) const override {
         // The albedo is developed to RGB from the visible range's wavelengths; a film's bands
         // draw others.
-        if (m_spectral && sensor.film().bands())
+        if (m_spectral && sensor.draws_wavelengths())
             for (const Aov &a : m_aovs)
                 if (a.kind == Kind::Albedo)
-                    FACET_THROW("aov: the albedo AOV \"{}\" is developed to RGB and cannot be "
-                                "rendered with the spectral bands of {} (the geometric AOVs "
+                    FACET_THROW("aov: the albedo AOV \"{}\" is developed to RGB from the "
+                                "visible range's wavelengths: it cannot be rendered with a "
+                                "film's spectral bands or a sensor's srf (the geometric AOVs "
                                 "can)",
-                                a.name, sensor.film().to_string());
+                                a.name);
         if (m_nested) m_nested->begin_render(sensor);
     }
 

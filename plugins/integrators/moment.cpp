@@ -87,10 +87,9 @@ public:
     }
 
     void begin_render(const Sensor &sensor) const override {
-        if (sensor.film().bands())
-            FACET_THROW("moment: its channels are the XYZ of the visible range's wavelengths and "
-                        "cannot be rendered with the spectral bands of {}",
-                        sensor.film().to_string());
+        if (sensor.draws_wavelengths())
+            FACET_THROW("moment: its channels are the XYZ of the visible range's wavelengths: "
+                        "it cannot be rendered with a film's spectral bands or a sensor's srf");
         for (const Nested &n : m_nested) n.integrator->begin_render(sensor);
     }
 

@@ -85,10 +85,10 @@ public:
     }
 
     void begin_render(const Sensor &sensor) const override {
-        if (sensor.film().bands())
-            FACET_THROW("stokes: its S0-S3 channels are developed to RGB and cannot be rendered "
-                        "with the spectral bands of {}",
-                        sensor.film().to_string());
+        if (sensor.draws_wavelengths())
+            FACET_THROW("stokes: its S0-S3 channels are developed to RGB from the visible "
+                        "range's wavelengths: it cannot be rendered with a film's spectral bands "
+                        "or a sensor's srf");
         const Vector3f up = normalize(sensor.to_world().apply_vector(Vector3f(0.f, 1.f, 0.f)));
         m_up_x.store(up.x);
         m_up_y.store(up.y);

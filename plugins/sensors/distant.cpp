@@ -21,6 +21,7 @@ As in Mitsuba 3 the film must be 1x1 pixels (use the box filter).
 | target | point or shape | (none) | Where the rays aim (see above) |
 | shutter_open | float | 0 | Accepted for compatibility; facet renders still images |
 | shutter_close | float | 0 | Accepted for compatibility (must be >= shutter_open) |
+| srf | spectrum | none | Spectral response function (the spectral modes only): the wavelengths are drawn from it and the radiance is weighted by it before the film develops it; not with a `specfilm` |
 | (film) | film | hdrfilm | Nested film; must be 1x1 pixels |
 | (sampler) | sampler | independent | Nested sampler |
 

@@ -13,6 +13,7 @@ is meant for a 1x1 film with the box filter.
 | to_world | transform | — | Not accepted (an error): the meter follows the shape it is nested in |
 | shutter_open | float | 0 | Accepted for compatibility; facet renders still images |
 | shutter_close | float | 0 | Accepted for compatibility (must be >= shutter_open) |
+| srf | spectrum | none | Spectral response function (the spectral modes only): the wavelengths are drawn from it and the radiance is weighted by it before the film develops it; not with a `specfilm` |
 | (film) | film | hdrfilm | Nested film; 1x1 pixels (another size measures the same in every pixel) |
 | (sampler) | sampler | independent | Nested sampler |
 

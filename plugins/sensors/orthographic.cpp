@@ -12,6 +12,7 @@ larger or smaller region, as in Mitsuba.
 | far_clip  | float     | 10000       | Far clipping distance (local units)            |
 | shutter_open | float  | 0           | Accepted for compatibility (still images)      |
 | shutter_close| float  | 0           | Accepted for compatibility (>= shutter_open)   |
+| srf | spectrum | none | Spectral response function (the spectral modes only): the wavelengths are drawn from it and the radiance is weighted by it before the film develops it; not with a `specfilm` |
 | (film)    | film      | hdrfilm     | Nested film                                    |
 | (sampler) | sampler   | independent | Nested sampler                                 |
 

@@ -19,6 +19,7 @@ either, the camera has a 50 mm lens on a 36x24 mm film, measured along the diago
 | focus_distance | float | (none) | Accepted for Mitsuba scenes that give it; a pinhole is always in focus |
 | shutter_open | float | 0 | Accepted for compatibility; facet renders still images |
 | shutter_close | float | 0 | Accepted for compatibility (must be >= shutter_open) |
+| srf | spectrum | none | Spectral response function (the spectral modes only): the wavelengths are drawn from it and the radiance is weighted by it before the film develops it; not with a `specfilm` |
 | (film) | film | hdrfilm | Nested film |
 | (sampler) | sampler | independent | Nested sampler |
 

@@ -16,6 +16,7 @@ when `to_world` is given, `origin` and `direction` are ignored, as in Mitsuba 3.
 | direction | vector | (0, 0, 1) | Viewing direction (with `origin`) |
 | shutter_open | float | 0 | Accepted for compatibility; facet renders still images |
 | shutter_close | float | 0 | Accepted for compatibility (must be >= shutter_open) |
+| srf | spectrum | none | Spectral response function (the spectral modes only): the wavelengths are drawn from it and the radiance is weighted by it before the film develops it; not with a `specfilm` |
 | (film) | film | hdrfilm | Nested film; must be 1x1 pixels |
 | (sampler) | sampler | independent | Nested sampler |
 

@@ -17,6 +17,7 @@ frame and field of view are those of `perspective` (looks down local +Z, +X is l
 | far_clip        | float     | 10000              | Far clipping distance                                     |
 | shutter_open    | float     | 0                  | Accepted for compatibility; facet renders still images    |
 | shutter_close   | float     | 0                  | Accepted for compatibility (>= shutter_open)              |
+| srf | spectrum | none | Spectral response function (the spectral modes only): the wavelengths are drawn from it and the radiance is weighted by it before the film develops it; not with a `specfilm` |
 | (film)          | film      | hdrfilm            | Nested film                                               |
 | (sampler)       | sampler   | independent        | Nested sampler                                            |
 

@@ -167,6 +167,12 @@ public:
     /// `lambda_min` to `lambda_max` nm (both included, within 360-830 nm). Throws facet::Error
     /// when S has no positive value on the grid.
     SpectralBands(std::vector<Band> bands, float lambda_min, float lambda_max, size_t points);
+    /// The bands on the grid their responses call for: from the smallest to the largest
+    /// wavelength a tabulated response is given at (360-830 nm for one that is not, such as a
+    /// constant), at their finest spacing and at least every nanometre, cut to 360-830 nm (with
+    /// a warning for a response given partly outside). Throws facet::Error, without a
+    /// location, for a response given only outside that range or responses zero everywhere.
+    static std::shared_ptr<const SpectralBands> fit(std::vector<Band> bands);
 
     size_t size() const { return m_bands.size(); }
     const std::vector<std::string> &names() const { return m_names; }
@@ -175,6 +181,8 @@ public:
     std::pair<Wavelengths, Color3f> sample_wavelengths(float u) const;
     /// The density sample_wavelengths() draws each lane from (per nm; 0 outside the grid).
     float pdf(float lambda) const;
+    /// Band j's response at `lambda`.
+    Color3f eval(size_t j, const Wavelengths &lambda) const;
     /// The bands of a path's radiance `L` at `lambda` (drawn with weights `weight`): size()
     /// values written to `out`.
     void develop(const Color3f &L, const Wavelengths &lambda, const Color3f &weight,

@@ -38,6 +38,13 @@ struct ImageWriteOptions {
     /// developed film). AOV channels after them always stay float32: a half holds integers
     /// exactly only up to 2048 and overflows to infinity above 65504 (primitive indices, depths).
     bool half = false;
+    /// EXR: the channels stored as float16, by name, when not empty (a film whose colour
+    /// channels are not R, G, B: specfilm's bands; a merge writes each channel as its parts
+    /// have it); `half` is ignored then.
+    std::vector<std::string> half_channels;
+    /// EXR: the colour channels are Rec.709 (R, G, B, or Y), tagged with its chromaticities (XYZ
+    /// pixels and a film's spectral bands are not).
+    bool rec709 = true;
     std::string ocio_config; ///< "" = $OCIO, else the installed config
     std::string display;     ///< OpenColorIO display; "" = the config's default display
     std::string view;        ///< view of that display; "" = the display's default view
@@ -123,6 +130,7 @@ ByteImage read_image_bytes(const std::string &path);
 struct ImageFile {
     Image image;
     bool half = false; ///< the first channel (a film's colour) is stored as float16
+    std::vector<std::string> half_channels;        ///< the names of the channels stored as float16
     std::map<std::string, std::string> attributes; ///< every attribute, as text
 };
 /// read_image(), and the storage and attributes of the file.

@@ -22,11 +22,12 @@
 namespace facet::merge {
 
 struct Part {
-    std::string name;                    ///< file name (or "part N") for messages
-    int full_width = 0, full_height = 0; ///< display window
-    int x = 0, y = 0;                    ///< data window origin inside the display window
-    Image image;                         ///< the data window's pixels
-    bool half = false;                   ///< colour stored as float16
+    std::string name;                       ///< file name (or "part N") for messages
+    int full_width = 0, full_height = 0;    ///< display window
+    int x = 0, y = 0;                       ///< data window origin inside the display window
+    Image image;                            ///< the data window's pixels
+    bool half = false;                      ///< colour stored as float16
+    std::vector<std::string> half_channels; ///< the channels stored as float16
     /// The facet:* string attributes and the camera matrices (attr::world_to_camera and
     /// attr::world_to_ndc; read from a file to the 6 digits its text form keeps).
     FileMetadata metadata;
@@ -38,6 +39,7 @@ Part read_part(const std::string &path);
 struct Merged {
     Image image; ///< the full image
     bool half = false;
+    std::vector<std::string> half_channels; ///< stored as float16 in every part
     /// What all parts agree on, and the attributes of one render of the whole film
     /// (render_file_metadata()) with all the parts' samples and render time.
     FileMetadata metadata;

@@ -50,11 +50,19 @@ public:
     const Film &film() const { return *m_film; }
     const Sampler &sampler() const { return *m_sampler; }
     const Transform &to_world() const { return m_to_world; }
+    /// The sensor's spectral response function (the `srf` parameter of the spectral modes, one
+    /// band named "srf"; null: none): the paths' wavelengths are drawn from it, and the radiance
+    /// the film develops is weighted by it.
+    const SpectralBands *srf() const { return m_srf.get(); }
+    /// Whether the paths' wavelengths come from the sensor's srf or the film's bands rather
+    /// than the visible range's density (integrators that develop their own RGB refuse it).
+    bool draws_wavelengths() const { return m_srf || m_film->bands(); }
 
 protected:
     Transform m_to_world;
     std::shared_ptr<Film> m_film;
     std::shared_ptr<Sampler> m_sampler;
+    std::shared_ptr<const SpectralBands> m_srf;
 };
 
 } // namespace facet

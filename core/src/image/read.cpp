@@ -246,6 +246,10 @@ ImageFile read_image_file(const std::string &path) {
     // The film's colour comes first; AOVs and raw sums after it may be float32.
     file.half = (spec.channelformats.empty() ? spec.format : spec.channelformats[0]) ==
                 OIIO::TypeDesc::HALF;
+    for (int c = 0; c < spec.nchannels; ++c)
+        if ((spec.channelformats.empty() ? spec.format : spec.channelformats[size_t(c)]) ==
+            OIIO::TypeDesc::HALF)
+            file.half_channels.push_back(spec.channel_name(c));
     for (const OIIO::ParamValue &p : spec.extra_attribs)
         file.attributes[p.name().string()] = p.get_string();
     in->close();

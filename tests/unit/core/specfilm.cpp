@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -227,8 +228,9 @@ TEST(SpecFilm, RecordsOneChannelPerResponseSortedByName) {
     LoadOptions lo;
     lo.mode = "scalar_spectral";
     auto scene = std::dynamic_pointer_cast<Scene>(load_string(
-        view(film, sky, "",
-             4, R"(<integrator type="aov"><string name="aovs" value="d:depth"/><integrator type="path"/></integrator>)"),
+        view(
+            film, sky, "", 4,
+            R"(<integrator type="aov"><string name="aovs" value="d:depth"/><integrator type="path"/></integrator>)"),
         lo));
     RenderOptions ro;
     ro.progress = false;
@@ -244,9 +246,10 @@ TEST(SpecFilm, DrawsThePathsWavelengthsFromItsBands) {
     LoadOptions lo;
     lo.mode = "scalar_spectral";
     auto scene = std::dynamic_pointer_cast<Scene>(load_string(
-        view(specfilm(R"(<spectrum name="red_edge" value="700:0, 705:1, 710:0"/>)"),
-             R"(<emitter type="constant"><spectrum name="radiance" value="360:2, 830:2"/></emitter>)",
-             "", 1),
+        view(
+            specfilm(R"(<spectrum name="red_edge" value="700:0, 705:1, 710:0"/>)"),
+            R"(<emitter type="constant"><spectrum name="radiance" value="360:2, 830:2"/></emitter>)",
+            "", 1),
         lo));
     RenderOptions ro;
     ro.progress = false;
@@ -271,7 +274,8 @@ TEST(SpecFilm, TheCieCurvesAsBandsGiveTheXyzOfTheHdrFilm) {
     const std::string sky = R"(<emitter type="constant">
         <spectrum name="radiance" type="blackbody"><float name="temperature" value="4000"/></spectrum>
         </emitter>)";
-    const std::string plane = R"(<shape type="rectangle"><transform name="to_world"><scale value="10"/>
+    const std::string plane =
+        R"(<shape type="rectangle"><transform name="to_world"><scale value="10"/>
         </transform><bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.6, 0.3"/></bsdf></shape>)";
     const auto spec = channel_means(view(specfilm(bands), sky, plane, 256), "scalar_spectral");
     const auto xyz = channel_means(view(R"(<film type="hdrfilm"><integer name="width" value="16"/>
@@ -286,6 +290,43 @@ TEST(SpecFilm, TheCieCurvesAsBandsGiveTheXyzOfTheHdrFilm) {
     }
 }
 
+TEST(SpecFilm, WritesItsBandsInItsComponentFormat) {
+    // float16 (the default) stores the bands as half, the AOVs after them as float32; float32
+    // stores everything as float. An EXR of bands has no Rec.709 chromaticities.
+    const std::string dir = ::testing::TempDir();
+    for (const char *format : {"float16", "float32"}) {
+        SCOPED_TRACE(format);
+        LoadOptions lo;
+        lo.mode = "scalar_spectral";
+        auto scene = std::dynamic_pointer_cast<Scene>(load_string(
+            view(
+                specfilm(fmt::format(R"(<spectrum name="short" value="450:0, 500:1, 550:0"/>
+                                         <spectrum name="long" value="550:0, 600:1, 650:0"/>
+                                         <string name="component_format" value="{}"/>)",
+                                     format)),
+                R"(<emitter type="constant"/>)", "", 2,
+                R"(<integrator type="aov"><string name="aovs" value="d:depth"/><integrator type="path"/></integrator>)"),
+            lo));
+        RenderOptions ro;
+        ro.progress = false;
+        const Sensor &sensor = *scene->sensors().at(0);
+        const Image img = render(*scene, sensor, ro).image;
+        const std::string path = dir + "/specfilm_" + format + ".exr";
+        sensor.film().write(img, path, {});
+        const ImageFile file = read_image_file(path);
+        // (A reader may order the channels its own way.)
+        std::vector<std::string> names = file.image.channel_names, half = file.half_channels;
+        std::sort(names.begin(), names.end());
+        std::sort(half.begin(), half.end());
+        EXPECT_EQ(names, (std::vector<std::string>{"d", "long", "short"}));
+        if (std::string(format) == "float16")
+            EXPECT_EQ(half, (std::vector<std::string>{"long", "short"}));
+        else
+            EXPECT_TRUE(file.half_channels.empty());
+        EXPECT_EQ(file.attributes.count("chromaticities"), 0u);
+    }
+}
+
 TEST(SpecFilm, GivesTheSameImageWhateverTheThreadCount) {
     const std::string xml =
         view(specfilm(R"(<spectrum name="a" value="450:0, 500:1, 550:0"/>)"),
@@ -295,7 +336,8 @@ TEST(SpecFilm, GivesTheSameImageWhateverTheThreadCount) {
 }
 
 TEST(SpecFilm, RefusesWhatItCannotRecord) {
-    const std::string sky = R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)";
+    const std::string sky =
+        R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)";
     const std::string band = R"(<spectrum name="a" value="450:0, 500:1, 550:0"/>)";
     // Outside the spectral modes, as Mitsuba's.
     const std::string rgb = load_error(view(specfilm(band), sky, "", 4), "scalar_rgb");
@@ -306,27 +348,73 @@ TEST(SpecFilm, RefusesWhatItCannotRecord) {
              {"", "at least one spectrum"},
              {R"(<texture name="t" type="checkerboard"/>)", "not a spectrum"},
              {R"(<spectrum name="z" value="400:0, 700:0"/>)", "zero everywhere"},
-             {R"(<spectrum name="ir" value="900:1, 1000:1"/>)", "outside"}}) {
+             {R"(<spectrum name="ir" value="900:1, 1000:1"/>)", "outside"},
+             {R"(<spectrum name="facet.sum.x" value="400:0, 500:1, 600:0"/>)", "prefix"}}) {
         const std::string msg = load_error(view(specfilm(film), sky, "", 4), "scalar_spectral");
         EXPECT_TRUE(contains(msg, expect)) << msg;
         // The film's line (6) or the spectrum's (7).
         EXPECT_TRUE(contains(msg, "string:6:") || contains(msg, "string:7:")) << msg;
     }
     // Integrators that develop their own RGB, and light tracers (which splat R, G, B).
-    for (const char *integrator :
-         {R"(<integrator type="aov"><string name="aovs" value="a:albedo"/><integrator type="path"/></integrator>)",
-          R"(<integrator type="moment"><integrator type="path"/></integrator>)",
-          R"(<integrator type="stokes"><integrator type="path"/></integrator>)",
-          R"(<integrator type="ptracer"/>)"}) {
-        const std::string mode = contains(integrator, "stokes") ? "scalar_spectral_polarized"
-                                                                : "scalar_spectral";
-        const std::string msg =
-            render_error(view(specfilm(band), sky, "", 4, integrator), mode);
+    for (
+        const char *integrator :
+        {R"(<integrator type="aov"><string name="aovs" value="a:albedo"/><integrator type="path"/></integrator>)",
+         R"(<integrator type="moment"><integrator type="path"/></integrator>)",
+         R"(<integrator type="stokes"><integrator type="path"/></integrator>)",
+         R"(<integrator type="ptracer"/>)"}) {
+        const std::string mode =
+            contains(integrator, "stokes") ? "scalar_spectral_polarized" : "scalar_spectral";
+        const std::string msg = render_error(view(specfilm(band), sky, "", 4, integrator), mode);
         EXPECT_TRUE(contains(msg, "spectral bands")) << integrator << ": " << msg;
     }
     // The aov integrator's geometric channels render with bands.
-    EXPECT_EQ(render_error(view(specfilm(band), sky, "", 4,
-                                R"(<integrator type="aov"><string name="aovs" value="d:depth"/><integrator type="path"/></integrator>)"),
-                           "scalar_spectral"),
-              "");
+    EXPECT_EQ(
+        render_error(
+            view(
+                specfilm(band), sky, "", 4,
+                R"(<integrator type="aov"><string name="aovs" value="d:depth"/><integrator type="path"/></integrator>)"),
+            "scalar_spectral"),
+        "");
+}
+
+TEST(SensorSrf, WeighsTheRadianceTheFilmDevelops) {
+    // A sensor response of 1 over 500-600 nm (0 elsewhere) under a sky of radiance 2 at every
+    // wavelength: the hdrfilm's XYZ is 2 ∫ over 500-600 nm of x̄, ȳ, z̄, over ∫ȳ.
+    constexpr double CieYIntegral = 106.7502593994140625;
+    double expected[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 10000; ++k) {
+        const Color3f c = cie1931_xyz(500.0 + 0.01 * (k + 0.5));
+        for (int i = 0; i < 3; ++i) expected[i] += 2.0 * double(c[i]) * 0.01 / CieYIntegral;
+    }
+    const std::string film = R"(<film type="hdrfilm"><integer name="width" value="16"/>
+        <integer name="height" value="16"/><rfilter type="box"/>
+        <string name="pixel_format" value="xyz"/></film>)";
+    std::string xml = view(
+        film,
+        R"(<emitter type="constant"><spectrum name="radiance" value="360:2, 830:2"/></emitter>)",
+        "", 64);
+    const std::string srf = R"(<spectrum name="srf" value="499.99:0, 500:1, 600:1, 600.01:0"/>)";
+    xml.insert(xml.find("<sampler"), srf);
+    for (const char *mode : {"scalar_spectral", "scalar_spectral_polarized"}) {
+        SCOPED_TRACE(mode);
+        const auto mean = channel_means(xml, mode);
+        EXPECT_NEAR(mean.at("X"), expected[0], 0.01 * expected[0]);
+        EXPECT_NEAR(mean.at("Y"), expected[1], 0.01 * expected[1]);
+        EXPECT_NEAR(mean.at("Z"), expected[2], 0.01 * expected[2]);
+    }
+    // Refused outside the spectral modes (as Mitsuba's), with a film's bands, by light tracers
+    // and by integrators that develop their own RGB.
+    EXPECT_TRUE(contains(load_error(xml, "scalar_rgb"), "needs a spectral mode"));
+    std::string both = view(specfilm(R"(<spectrum name="a" value="450:0, 500:1, 550:0"/>)"),
+                            R"(<emitter type="constant"/>)", "", 4);
+    both.insert(both.find("<sampler"), srf);
+    EXPECT_TRUE(contains(load_error(both, "scalar_spectral"), "give only one"));
+    std::string traced = xml;
+    traced.replace(traced.find("<integrator type=\"path\"/>"), 25,
+                   "<integrator type=\"ptracer\"/>");
+    EXPECT_TRUE(contains(render_error(traced, "scalar_spectral"), "srf"));
+    std::string moment = xml;
+    moment.replace(moment.find("<integrator type=\"path\"/>"), 25,
+                   "<integrator type=\"moment\"><integrator type=\"path\"/></integrator>");
+    EXPECT_TRUE(contains(render_error(moment, "scalar_spectral"), "srf"));
 }
