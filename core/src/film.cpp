@@ -276,18 +276,18 @@ FilmBuffer::FilmBuffer(const Point2i &offset, const Point2i &size,
     if (splats && m_colour_names != std::vector<std::string>{"R", "G", "B"})
         FACET_THROW("a light tracer splats R, G, B: it cannot fill the colour channels {}",
                     fmt::join(m_colour_names, ", "));
-    // The accumulation buffer (doubles) and the developed image (floats) of every channel.
+    // The accumulation buffer and the developed image (floats) of every channel.
     constexpr uint64_t BudgetBytes = uint64_t(8) << 30;
     const uint64_t pixels = uint64_t(std::max(size.x, 0)) * uint64_t(std::max(size.y, 0));
     const uint64_t channels = channel_count() + (splats ? 3 : 0);
     uint64_t bytes = 0;
-    if (__builtin_mul_overflow(pixels, channels * 12, &bytes) || bytes > BudgetBytes)
+    if (__builtin_mul_overflow(pixels, channels * 8, &bytes) || bytes > BudgetBytes)
         FACET_THROW("a {}x{} film with {} AOV channels needs {:.1f} GiB for its buffers, more "
                     "than the {} GiB budget: lower the resolution, crop it or use fewer AOVs",
                     size.x, size.y, m_aov_names.size(),
-                    double(pixels) * double(channels) * 12.0 / double(1 << 30), BudgetBytes >> 30);
-    m_sums.assign(size_t(pixels) * channel_count(), 0.0);
-    if (splats) m_splats.assign(size_t(pixels) * 3, 0.0);
+                    double(pixels) * double(channels) * 8.0 / double(1 << 30), BudgetBytes >> 30);
+    m_sums.assign(size_t(pixels) * channel_count(), 0.f);
+    if (splats) m_splats.assign(size_t(pixels) * 3, 0.f);
 }
 
 void FilmBuffer::put_splats(const ImageBlock &block) {
@@ -304,8 +304,8 @@ void FilmBuffer::put_splats(const ImageBlock &block) {
             int cx = bx + x;
             if (cx < 0 || cx >= m_size.x) continue;
             const float *src = data + (size_t(y) * s.x + x) * nc;
-            double *dst = m_splats.data() + (size_t(cy) * m_size.x + cx) * 3;
-            for (int c = 0; c < 3; ++c) dst[c] += double(src[c]);
+            float *dst = m_splats.data() + (size_t(cy) * m_size.x + cx) * 3;
+            for (int c = 0; c < 3; ++c) dst[c] += src[c];
         }
     }
 }
@@ -329,8 +329,8 @@ void FilmBuffer::put_block(const ImageBlock &block) {
             int cx = bx + x;
             if (cx < 0 || cx >= m_size.x) continue;
             const float *src = data + (size_t(y) * s.x + x) * nc;
-            double *dst = m_sums.data() + (size_t(cy) * m_size.x + cx) * nc;
-            for (int c = 0; c < nc; ++c) dst[c] += double(src[c]);
+            float *dst = m_sums.data() + (size_t(cy) * m_size.x + cx) * nc;
+            for (int c = 0; c < nc; ++c) dst[c] += src[c];
         }
     }
 }
@@ -347,45 +347,57 @@ std::vector<std::string> FilmBuffer::raw_channel_names() const {
 }
 
 std::vector<float> FilmBuffer::raw_sums() const {
+    if (!m_raw.empty()) return std::vector<float>(m_raw.begin(), m_raw.end());
     const size_t pixels = size_t(m_size.x) * size_t(m_size.y);
     const size_t nc = channel_count(), ns = m_splats.empty() ? 0 : 3, n = nc + ns;
     std::vector<float> out(pixels * n);
     for (size_t i = 0; i < pixels; ++i) {
-        for (size_t c = 0; c < nc; ++c) out[i * n + c] = float(m_sums[i * nc + c]);
-        for (size_t c = 0; c < ns; ++c) out[i * n + nc + c] = float(m_splats[i * 3 + c]);
+        for (size_t c = 0; c < nc; ++c) out[i * n + c] = m_sums[i * nc + c];
+        for (size_t c = 0; c < ns; ++c) out[i * n + nc + c] = m_splats[i * 3 + c];
     }
     return out;
 }
 
 void FilmBuffer::set_raw_sums(const std::vector<double> &raw) {
     const size_t pixels = size_t(m_size.x) * size_t(m_size.y);
-    const size_t nc = channel_count(), ns = m_splats.empty() ? 0 : 3, n = nc + ns;
+    const size_t n = channel_count() + (m_splats.empty() ? 0 : 3);
     if (raw.size() != pixels * n)
         FACET_THROW("FilmBuffer::set_raw_sums: {} values for {} pixels of {} raw channels",
                     raw.size(), pixels, n);
-    for (size_t i = 0; i < pixels; ++i) {
-        for (size_t c = 0; c < nc; ++c) m_sums[i * nc + c] = raw[i * n + c];
-        for (size_t c = 0; c < ns; ++c) m_splats[i * 3 + c] = raw[i * n + nc + c];
-    }
+    m_raw = raw;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Development
 
-void develop_pixel(const double *storage, int values, const double *splat, double splat_scale,
-                   int alpha_at, float *dst) {
-    const bool splatted = splat && (splat[0] != 0.0 || splat[1] != 0.0 || splat[2] != 0.0);
-    const double w = storage ? storage[values] : 0.0;
+namespace {
+
+template <typename T> void develop_sums(const T *storage, int values, const T *splat,
+                                        double splat_scale, int alpha_at, float *dst) {
+    const bool splatted = splat && (splat[0] != 0 || splat[1] != 0 || splat[2] != 0);
+    const double w = storage ? double(storage[values]) : 0.0;
     // Filters with negative lobes can give a negative sum: divide by it all the same (as
     // Mitsuba does); only a pixel without any weight stays 0.
     const double inv = w != 0.0 ? 1.0 / w : 0.0;
     int o = 0;
     for (int c = 0; c < values; ++c) {
         if (c == alpha_at) dst[o++] = w > 0.0 || splatted ? 1.f : 0.f;
-        const double s = c < 3 && splat ? splat[c] * splat_scale : 0.0;
-        dst[o++] = float((storage ? storage[c] * inv : 0.0) + s);
+        const double s = c < 3 && splat ? double(splat[c]) * splat_scale : 0.0;
+        dst[o++] = float((storage ? double(storage[c]) * inv : 0.0) + s);
     }
     if (alpha_at >= values) dst[o] = w > 0.0 || splatted ? 1.f : 0.f;
+}
+
+} // namespace
+
+void develop_pixel(const double *storage, int values, const double *splat, double splat_scale,
+                   int alpha_at, float *dst) {
+    develop_sums(storage, values, splat, splat_scale, alpha_at, dst);
+}
+
+void develop_pixel(const float *storage, int values, const float *splat, double splat_scale,
+                   int alpha_at, float *dst) {
+    develop_sums(storage, values, splat, splat_scale, alpha_at, dst);
 }
 
 std::vector<std::string> Film::colour_channels() const {
@@ -404,12 +416,21 @@ Image Film::develop(const FilmBuffer &buffer) const {
     img.channel_names = colours;
     if (m_alpha) img.channel_names.push_back("A");
     img.channel_names.insert(img.channel_names.end(), aovs.begin(), aovs.end());
-    const std::vector<double> &sums = buffer.sums(), &splats = buffer.splats();
+    const std::vector<float> &sums = buffer.sums(), &splats = buffer.splats();
+    const std::vector<double> &raw = buffer.raw();
     const int alpha_at = m_alpha ? int(colours.size()) : -1;
-    for (size_t i = 0, n = size_t(buffer.size().x) * size_t(buffer.size().y); i < n; ++i)
-        develop_pixel(sums.data() + i * nc, values,
-                      splats.empty() ? nullptr : splats.data() + i * 3, buffer.splat_scale(),
-                      alpha_at, img.data.data() + i * size_t(img.channels));
+    const size_t nraw = nc + (splats.empty() ? 0 : 3);
+    for (size_t i = 0, n = size_t(buffer.size().x) * size_t(buffer.size().y); i < n; ++i) {
+        float *dst = img.data.data() + i * size_t(img.channels);
+        if (!raw.empty())
+            develop_pixel(raw.data() + i * nraw, values,
+                          splats.empty() ? nullptr : raw.data() + i * nraw + nc,
+                          buffer.splat_scale(), alpha_at, dst);
+        else
+            develop_pixel(sums.data() + i * nc, values,
+                          splats.empty() ? nullptr : splats.data() + i * 3, buffer.splat_scale(),
+                          alpha_at, dst);
+    }
     return img;
 }
 

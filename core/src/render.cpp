@@ -514,6 +514,8 @@ RenderResult RenderJob::finish(const WorkUnitsRun &run, size_t units_per_pass, s
     RenderResult result;
     result.blocks_total = units_per_pass * passes;
     result.blocks_done = m_merger->merged();
+    // The blocks' memory (a pass of them waits for its last one) goes before the image comes.
+    m_merger.reset();
     result.first_block_cpu_seconds = run.first_unit_cpu_seconds;
     result.cancelled = passes_done < passes;
     result.timed_out = result.cancelled && run.timed_out;

@@ -110,7 +110,7 @@ public:
     const std::vector<std::string> &colour_names() const { return m_colour_names; }
     const std::vector<std::string> &aov_names() const { return m_aov_names; }
     bool has_splats() const { return !m_splats.empty(); }
-    /// Doubles per pixel of sums(): the colours, the AOVs, weight.
+    /// Floats per pixel of sums(): the colours, the AOVs, weight.
     size_t channel_count() const { return m_colour_names.size() + m_aov_names.size() + 1; }
 
     /// Adds a finished block (the render loop calls this in a fixed order). Pixels outside the
@@ -124,10 +124,11 @@ public:
     void set_splat_scale(double scale) { m_splat_scale = scale; }
     double splat_scale() const { return m_splat_scale; }
 
-    /// channel_count() sums per window pixel, in scanline order.
-    const std::vector<double> &sums() const { return m_sums; }
+    /// channel_count() sums per window pixel, in scanline order (float, as the blocks: half
+    /// the memory of doubles; a pass adds each pixel's blocks in a fixed order).
+    const std::vector<float> &sums() const { return m_sums; }
     /// 3 splat sums per window pixel (empty without a splat buffer).
-    const std::vector<double> &splats() const { return m_splats; }
+    const std::vector<float> &splats() const { return m_splats; }
 
     /// Raw channels: the sums the window is developed from, named "facet.sum.<colour>" (R, G, B
     /// or the film's bands), "facet.sum.<aov>" (Σ w·value over the samples that reach the pixel
@@ -139,14 +140,17 @@ public:
     /// The raw channels of every window pixel, rounded to float (raw_channel_names() per pixel).
     std::vector<float> raw_sums() const;
     /// Replaces the sums (and splats) by `raw`, raw_channel_names() doubles per pixel: the sums
-    /// of several passes added up, developed once.
+    /// of several passes added up, developed once. They are kept in double (raw()).
     void set_raw_sums(const std::vector<double> &raw);
+    /// The sums set_raw_sums() gave (empty: none), which development takes instead of sums().
+    const std::vector<double> &raw() const { return m_raw; }
 
 private:
     Point2i m_offset, m_size;
     std::vector<std::string> m_colour_names, m_aov_names;
-    std::vector<double> m_sums;   ///< channel_count() per window pixel
-    std::vector<double> m_splats; ///< 3 per window pixel (empty: none)
+    std::vector<float> m_sums;   ///< channel_count() per window pixel
+    std::vector<float> m_splats; ///< 3 per window pixel (empty: none)
+    std::vector<double> m_raw;   ///< set_raw_sums()
     double m_splat_scale = 1.0;
 };
 
@@ -256,6 +260,9 @@ inline constexpr const char *RawChannelPrefix = "facet.";
 /// divided by Σ w to `dst`, with the alpha (1 where the pixel has a weight or a splat) inserted
 /// before value `alpha_at` (none: -1).
 void develop_pixel(const double *storage, int values, const double *splat, double splat_scale,
+                   int alpha_at, float *dst);
+/// The same from float sums (a FilmBuffer's), in double arithmetic.
+void develop_pixel(const float *storage, int values, const float *splat, double splat_scale,
                    int alpha_at, float *dst);
 
 } // namespace facet
