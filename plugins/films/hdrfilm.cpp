@@ -18,7 +18,7 @@ everything (float16 or float32, AOV channels, metadata); `.hdr`/`.rgbe`/`.pfm` k
 | pixel_format | string | rgb | rgb, rgba, luminance, luminance_alpha, xyz or xyza |
 | component_format | string | float16 | float16 or float32 (EXR sample type) |
 | sample_border | boolean | false | Accepted for compatibility; facet always samples the pixels whose filter footprint reaches the crop window, so a crop's pixels equal those of the full image |
-| compensate | boolean | false | Accepted for compatibility; the film always accumulates in double precision |
+| compensate | boolean | false | Accepted for compatibility, no effect: a pixel's sums are float, each pass's added in a fixed order, and the passes of a split render are added in double |
 | high_quality_edges | boolean | false | Mitsuba 0.6 name of sample_border; accepted, no effect |
 | banner | boolean | false | Mitsuba 0.6 parameter; accepted, no effect |
 | attach_log | boolean | false | Mitsuba 0.6 parameter; accepted, no effect |

@@ -27,7 +27,7 @@ RGB and are refused with it, and so is a sensor's own `srf`.
 | crop_height | integer | height - crop_offset_y | Height of the crop window |
 | component_format | string | float16 | float16 or float32 (EXR sample type) |
 | sample_border | boolean | false | Accepted for compatibility (as hdrfilm's) |
-| compensate | boolean | false | Accepted for compatibility; the film always accumulates in double precision |
+| compensate | boolean | false | Accepted for compatibility, no effect: a pixel's sums are float, each pass's added in a fixed order, and the passes of a split render are added in double |
 | (spectra) | spectrum | — | One or more SRFs: `<spectrum name="..." value="λ:v, ..."/>`, `filename="x.spd"`, or a spectrum plugin (`regular`, `irregular`, `uniform`, ...) |
 | (rfilter) | rfilter | gaussian | Nested reconstruction filter |
 
