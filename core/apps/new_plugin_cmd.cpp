@@ -650,6 +650,7 @@ facet's base film and scales the colour by 2^`exposure` (photographic stops) bef
 | crop_offset_y | integer | 0 | Top row of the crop window |
 | crop_width | integer | width - crop_offset_x | Width of the crop window |
 | crop_height | integer | height - crop_offset_y | Height of the crop window |
+| component_format | string | float16 | float16 or float32 (EXR sample type; read by the base class) |
 | exposure | float | 0 | Exposure in stops: the colour is multiplied by 2^exposure |
 | (rfilter) | rfilter | gaussian | Nested reconstruction filter |
 
@@ -662,8 +663,8 @@ facet's base film and scales the colour by 2^`exposure` (photographic stops) bef
 ```
 )DOC";
 
-// Conventions (facet/film.h): the base class reads the size, the crop window and the nested
-// rfilter, and develops a render's pixel sums (a FilmBuffer the render owns: the film is only
+// Conventions (facet/film.h): the base class reads the size, the crop window, the component
+// format and the nested rfilter, and develops a render's pixel sums (a FilmBuffer the render owns: the film is only
 // read, by any number of renders at once) into linear RGB, alpha, then the AOVs of the render. A
 // film changes what develop() returns or how write() stores it. A render of several passes in
 // one process or a merge develops the pass sums with the base class's Film::develop(), not this

@@ -4,6 +4,7 @@
 #include <facet/plugin.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 namespace facet {
@@ -90,31 +91,24 @@ inline void add_values(float *p, float w, const float *values, int n) {
 
 } // namespace
 
-void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
-                     const ReconstructionFilter &filter) {
-    FACET_ASSERT(m_colour_count == 3);
+inline bool ImageBlock::single_pixel(const Point2f &pos, float c, float *&pixel) {
     // A filter whose weight is a constant c on [-1/2, 1/2) and 0 elsewhere (the box), at film
     // positions in [0, 2^22) (every sample of a film, short of absurd sizes): there pos - 0.5
     // and its offset from any pixel are exact in float, so the one pixel of the footprint with
     // a non-zero weight is floor(pos), the pixel the sample lies in, with the weight c·c.
-    // put_footprint() takes the rest, with the same weights.
-    const float c = filter.table().single_pixel_weight();
-    if (c != 0.f && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
-        const Point2i s = storage_size();
-        const int x = int(pos.x) - (m_offset.x - m_border),
-                  y = int(pos.y) - (m_offset.y - m_border);
-        if (x >= 0 && x < s.x && y >= 0 && y < s.y)
-            add_sample(m_data.data() +
-                           (size_t(y) * size_t(s.x) + size_t(x)) * size_t(channel_count()),
-                       c * c, L, aovs, m_aov_count);
-        return;
-    }
-    put_footprint(pos, L, aovs, filter);
+    if (!(c != 0.f && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f))
+        return false;
+    const Point2i s = storage_size();
+    const int x = int(pos.x) - (m_offset.x - m_border), y = int(pos.y) - (m_offset.y - m_border);
+    pixel = x >= 0 && x < s.x && y >= 0 && y < s.y
+                ? m_data.data() + (size_t(y) * size_t(s.x) + size_t(x)) * size_t(channel_count())
+                : nullptr;
+    return true;
 }
 
-__attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, const Color3f &L,
-                                                         const float *aovs,
-                                                         const ReconstructionFilter &filter) {
+template <typename Add>
+inline void ImageBlock::for_each_footprint_pixel(const Point2f &pos,
+                                                 const ReconstructionFilter &filter, Add add) {
     const Point2i s = storage_size();
     const int nc = channel_count();
     Footprint fp;
@@ -125,44 +119,39 @@ __attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, con
         float *row = m_data.data() + (size_t(fp.y0) + j) * size_t(s.x) * nc;
         for (size_t i = 0; i < fp.nx; ++i) {
             const float w = m_wx[i] * wy;
-            if (w != 0.f) add_sample(row + (size_t(fp.x0) + i) * nc, w, L, aovs, m_aov_count);
+            if (w != 0.f) add(row + (size_t(fp.x0) + i) * nc, w);
         }
     }
+}
+
+void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
+                     const ReconstructionFilter &filter) {
+    FACET_ASSERT(m_colour_count == 3);
+    // The box's one pixel here; put_footprint() takes the rest, with the same weights.
+    const float c = filter.table().single_pixel_weight();
+    if (float *p; single_pixel(pos, c, p)) {
+        if (p) add_sample(p, c * c, L, aovs, m_aov_count);
+        return;
+    }
+    put_footprint(pos, L, aovs, filter);
+}
+
+__attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, const Color3f &L,
+                                                         const float *aovs,
+                                                         const ReconstructionFilter &filter) {
+    for_each_footprint_pixel(pos, filter,
+                             [&](float *p, float w) { add_sample(p, w, L, aovs, m_aov_count); });
 }
 
 void ImageBlock::put_values(const Point2f &pos, const float *values,
                             const ReconstructionFilter &filter) {
     const int n = m_colour_count + m_aov_count;
-    // The box's one pixel, as put() finds it.
     const float c = filter.table().single_pixel_weight();
-    if (c != 0.f && pos.x >= 0.f && pos.x < 4194304.f && pos.y >= 0.f && pos.y < 4194304.f) {
-        const Point2i s = storage_size();
-        const int x = int(pos.x) - (m_offset.x - m_border),
-                  y = int(pos.y) - (m_offset.y - m_border);
-        if (x >= 0 && x < s.x && y >= 0 && y < s.y)
-            add_values(m_data.data() +
-                           (size_t(y) * size_t(s.x) + size_t(x)) * size_t(channel_count()),
-                       c * c, values, n);
+    if (float *p; single_pixel(pos, c, p)) {
+        if (p) add_values(p, c * c, values, n);
         return;
     }
-    put_values_footprint(pos, values, filter);
-}
-
-void ImageBlock::put_values_footprint(const Point2f &pos, const float *values,
-                                      const ReconstructionFilter &filter) {
-    const Point2i s = storage_size();
-    const int nc = channel_count(), n = m_colour_count + m_aov_count;
-    Footprint fp;
-    if (!footprint(pos, filter, fp)) return;
-    for (size_t j = 0; j < fp.ny; ++j) {
-        const float wy = m_wy[j];
-        if (wy == 0.f) continue;
-        float *row = m_data.data() + (size_t(fp.y0) + j) * size_t(s.x) * nc;
-        for (size_t i = 0; i < fp.nx; ++i) {
-            const float w = m_wx[i] * wy;
-            if (w != 0.f) add_values(row + (size_t(fp.x0) + i) * nc, w, values, n);
-        }
-    }
+    for_each_footprint_pixel(pos, filter, [&](float *p, float w) { add_values(p, w, values, n); });
 }
 
 void ImageBlock::splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter) {
@@ -239,6 +228,23 @@ Film::Film(const Properties &props) {
             "{}x{} film",
             ox, oy, cw, ch, m_size.x, m_size.y);
     m_crop_size = {int(cw), int(ch)};
+
+    // Far above real renders (16384x8192); a hostile size fails here, not in the allocator.
+    constexpr int64_t MaxPixels = int64_t(1) << 27;
+    if (int64_t(m_size.x) * int64_t(m_size.y) > MaxPixels)
+        FACET_THROW_AT(props.location(),
+                       "the film is {}x{} pixels, more than the {} pixels (2^27, e.g. 16384x8192) "
+                       "{} supports",
+                       m_size.x, m_size.y, MaxPixels, props.plugin_name());
+    std::string format = props.get_string("component_format", "float16");
+    std::transform(format.begin(), format.end(), format.begin(),
+                   [](unsigned char ch) { return char(std::tolower(ch)); });
+    if (format == "float16" || format == "float32")
+        m_half = format == "float16";
+    else
+        FACET_THROW_AT(props.location("component_format"),
+                       "component_format must be float16 or float32, got \"{}\"{}", format,
+                       format == "uint32" ? " (uint32 is not supported)" : "");
 
     for (const auto &[name, obj] : props.objects()) {
         if (!obj || obj->type() != ObjectType::ReconstructionFilter) continue;

@@ -48,15 +48,6 @@ public:
     enum class PixelFormat { RGB, RGBA, Luminance, LuminanceAlpha, XYZ, XYZA };
 
     explicit HDRFilm(const Properties &props) : Film(props) {
-        // Far above real renders (16384x8192); a hostile size fails here, not in the allocator.
-        constexpr int64_t MaxPixels = int64_t(1) << 27;
-        int64_t pixels = 0;
-        if (__builtin_mul_overflow(int64_t(m_size.x), int64_t(m_size.y), &pixels) ||
-            pixels > MaxPixels)
-            FACET_THROW_AT(props.location(),
-                           "the film is {}x{} pixels, more than the {} pixels (2^27, e.g. "
-                           "16384x8192) hdrfilm supports",
-                           m_size.x, m_size.y, MaxPixels);
         std::string file_format = lower(props.get_string("file_format", "openexr"));
         if (file_format == "openexr" || file_format == "exr")
             m_extension = ".exr";
@@ -91,17 +82,6 @@ public:
         m_alpha = m_pixel_format == PixelFormat::RGBA ||
                   m_pixel_format == PixelFormat::LuminanceAlpha ||
                   m_pixel_format == PixelFormat::XYZA;
-
-        std::string component_format = lower(props.get_string("component_format", "float16"));
-        if (component_format == "float16")
-            m_half = true;
-        else if (component_format == "float32")
-            m_half = false;
-        else
-            FACET_THROW_AT(props.location("component_format"),
-                           "component_format must be float16 or float32, got \"{}\"{}",
-                           component_format,
-                           component_format == "uint32" ? " (uint32 is not supported)" : "");
 
         // Compatibility switches without an effect in facet (see the table above).
         props.get_bool("sample_border", false);

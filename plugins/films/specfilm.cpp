@@ -62,24 +62,6 @@ namespace facet {
 class SpecFilm final : public Film {
 public:
     explicit SpecFilm(const Properties &props) : Film(props) {
-        constexpr int64_t MaxPixels = int64_t(1) << 27;
-        int64_t pixels = 0;
-        if (__builtin_mul_overflow(int64_t(m_size.x), int64_t(m_size.y), &pixels) ||
-            pixels > MaxPixels)
-            FACET_THROW_AT(props.location(),
-                           "the film is {}x{} pixels, more than the {} pixels (2^27, e.g. "
-                           "16384x8192) specfilm supports",
-                           m_size.x, m_size.y, MaxPixels);
-        const std::string component_format = lower(props.get_string("component_format", "float16"));
-        if (component_format == "float16")
-            m_half = true;
-        else if (component_format == "float32")
-            m_half = false;
-        else
-            FACET_THROW_AT(props.location("component_format"),
-                           "component_format must be float16 or float32, got \"{}\"{}",
-                           component_format,
-                           component_format == "uint32" ? " (uint32 is not supported)" : "");
         props.get_bool("sample_border", false);
         props.get_bool("compensate", false);
         m_bands = read_bands(props);

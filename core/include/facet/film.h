@@ -81,9 +81,13 @@ private:
     /// shortcut: out of line, so that put()'s shortcut saves no registers.
     void put_footprint(const Point2f &pos, const Color3f &L, const float *aovs,
                        const ReconstructionFilter &filter);
-    /// put_values() over the footprint.
-    void put_values_footprint(const Point2f &pos, const float *values,
-                              const ReconstructionFilter &filter);
+    /// For a box filter of constant weight `c` (single_pixel_weight(), 0 for other filters) at
+    /// an ordinary film position: true, with the one pixel the sample reaches (null: outside
+    /// the block). False: the footprint decides.
+    bool single_pixel(const Point2f &pos, float c, float *&pixel);
+    /// add(pixel, weight) for each pixel of the sample's footprint with a non-zero weight.
+    template <typename Add>
+    void for_each_footprint_pixel(const Point2f &pos, const ReconstructionFilter &filter, Add add);
 
     std::vector<float> m_wx, m_wy; ///< scratch filter weights, reused
 };
@@ -208,8 +212,8 @@ private:
 /// description during a render. The `hdrfilm` plugin derives from it.
 class Film : public Object {
 public:
-    /// Reads width (768), height (576), crop_offset_x/y, crop_width/height and the nested rfilter
-    /// (default gaussian).
+    /// Reads width (768), height (576; at most 2^27 pixels), crop_offset_x/y, crop_width/height,
+    /// component_format (float16 or float32) and the nested rfilter (default gaussian).
     explicit Film(const Properties &props);
     ObjectType type() const override { return ObjectType::Film; }
 
