@@ -356,10 +356,7 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     const int band_count = bands ? int(bands->size()) : 0;
     const int aov_count = int(aovs.size()) - 1 - band_count;
     float *const aov_values = aovs.data() + band_count;
-    if (bands)
-        block.reset(offset, size, grid.border, aov_count, band_count);
-    else
-        block.reset(offset, size, grid.border, aov_count);
+    block.reset(offset, size, grid.border, aov_count, bands ? band_count : 3);
     const int x0 = std::max(offset.x, grid.x0), x1 = std::min(offset.x + size.x, grid.x1);
     const int y0 = std::max(offset.y, grid.y0), y1 = std::min(offset.y + size.y, grid.y1);
     const ReconstructionFilter &filter = m_film.rfilter();

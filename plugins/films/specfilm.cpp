@@ -11,9 +11,9 @@ OpenEXR only.
 The paths' wavelengths are drawn from the sum of the SRFs (four per path, stratified), tabulated
 on a regular grid from the smallest to the largest wavelength the spectra are given at (the whole
 range for a spectrum not given at wavelengths, such as a constant or `blackbody`), at the finest
-spacing of their wavelengths and at least every nanometre, so every band gets samples and no
-wavelength outside all bands is traced. Parts of
-an SRF outside 360-830 nm are not rendered (facet's spectral range). Light tracers (`ptracer`)
+spacing of their wavelengths and at least every nanometre, so every band gets samples and
+wavelengths outside all bands are traced only in short stretches next to a band's edge. Parts
+of an SRF outside 360-830 nm are not rendered (facet's spectral range). Light tracers (`ptracer`)
 cannot render into bands; the `aov` integrator's albedo, `moment` and `stokes` develop their own
 RGB and are refused with it, and so is a sensor's own `srf`.
 
