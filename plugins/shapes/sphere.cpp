@@ -118,36 +118,40 @@ public:
     }
 
     DirectionSample sample_direction(const Interaction &ref, const Point2f &u) const override {
-        double one_minus_cos_max;
-        if (!sees_cone(ref, one_minus_cos_max))
+        double one_minus_cos_max, dist2;
+        if (!sees_cone(ref, one_minus_cos_max, dist2))
             return Shape::sample_direction(ref, u); // inside: every point is visible
 
         // Uniform direction in the cone around the axis towards the centre, in double so that
-        // small distant spheres keep their precision.
-        Vector3d axis = Vector3d(m_center) - Vector3d(ref.p);
-        double dist = norm(axis);
-        axis /= dist;
-        double x = double(u.x) * one_minus_cos_max;
-        double cos_theta = 1.0 - x, sin2_theta = x * (2.0 - x);
-        double sin_theta = std::sqrt(std::max(sin2_theta, 0.0));
-        double phi = 2.0 * 3.14159265358979323846 * double(u.y);
+        // small distant spheres keep their precision. The angle around the axis needs no more
+        // than float: its rounding moves the point by a float's part of the cone's width.
+        const double dist = std::sqrt(dist2);
+        const Vector3d axis = (Vector3d(m_center) - Vector3d(ref.p)) * (1.0 / dist);
+        const double x = double(u.x) * one_minus_cos_max;
+        const double cos_theta = 1.0 - x, sin2_theta = x * (2.0 - x);
+        const double sin_theta = std::sqrt(std::max(sin2_theta, 0.0));
+        const float phi = 2.f * Pi * u.y;
+        const double cos_phi = double(std::cos(phi)), sin_phi = double(std::sin(phi));
         Vector3d s, t;
         build_basis(axis, s, t);
-        Vector3d d =
-            s * (sin_theta * std::cos(phi)) + t * (sin_theta * std::sin(phi)) + axis * cos_theta;
+        const Vector3d d = s * (sin_theta * cos_phi) + t * (sin_theta * sin_phi) + axis * cos_theta;
         // Nearest intersection of ref + τ·d with the sphere.
-        double r2 = double(m_radius) * double(m_radius);
-        double disc = std::max(r2 - dist * dist * sin2_theta, 0.0);
-        double tau = dist * cos_theta - std::sqrt(disc);
+        const double r = double(m_radius);
+        const double disc = std::max(r * r - dist2 * sin2_theta, 0.0);
+        const double tau = dist * cos_theta - std::sqrt(disc);
 
         DirectionSample ds;
         ds.emitter = m_emitter.get();
         if (!(tau > 0.0)) return ds;
-        Vector3d hit = Vector3d(ref.p) + d * tau - Vector3d(m_center);
-        Vector3f dir = Vector3f(hit / norm(hit));
+        // The point lies on the sphere to double rounding: its offset over the radius is the
+        // unit normal (to float precision, as normalising it would give).
+        const Vector3f dir = Vector3f((Vector3d(ref.p) + d * tau - Vector3d(m_center)) * (1.0 / r));
         ds.p = m_center + dir * m_radius;
         ds.n = m_flip_normals ? -dir : dir;
-        ds.uv = spherical_uv(object_direction(dir));
+        // The uv only for whom reads it: a light whose radiance varies over the surface (a
+        // uniform one, the common case, ignores it), or a caller without a light.
+        if (!m_emitter || has_flag(m_emitter->flags(), EmitterFlags::SpatiallyVarying))
+            ds.uv = spherical_uv(object_direction(dir));
         ds.d = ds.p - ref.p;
         ds.dist = norm(ds.d);
         if (!(ds.dist > 0.f)) return ds;
@@ -157,8 +161,8 @@ public:
     }
 
     float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
-        double one_minus_cos_max;
-        if (!sees_cone(ref, one_minus_cos_max)) return Shape::pdf_direction(ref, ds);
+        double one_minus_cos_max, dist2;
+        if (!sees_cone(ref, one_minus_cos_max, dist2)) return Shape::pdf_direction(ref, ds);
         return cone_pdf(one_minus_cos_max);
     }
 
@@ -211,9 +215,10 @@ private:
     }
 
     /// Whether `ref` samples the sphere by its cone of directions (it lies outside), and the
-    /// cone's 1 - cos θmax. Points on the surface count as outside unless the normals are flipped.
-    bool sees_cone(const Interaction &ref, double &one_minus_cos_max) const {
-        double dist2 = squared_norm(Vector3d(m_center) - Vector3d(ref.p));
+    /// cone's 1 - cos θmax and the squared distance to the centre. Points on the surface count
+    /// as outside unless the normals are flipped.
+    bool sees_cone(const Interaction &ref, double &one_minus_cos_max, double &dist2) const {
+        dist2 = squared_norm(Vector3d(m_center) - Vector3d(ref.p));
         double r2 = double(m_radius) * double(m_radius);
         double threshold = r2 * (m_flip_normals ? 1.0 + 2e-4 : 1.0 - 2e-4);
         if (!(dist2 > threshold)) return false;

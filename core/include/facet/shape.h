@@ -61,7 +61,9 @@ public:
     virtual float pdf_position(const PositionSample &ps) const { return 1.f / surface_area(); }
 
     /// A point on the surface seen from `ref`, with a solid-angle pdf. The default converts
-    /// sample_position(); shapes with a better strategy (spheres) override both.
+    /// sample_position(); shapes with a better strategy (spheres) override both. An override
+    /// may leave the sample's uv at zero when the shape's emitter is not SpatiallyVarying (its
+    /// radiance does not read it).
     virtual DirectionSample sample_direction(const Interaction &ref, const Point2f &u) const;
     virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const;
 
