@@ -77,7 +77,12 @@ public:
         std::string filename = props.get_string("filename");
         m_path = file_resolver().resolve(filename);
         m_scale = float(props.get_float("scale", 1.0));
-        m_to_world = props.get_transform("to_world", Transform());
+        const Transform to_world = props.get_transform("to_world", Transform());
+        for (int r = 0; r < 3; ++r) {
+            const auto &m = to_world.matrix.m, &inv = to_world.inverse_matrix.m;
+            m_world_rows[r] = Vector3f(m[r][0], m[r][1], m[r][2]);
+            m_local_rows[r] = Vector3f(inv[r][0], inv[r][1], inv[r][2]);
+        }
         m_mis_compensation = props.get_bool("mis_compensation", false);
         std::string filter = props.get_string("filter_type", "bilinear");
         if (filter != "bilinear" && filter != "nearest")
@@ -151,14 +156,14 @@ public:
         DirectionSample ds;
         Vector3f local =
             sampling_enabled() ? uv_to_direction(sample_uv(u)) : warp::square_to_uniform_sphere(u);
-        ds.d = normalize(m_to_world.apply_vector(local));
+        ds.d = to_world(local);
         ds.dist = Infinity;
         ds.p = ref.p + ds.d * (2.f * m_radius + norm(ref.p - m_center));
         ds.n = -ds.d;
         ds.emitter = this;
         // Density and radiance of the direction as pdf_direction() and eval() will see it, so
         // the three agree to the last bit even where rounding moves it across a cell border.
-        local = normalize(m_to_world.inverse().apply_vector(ds.d));
+        local = to_local(ds.d);
         const GridPoint g = grid_point(local); // one atan2 and acos for both
         ds.pdf = pdf_local(local, g);
         if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
@@ -167,7 +172,7 @@ public:
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
         if (!sampling_enabled()) return InvFourPi;
-        const Vector3f local = normalize(m_to_world.inverse().apply_vector(ds.d));
+        const Vector3f local = to_local(ds.d);
         return pdf_local(local, grid_point(local));
     }
 
@@ -178,8 +183,8 @@ public:
                                        const Wavelengths &wavelengths) const override {
         Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir))
                                             : warp::square_to_uniform_sphere(u_dir);
-        const Vector3f from = normalize(m_to_world.apply_vector(local));
-        local = normalize(m_to_world.inverse().apply_vector(from));
+        const Vector3f from = to_world(local);
+        local = to_local(from);
         const GridPoint g = grid_point(local);
         const float pdf = pdf_local(local, g);
         if (!(pdf > 0.f)) return {Ray(), Color3f(0.f)};
@@ -194,7 +199,7 @@ public:
 
     Color3f eval(const SurfaceInteraction &si) const override {
         // si is the record of a ray that left the scene: wi points back along it (local frame).
-        Vector3f local = normalize(m_to_world.inverse().apply_vector(-si.to_world(si.wi)));
+        const Vector3f local = to_local(-si.to_world(si.wi));
         return radiance(grid_point(local), si.wavelengths);
     }
 
@@ -208,6 +213,14 @@ public:
     }
 
 private:
+    /// The map's frame (to_world's rotation), applied inline: every direction of a sample, a
+    /// density and a lookup passes through it, with the arithmetic of Transform::apply_vector().
+    static Vector3f rotate(const Vector3f (&rows)[3], const Vector3f &v) {
+        return normalize(Vector3f(dot(rows[0], v), dot(rows[1], v), dot(rows[2], v)));
+    }
+    Vector3f to_world(const Vector3f &local) const { return rotate(m_world_rows, local); }
+    Vector3f to_local(const Vector3f &world) const { return rotate(m_local_rows, world); }
+
     /// uv in [0,1]²: u = atan2(x, -z)/2π around +Y from -Z towards +X, v = θ/π from +Y.
     static Point2f direction_to_uv(const Vector3f &d) {
         float u = fast_atan2(d.x, -d.z) * InvTwoPi;
@@ -422,7 +435,7 @@ private:
 
     std::string m_path;
     float m_scale = 1.f;
-    Transform m_to_world;
+    Vector3f m_world_rows[3], m_local_rows[3]; ///< to_world's 3x3 part and its inverse's, by rows
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
     std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels and the sampling table
