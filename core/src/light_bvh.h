@@ -1,9 +1,10 @@
-// The scene's light hierarchy: a binary tree over the emitters that have bounds (LightBounds),
-// which picks an emitter for a point in proportion to a bound of its importance there (power
-// over squared distance, times the best cosines the bounds allow), choosing a child at each
-// node. Emitters that cannot reach the point get nothing; far, dim or turned-away ones little.
-// The probability of an emitter for a point is recomputed along the emitter's path from the
-// root with the same arithmetic, so that sampling and pmf() agree to the last bit.
+// The scene's light hierarchy: a tree over the emitters that have bounds (LightBounds), four
+// children per node, which picks an emitter for a point in proportion to a bound of its
+// importance there (power over squared distance, times the best cosines the bounds allow),
+// choosing a child at each node. Emitters that cannot reach the point get nothing; far, dim or
+// turned-away ones little. The probability of an emitter for a point is recomputed along the
+// emitter's path from the root with the same arithmetic, so that sampling and pmf() agree to the
+// last bit.
 #pragma once
 
 #include <facet/emitter.h>
@@ -28,29 +29,37 @@ public:
     /// one that is not in the tree.
     float pmf(const Point3f &p, const Normal3f &n, uint32_t index) const;
 
+    /// Children per node: the importances of a node's children are computed together, one
+    /// child per lane of a 4-wide vector.
+    static constexpr int Arity = 4;
+
 private:
-    /// A node's bounds, as the importance reads them.
-    struct Node {
-        Point3f center;     ///< of the bounding box
-        float radius = 0;   ///< of the box's bounding sphere
-        float radius2 = 0;  ///< its square
-        Vector3f axis;      ///< of the normals' cone
-        float cos_normals;  ///< of the normals' cone's half-angle
-        float sin_normals;  ///< of the same
-        float cos_emission; ///< of the emission's spread beyond the normals
-        float power = 0;
-        bool two_sided = false;
-        bool leaf = false;
-        /// Inner: the second child (the first follows the node); leaf: the scene index.
-        uint32_t child = 0;
+    /// A node: the bounds of its (up to four) children, as the importance reads them, one
+    /// array per quantity (a lane per child). An unused slot has power 0.
+    struct alignas(16) Node {
+        float cx[Arity], cy[Arity], cz[Arity]; ///< centre of the child's bounding box
+        float radius[Arity];                   ///< of the box's bounding sphere
+        float radius2[Arity];                  ///< its square
+        float ax[Arity], ay[Arity], az[Arity]; ///< axis of the normals' cone
+        float cos_normals[Arity];              ///< of the normals' cone's half-angle
+        float sin_normals[Arity];              ///< of the same
+        float cos_emission[Arity];             ///< of the emission's spread beyond the normals
+        float power[Arity];
+        float two_sided[Arity]; ///< 1 for a two-sided child, else 0
+        /// Inner child: its node; leaf child: the emitter's scene index.
+        uint32_t child[Arity];
+        uint8_t count = 0; ///< slots in use (the first ones)
+        uint8_t leaf = 0;  ///< bit k: slot k is an emitter
     };
-    static float importance(const Node &node, const Point3f &p, const Normal3f &n);
+    /// The importances of a node's children for (p, n).
+    static void importance(const Node &node, const Point3f &p, const Normal3f &n,
+                           float (&out)[Arity]);
     uint32_t build_range(std::vector<std::pair<uint32_t, LightBounds>> &items, size_t begin,
-                         size_t end, uint64_t bits, int depth);
+                         size_t end, uint64_t path, int depth);
 
     std::vector<Node> m_nodes;
-    /// Per scene index: the emitter's path from the root (bit k: the second child at depth k)
-    /// and its depth; depth -1 for an emitter not in the tree.
+    /// Per scene index: the emitter's path from the root (two bits per level: the slot taken
+    /// at depth k in bits 2k and 2k+1) and its depth; depth -1 for an emitter not in the tree.
     std::vector<std::pair<uint64_t, int>> m_paths;
 };
 
