@@ -39,23 +39,21 @@ namespace facet {
 
 namespace {
 
-/// OpenEXR's output into memory: replace_image_file() writes the file and checks every step.
-class MemoryStream : public Imf::OStream {
+/// OpenEXR's output, straight into the file replace_image_file() writes and checks.
+class SinkStream : public Imf::OStream {
 public:
-    explicit MemoryStream(std::vector<unsigned char> &bytes)
-        : Imf::OStream("memory"), m_bytes(bytes) {}
+    explicit SinkStream(const detail::ByteSink &sink) : Imf::OStream("file"), m_sink(sink) {}
     void write(const char c[], int n) override {
         if (n <= 0) return;
-        if (m_pos + size_t(n) > m_bytes.size()) m_bytes.resize(m_pos + size_t(n));
-        std::memcpy(m_bytes.data() + m_pos, c, size_t(n));
-        m_pos += size_t(n);
+        m_sink.write_at(c, size_t(n), m_pos);
+        m_pos += uint64_t(n);
     }
     uint64_t tellp() override { return m_pos; }
-    void seekp(uint64_t pos) override { m_pos = size_t(pos); }
+    void seekp(uint64_t pos) override { m_pos = pos; }
 
 private:
-    std::vector<unsigned char> &m_bytes;
-    size_t m_pos = 0;
+    const detail::ByteSink &m_sink;
+    uint64_t m_pos = 0;
 };
 
 /// The channels of a developed film's colour (and alpha), as opposed to AOV channels.
@@ -190,40 +188,59 @@ void write_exr(const std::string &path, const Image &image, const ImageWriteOpti
             types[c] = Imf::HALF;
     }
 
-    std::vector<unsigned char> bytes;
-    try {
-        // OpenEXR compresses blocks of 16 rows; large images on all cores, as OpenImageIO did.
-        static const bool threads = [] {
+    // OpenEXR compresses blocks of 16 rows: large images on all cores, as OpenImageIO did; a
+    // small one (a render's typical preview or test) on this thread, without starting a pool
+    // of threads (each with its own heap: 0.3 MiB at the end of a render, its peak of memory).
+    int threads = 0;
+    if (size_t(image.width) * size_t(image.height) >= (size_t(1) << 20)) {
+        static const int pool = [] {
             Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
-            return true;
+            return Imf::globalThreadCount();
         }();
-        (void)threads;
-        // OpenEXR writes slices of the channel's own type: the half channels are rounded here,
-        // interleaved like the image.
-        const size_t npix = size_t(image.width) * size_t(image.height);
-        std::vector<size_t> half_of; // the image channel of each half one
-        for (size_t c = 0; c < types.size(); ++c)
-            if (types[c] == Imf::HALF) half_of.push_back(c);
-        const size_t nhalf = half_of.size();
-        std::vector<Imath::half> halves(npix * nhalf);
-        for (size_t i = 0; i < npix; ++i)
-            for (size_t h = 0; h < nhalf; ++h)
-                halves[i * nhalf + h] =
-                    Imath::half(image.data[i * size_t(image.channels) + half_of[h]]);
-        Imf::FrameBuffer fb = frame_buffer(image, names, image.data.data(), image.y, image.height);
-        for (size_t h = 0; h < nhalf; ++h)
-            fb.insert(names[half_of[h]],
-                      Imf::Slice::Make(Imf::HALF, halves.data() + h, Imath::V2i(image.x, image.y),
-                                       image.width, image.height, sizeof(Imath::half) * nhalf,
-                                       sizeof(Imath::half) * nhalf * image.width));
-        MemoryStream stream(bytes);
-        Imf::OutputFile out(stream, exr_header(image, names, types, opts));
-        out.setFrameBuffer(fb);
-        out.writePixels(image.height);
-    } catch (const std::exception &e) {
-        FACET_THROW("cannot write image \"{}\": {}", path, e.what());
+        threads = pool;
     }
-    detail::replace_image_file(path, bytes, [&](const std::string &file) {
+    const auto encode = [&](const detail::ByteSink &sink) {
+        try {
+            // OpenEXR writes slices of the channel's own type: the half channels are rounded
+            // here, interleaved like the image, a band of rows at a time (whole ZIP blocks of
+            // 16 rows, about 256 KiB, so that the threads still compress several blocks at
+            // once), not as a second copy of the image at the end of a render, its peak.
+            std::vector<size_t> half_of; // the image channel of each half one
+            for (size_t c = 0; c < types.size(); ++c)
+                if (types[c] == Imf::HALF) half_of.push_back(c);
+            const size_t nhalf = half_of.size(), row_halves = size_t(image.width) * nhalf;
+            const int band =
+                nhalf == 0 ? image.height
+                           : std::max(16, int((size_t(1) << 17) / std::max<size_t>(row_halves, 1)) /
+                                              16 * 16);
+            std::vector<Imath::half> halves(size_t(std::min(band, image.height)) * row_halves);
+            SinkStream stream(sink);
+            Imf::OutputFile out(stream, exr_header(image, names, types, opts), threads);
+            for (int row = 0; row < image.height; row += band) {
+                const int rows = std::min(band, image.height - row);
+                const float *in = image.data.data() + size_t(row) * image.width * image.channels;
+                for (size_t i = 0, n = size_t(rows) * image.width; i < n; ++i)
+                    for (size_t h = 0; h < nhalf; ++h)
+                        halves[i * nhalf + h] =
+                            Imath::half(in[i * size_t(image.channels) + half_of[h]]);
+                Imf::FrameBuffer fb =
+                    frame_buffer(image, names, image.data.data(), image.y, image.height);
+                for (size_t h = 0; h < nhalf; ++h)
+                    fb.insert(names[half_of[h]],
+                              Imf::Slice::Make(Imf::HALF, halves.data() + h,
+                                               Imath::V2i(image.x, image.y + row), image.width,
+                                               rows, sizeof(Imath::half) * nhalf,
+                                               sizeof(Imath::half) * row_halves));
+                out.setFrameBuffer(fb);
+                out.writePixels(rows);
+            }
+        } catch (const Error &) {
+            throw; // the file's own write failed: its reason
+        } catch (const std::exception &e) {
+            FACET_THROW("{}", e.what());
+        }
+    };
+    detail::replace_image_file(path, encode, [&](const std::string &file) {
         return verify_written(file, image, names, types);
     });
 }

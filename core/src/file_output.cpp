@@ -3,6 +3,7 @@
 #include <facet/image.h>
 #include <facet/logger.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstdint>
@@ -48,22 +49,35 @@ struct TempFileGuard {
     }
 };
 
-/// Writes `bytes` to the new file `file`, checking every write, the flush to the disk and the
-/// close: on a full disk one of them fails (with stdio or an image library's own buffering, the
-/// failure can go unnoticed). Returns "" or the reason.
-std::string write_bytes(const std::string &file, const std::vector<unsigned char> &bytes) {
+/// Writes the bytes `write(sink)` gives to the new file `file`, checking every write, the flush
+/// to the disk and the close: on a full disk one of them fails (with stdio or an image library's
+/// own buffering, the failure can go unnoticed). Returns "" or the reason; `size` is the end of
+/// the furthest write.
+std::string write_file(const std::string &file, const std::function<void(const ByteSink &)> &write,
+                       uint64_t &size) {
     const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) return std::strerror(errno);
     std::string err;
-    size_t done = 0;
-    while (err.empty() && done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n > 0)
-            done += size_t(n);
-        else if (n < 0 && errno == EINTR)
-            continue;
-        else
-            err = n < 0 ? std::strerror(errno) : "no space left";
+    size = 0;
+    ByteSink sink;
+    sink.write_at = [&](const void *data, size_t n, uint64_t offset) {
+        const char *bytes = static_cast<const char *>(data);
+        size_t done = 0;
+        while (done < n) {
+            const ssize_t k = ::pwrite(fd, bytes + done, n - done, off_t(offset + done));
+            if (k > 0)
+                done += size_t(k);
+            else if (k < 0 && errno == EINTR)
+                continue;
+            else
+                FACET_THROW("{}", k < 0 ? std::strerror(errno) : "no space left");
+        }
+        size = std::max<uint64_t>(size, offset + n);
+    };
+    try {
+        write(sink);
+    } catch (const std::exception &e) {
+        err = e.what();
     }
     // Some file systems (NFS, quotas, delayed allocation) report a full disk only here.
     if (err.empty() && ::fdatasync(fd) != 0 && errno != EINVAL && errno != EROFS)
@@ -78,19 +92,25 @@ std::string temp_file_for(const std::string &path) { return temp_path_for(path);
 
 void replace_image_file(const std::string &path, const std::vector<unsigned char> &bytes,
                         const std::function<std::string(const std::string &)> &verify) {
+    replace_image_file(
+        path, [&](const ByteSink &sink) { sink.write_at(bytes.data(), bytes.size(), 0); }, verify);
+}
+
+void replace_image_file(const std::string &path, const std::function<void(const ByteSink &)> &write,
+                        const std::function<std::string(const std::string &)> &verify) {
     const std::string tmp = temp_path_for(path);
     TempFileGuard guard{tmp};
     const char *kept = fs::exists(path) ? "the existing file is unchanged" : "nothing was written";
-    if (std::string err = write_bytes(tmp, bytes); !err.empty())
+    uint64_t written = 0;
+    if (std::string err = write_file(tmp, write, written); !err.empty())
         FACET_THROW("cannot write image \"{}\": {}; {}", path, err, kept);
     // Nothing replaces the old file unless the new one is complete and reads back.
     std::error_code ec;
     const uintmax_t size = fs::file_size(tmp, ec);
-    std::string bad =
-        ec ? fmt::format("cannot stat the written file: {}", ec.message())
-        : size != bytes.size()
-            ? fmt::format("the written file has {} bytes instead of {}", size, bytes.size())
-            : verify(tmp);
+    std::string bad = ec ? fmt::format("cannot stat the written file: {}", ec.message())
+                      : size != written ? fmt::format("the written file has {} bytes instead of {}",
+                                                      size, written)
+                                        : verify(tmp);
     if (!bad.empty())
         FACET_THROW("cannot write image \"{}\": {} (disk full?); {}", path, bad, kept);
     if (std::rename(tmp.c_str(), path.c_str()) != 0)

@@ -8,6 +8,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -123,6 +124,46 @@ TEST_F(OutputSafety, WriteImageTakesTheLongestFileNames) {
         EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", a, b})) << ext;
         fs::remove(path(a));
         fs::remove(path(b));
+    }
+}
+
+TEST_F(OutputSafety, AWriteThatFailsHalfwayKeepsTheOldFile) {
+    // A disk that fills up while the image is written (here: a file size limit, which fails the
+    // write past it as a full disk does): "cannot write image" with the reason, the existing
+    // file unchanged, no temporary file left. The EXR writer streams its blocks into the file
+    // as OpenEXR compresses them, so the failure comes in the middle of its output.
+    facet::Image old_img(8, 8, 3);
+    for (size_t i = 0; i < old_img.data.size(); ++i) old_img.data[i] = 0.25f;
+    facet::Image img(512, 512, 3);
+    uint32_t state = 1;
+    for (float &v : img.data) { // noise: ZIP cannot shrink it below the limit
+        state = state * 1664525u + 1013904223u;
+        v = float(state >> 8) / float(1u << 24);
+    }
+    for (const std::string name : {"out.exr", "out.png"}) {
+        SCOPED_TRACE(name);
+        facet::write_image(path(name), old_img);
+        const std::string before = read_file(path(name));
+        struct rlimit saved;
+        ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved), 0);
+        struct rlimit limit = saved;
+        limit.rlim_cur = 64 * 1024;
+        void (*previous)(int) = std::signal(SIGXFSZ, SIG_IGN);
+        ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+        std::string error;
+        try {
+            facet::write_image(path(name), img);
+        } catch (const facet::Error &e) {
+            error = e.what();
+        }
+        setrlimit(RLIMIT_FSIZE, &saved);
+        std::signal(SIGXFSZ, previous);
+        EXPECT_NE(error.find("cannot write image"), std::string::npos) << error;
+        EXPECT_NE(error.find("File too large"), std::string::npos) << error;
+        EXPECT_NE(error.find("the existing file is unchanged"), std::string::npos) << error;
+        EXPECT_EQ(read_file(path(name)), before) << "the old file was changed";
+        EXPECT_EQ(files(), (std::set<std::string>{"scene.xml", name})) << "a file was left";
+        fs::remove(path(name));
     }
 }
 
