@@ -20,6 +20,10 @@
 #include <tuple>
 #include <utility>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace facet {
 
 // ---------------------------------------------------------------------------------------------
@@ -511,8 +515,13 @@ RenderResult RenderJob::finish(const WorkUnitsRun &run, size_t units_per_pass, s
     RenderResult result;
     result.blocks_total = units_per_pass * passes;
     result.blocks_done = m_merger->merged();
-    // The blocks' memory (a pass of them waits for its last one) goes before the image comes.
+    // The blocks' memory (a pass of them waits for its last one) goes before the image comes,
+    // back to the system: the blocks are small allocations of the render threads' heaps, which
+    // would keep their pages while the image's large allocation takes new ones.
     m_merger.reset();
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
     result.first_block_cpu_seconds = run.first_unit_cpu_seconds;
     result.cancelled = passes_done < passes;
     result.timed_out = result.cancelled && run.timed_out;
