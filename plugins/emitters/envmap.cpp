@@ -130,11 +130,15 @@ public:
             }
         build_distribution();
         if (is_spectral(props.mode())) {
+            m_weights.resize(m_texels.size());
+            for (int j = 0; j < m_height; ++j)
+                for (int i = 0; i <= m_width; ++i)
+                    m_weights[size_t(j) * size_t(m_width + 1) + size_t(i)] = table(i, j);
             // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
             // and the scale 2 max c, blended separately between pixels; radiance() multiplies
             // by D65, the spectrum of an RGB white light. The curve's coefficients replace the
-            // texel's colour (the sampling table below is built from the colours first), so a
-            // lookup reads the lines the density reads; the scales are a dense array beside.
+            // texel's colour (the sampling table's values were copied from the colours above),
+            // so a lookup reads the lines the density reads; the scales are a dense array beside.
             m_spectral = true;
             m_scales.resize(m_texels.size());
             for (size_t i = 0; i < m_texels.size(); ++i) {
@@ -258,10 +262,11 @@ private:
         return g;
     }
 
-    // The radiance and the sampling table of a grid point share a texel, so that a lookup and
-    // the density of the same direction (eval() and pdf_direction(), or the two halves of
-    // sample_direction()) read the same cache lines: in a map larger than the cache each
-    // texel row read is a miss, and separate arrays took twice as many.
+    // The radiance of a grid point and its sampling table's value come from one texel, so that
+    // a lookup and the density of the same direction (eval() and pdf_direction(), or the two
+    // halves of sample_direction()) read the same cache lines: in a map larger than the cache
+    // each texel row read is a miss, and separate arrays took twice as many. In rgb and mono the
+    // table's value is computed from the pixel (table()), so a texel is the pixel's 12 bytes.
     struct Texel {
         union {
             float rgb[3] = {0.f, 0.f, 0.f}; ///< the pixel, times `scale`
@@ -273,7 +278,6 @@ private:
             rgb[1] = c.g;
             rgb[2] = c.b;
         }
-        float weight = 0.f; ///< the sampling table's value (see build_distribution())
     };
     Texel &texel(int x, int y) { return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
     const Texel &texel(int x, int y) const {
@@ -327,7 +331,15 @@ private:
 
     bool sampling_enabled() const { return m_importance && m_total > 0.0; }
 
-    float table(int i, int j) const { return texel(i, j).weight; }
+    /// The sampling table's value at grid point (i, j), i in [0, W]: see build_distribution(). In
+    /// the spectral mode, whose texels hold curves, a stored copy.
+    float table(int i, int j) const {
+        if (m_spectral) return m_weights[size_t(j) * size_t(m_width + 1) + size_t(i)];
+        return table_value(texel(i, j).radiance(), j);
+    }
+    float table_value(const Color3f &pixel, int j) const {
+        return std::max(pixel.luminance() - m_offset, 0.f) * m_row_weight[size_t(j)];
+    }
 
     Point2f sample_uv(Point2f u) const {
         float uc = u.x;
@@ -399,28 +411,27 @@ private:
         m_mean_luminance = sphere_weight > 0.0 ? float(sphere_sum / sphere_weight) : 0.f;
         // MIS compensation (Karlík et al. 2019): sample only where the map is brighter than its
         // mean; skipped for near-constant maps, where it would leave (almost) nothing.
-        float offset = 0.f;
+        m_offset = 0.f;
         if (m_mis_compensation) {
-            offset = float(sum / double(lum.size()));
-            if (offset - min_lum <= 0.01f * offset) offset = 0.f;
+            m_offset = float(sum / double(lum.size()));
+            if (m_offset - min_lum <= 0.01f * m_offset) m_offset = 0.f;
         }
-        for (int j = 0; j < H; ++j) {
-            // Zero on the pole rows (sin of a float π is slightly negative).
-            float sin_theta = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
-            if (j == H - 1) sin_theta = 0.f;
-            for (int i = 0; i <= W; ++i)
-                texel(i, j).weight =
-                    std::max(lum[size_t(j) * W + size_t(i % W)] - offset, 0.f) * sin_theta;
-        }
-        // Scaled by a power of two so that the largest entry lies in [1, 2): the density is
-        // unchanged to the last bit (every operation on the table scales exactly), and the
-        // sampling's squares neither underflow for a very dark map nor overflow for a very bright
-        // one, nor does the density's normalisation (cells / total) overflow.
+        // Row j's factor: sin θ (zero on the pole rows: sin of a float π is slightly negative)
+        // times a power of two that puts the largest entry in [1, 2): the density is unchanged
+        // to the last bit (every operation on the table scales exactly), and the sampling's
+        // squares neither underflow for a very dark map nor overflow for a very bright one, nor
+        // does the density's normalisation (cells / total) overflow.
+        m_row_weight.assign(size_t(H), 0.f);
         float max_entry = 0.f;
-        for (const Texel &t : m_texels) max_entry = std::max(max_entry, t.weight);
+        for (int j = 0; j < H; ++j) {
+            m_row_weight[size_t(j)] = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
+            if (j == H - 1) m_row_weight[size_t(j)] = 0.f;
+            for (int i = 0; i < W; ++i)
+                max_entry = std::max(max_entry, table_value(pixel(i, j), j));
+        }
         if (max_entry > 0.f && std::isfinite(max_entry)) {
             const float to_unit = std::ldexp(1.f, -std::ilogb(max_entry));
-            for (Texel &t : m_texels) t.weight *= to_unit;
+            for (float &w : m_row_weight) w *= to_unit;
         }
         std::vector<float> cells(size_t(W) * size_t(H - 1));
         for (int j = 0; j + 1 < H; ++j)
@@ -438,9 +449,12 @@ private:
     Vector3f m_world_rows[3], m_local_rows[3]; ///< to_world's 3x3 part and its inverse's, by rows
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
-    std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels and the sampling table
-    bool m_spectral = false;     ///< the texels hold curves (the spectral mode)
-    std::vector<float> m_scales; ///< the spectral mode's pixel scales, laid out as m_texels
+    std::vector<Texel> m_texels;     ///< (W + 1) x H: the pixels and the sampling table
+    bool m_spectral = false;         ///< the texels hold curves (the spectral mode)
+    std::vector<float> m_scales;     ///< the spectral mode's pixel scales, laid out as m_texels
+    std::vector<float> m_weights;    ///< the spectral mode's sampling table, laid out as m_texels
+    float m_offset = 0.f;            ///< subtracted from the luminance (MIS compensation)
+    std::vector<float> m_row_weight; ///< per row: sin θ times the table's power-of-two scale
     DiscreteDistribution m_cells;
     double m_total = 0.0;
     float m_density_scale = 0.f;
