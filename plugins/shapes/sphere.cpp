@@ -52,6 +52,7 @@ public:
         if (!(m_radius > 0.f) || !std::isfinite(m_radius) || !is_finite(m_center))
             FACET_THROW_AT(props.location(), "sphere: to_world gives a degenerate sphere");
         m_to_object = m_to_world.inverse();
+        m_inv_radius = 1.0 / double(m_radius);
     }
 
     BoundingBox3f bbox() const override {
@@ -118,14 +119,13 @@ public:
     }
 
     DirectionSample sample_direction(const Interaction &ref, const Point2f &u) const override {
-        double one_minus_cos_max, dist2;
-        if (!sees_cone(ref, one_minus_cos_max, dist2))
+        double one_minus_cos_max, dist2, dist;
+        if (!sees_cone(ref, one_minus_cos_max, dist2, dist))
             return Shape::sample_direction(ref, u); // inside: every point is visible
 
         // Uniform direction in the cone around the axis towards the centre, in double so that
         // small distant spheres keep their precision. The angle around the axis needs no more
         // than float: its rounding moves the point by a float's part of the cone's width.
-        const double dist = std::sqrt(dist2);
         const Vector3d axis = (Vector3d(m_center) - Vector3d(ref.p)) * (1.0 / dist);
         const double x = double(u.x) * one_minus_cos_max;
         const double cos_theta = 1.0 - x, sin2_theta = x * (2.0 - x);
@@ -145,7 +145,8 @@ public:
         if (!(tau > 0.0)) return ds;
         // The point lies on the sphere to double rounding: its offset over the radius is the
         // unit normal (to float precision, as normalising it would give).
-        const Vector3f dir = Vector3f((Vector3d(ref.p) + d * tau - Vector3d(m_center)) * (1.0 / r));
+        const Vector3f dir =
+            Vector3f((Vector3d(ref.p) + d * tau - Vector3d(m_center)) * m_inv_radius);
         ds.p = m_center + dir * m_radius;
         ds.n = m_flip_normals ? -dir : dir;
         // The uv only for whom reads it: a light whose radiance varies over the surface (a
@@ -161,8 +162,8 @@ public:
     }
 
     float pdf_direction(const Interaction &ref, const DirectionSample &ds) const override {
-        double one_minus_cos_max, dist2;
-        if (!sees_cone(ref, one_minus_cos_max, dist2)) return Shape::pdf_direction(ref, ds);
+        double one_minus_cos_max, dist2, dist;
+        if (!sees_cone(ref, one_minus_cos_max, dist2, dist)) return Shape::pdf_direction(ref, ds);
         return cone_pdf(one_minus_cos_max);
     }
 
@@ -215,21 +216,23 @@ private:
     }
 
     /// Whether `ref` samples the sphere by its cone of directions (it lies outside), and the
-    /// cone's 1 - cos θmax and the squared distance to the centre. Points on the surface count
-    /// as outside unless the normals are flipped.
-    bool sees_cone(const Interaction &ref, double &one_minus_cos_max, double &dist2) const {
+    /// cone's 1 - cos θmax, the squared distance to the centre and the distance. Points on the
+    /// surface count as outside unless the normals are flipped.
+    bool sees_cone(const Interaction &ref, double &one_minus_cos_max, double &dist2,
+                   double &dist) const {
         dist2 = squared_norm(Vector3d(m_center) - Vector3d(ref.p));
-        double r2 = double(m_radius) * double(m_radius);
-        double threshold = r2 * (m_flip_normals ? 1.0 + 2e-4 : 1.0 - 2e-4);
+        const double r2 = double(m_radius) * double(m_radius);
+        const double threshold = r2 * (m_flip_normals ? 1.0 + 2e-4 : 1.0 - 2e-4);
         if (!(dist2 > threshold)) return false;
-        double sin2_max = std::min(r2 / dist2, 1.0);
-        // 1 - sqrt(1 - s) without cancellation for small cones.
-        one_minus_cos_max = sin2_max / (1.0 + std::sqrt(1.0 - sin2_max));
+        dist = std::sqrt(dist2);
+        // 1 - sqrt(1 - r²/d²) = r² / (d² + d·sqrt(d² - r²)): no cancellation for small cones,
+        // one division (a point on the surface, d² a rounding below r², gets the hemisphere).
+        one_minus_cos_max = r2 / (dist2 + dist * std::sqrt(std::max(dist2 - r2, 0.0)));
         return true;
     }
 
     static float cone_pdf(double one_minus_cos_max) {
-        float pdf = float(1.0 / (2.0 * 3.14159265358979323846 * one_minus_cos_max));
+        const float pdf = 1.f / (2.f * Pi * float(one_minus_cos_max));
         return std::isfinite(pdf) ? pdf : 0.f;
     }
 
@@ -279,6 +282,7 @@ private:
     Transform m_to_world, m_to_object;
     Point3f m_center;
     float m_radius = 1.f;
+    double m_inv_radius = 1.0;
     bool m_flip_normals = false;
 };
 
