@@ -284,8 +284,10 @@ void LightBVH::importance(const Node &node, const Point3f &p, const Normal3f &n,
         result = select(cos_i * cos_i < cos2_bound, result * factor, result);
     }
     result = select(turned_away, zero, result);
-    // (An unused slot has power 0, and a used one is outside or inside: no lane is NaN.)
-    select(outside, result, inside_value).store(out);
+    // Never negative (cos of a float π/2 is slightly below zero: cos_p can be), and nothing
+    // for a slot without power (an unused one: a NaN from a point at its centre included).
+    result = max(select(outside, result, inside_value), zero);
+    select(power > zero, result, zero).store(out);
 }
 
 namespace {
@@ -293,7 +295,9 @@ namespace {
 /// The children's probabilities at a node: importance over their sum, in slot order.
 bool shares(const float (&w)[LightBVH::Arity], float (&p)[LightBVH::Arity]) {
     const float total = (w[0] + w[1]) + (w[2] + w[3]);
-    if (!(total > 0.f)) return false;
+    // (An infinite total, a point at a point light's position, would make every share 0 or
+    // NaN: nothing is picked there.)
+    if (!(total > 0.f) || !std::isfinite(total)) return false;
     for (int k = 0; k < LightBVH::Arity; ++k) p[k] = w[k] / total;
     return true;
 }
@@ -320,6 +324,7 @@ std::pair<uint32_t, float> LightBVH::sample(const Point3f &p, const Normal3f &n,
             below += share[k];
         }
         if (k == node.count) {
+            if (last < 0) return {0, 0.f};
             k = last;
             below -= share[k];
         }

@@ -327,9 +327,13 @@ std::vector<Interaction> reference_points() {
 
 } // namespace
 
-TEST(EmitterSelection, TheLightHierarchyAgreesWithItsPmfAndMissesNoLight) {
-    auto scene = load(corridor_xml(12, "", "path", 1, 0));
-    ASSERT_EQ(scene->emitters().size(), 16u);
+namespace {
+
+/// sample_emitter() against emitter_pmf() and the lights every point can see, in the corridor
+/// of `lamps` lamps.
+void expect_hierarchy_agrees_with_its_pmf(int lamps) {
+    auto scene = load(corridor_xml(lamps, "", "path", 1, 0));
+    ASSERT_EQ(scene->emitters().size(), size_t(lamps) + 4u);
     PCG32 rng(9);
     int unreachable = 0;
     for (const Interaction &ref : reference_points()) {
@@ -383,6 +387,17 @@ TEST(EmitterSelection, TheLightHierarchyAgreesWithItsPmfAndMissesNoLight) {
     }
     // Every point sees some light (the point lamp shines everywhere).
     EXPECT_EQ(unreachable, 0);
+}
+
+} // namespace
+
+TEST(EmitterSelection, TheLightHierarchyAgreesWithItsPmfAndMissesNoLight) {
+    // 9, 16 and 44 emitters: trees of one, two and three levels of four children, with nodes
+    // that have two, three and four.
+    for (const int lamps : {5, 12, 40}) {
+        SCOPED_TRACE(::testing::Message() << lamps << " lamps");
+        expect_hierarchy_agrees_with_its_pmf(lamps);
+    }
 }
 
 TEST(EmitterSelection, TheLightHierarchyKeepsTheImageAndLowersItsNoise) {
