@@ -143,8 +143,9 @@ public:
         DirectionSample ds;
         ds.emitter = m_emitter.get();
         if (!(tau > 0.0)) return ds;
-        // The point lies on the sphere to double rounding: its offset over the radius is the
-        // unit normal (to float precision, as normalising it would give).
+        // The point lies on the sphere to double rounding, an error of about 1e-16 d: its offset
+        // over the radius is the unit normal to float precision while d/r < 1e8 (beyond, off by
+        // (d/r)·1e-16, e.g. 1e-6 of the radius for a sphere 1e10 radii away).
         const Vector3f dir =
             Vector3f((Vector3d(ref.p) + d * tau - Vector3d(m_center)) * m_inv_radius);
         ds.p = m_center + dir * m_radius;
@@ -227,7 +228,8 @@ private:
         dist = std::sqrt(dist2);
         // 1 - sqrt(1 - r²/d²) = r² / (d² + d·sqrt(d² - r²)): no cancellation for small cones,
         // one division (a point on the surface, d² a rounding below r², gets the hemisphere).
-        one_minus_cos_max = r2 / (dist2 + dist * std::sqrt(std::max(dist2 - r2, 0.0)));
+        one_minus_cos_max =
+            std::min(r2 / (dist2 + dist * std::sqrt(std::max(dist2 - r2, 0.0))), 1.0);
         return true;
     }
 

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace facet;
@@ -299,6 +300,41 @@ TEST(EmitterArea, TexturedRadiance) {
     si.wi = Vector3f(0.f, 0.f, 1.f);
     si.uv = Point2f(0.8f, 0.1f);
     expect_color_near(e->eval(si), Color3f(5.f), 1e-6f);
+}
+
+TEST(EmitterArea, TexturedRadianceOnASphere) {
+    // A sphere light samples its cone of directions; with a textured radiance each sample sees
+    // the value at its own point's spherical uv (a uniform one may skip the uv: see
+    // Shape::sample_direction()).
+    auto e = std::dynamic_pointer_cast<Emitter>(load_string(R"(
+        <emitter version="3.0.0" type="area">
+            <texture type="checkerboard" name="radiance">
+                <rgb name="color0" value="1, 2, 3"/>
+                <rgb name="color1" value="5, 5, 5"/>
+            </texture>
+        </emitter>)"));
+    ASSERT_TRUE(e);
+    auto shape = make_shape(Properties("sphere"), e);
+    Interaction ref = reference(Point3f(0.f, 0.f, 2.f), Normal3f(0.f, 0.f, -1.f));
+    PCG32 rng(15);
+    int seen[2] = {0, 0};
+    for (int i = 0; i < 1000; ++i) {
+        auto [ds, weight] = e->sample_direction(ref, next_point2f(rng));
+        ASSERT_GT(ds.pdf, 0.f);
+        EXPECT_EQ(e->pdf_direction(ref, ds), ds.pdf);
+        // u = φ/2π around +z, v = θ/π from +z, of the unit sphere's point.
+        double u = std::atan2(double(ds.p.y), double(ds.p.x)) / (2.0 * M_PI);
+        if (u < 0.0) u += 1.0;
+        const double v = std::acos(std::clamp(double(ds.p.z), -1.0, 1.0)) / M_PI;
+        if (std::abs(u - 0.5) < 1e-4 || u < 1e-4 || u > 1.0 - 1e-4) continue; // on an edge
+        EXPECT_NEAR(ds.uv.y, v, 1e-5);
+        EXPECT_NEAR(ds.uv.x, u, 1e-5);
+        const bool first = (u > 0.5) == (v > 0.5);
+        ++seen[first ? 0 : 1];
+        expect_color_near(weight * ds.pdf, first ? Color3f(1.f, 2.f, 3.f) : Color3f(5.f), 1e-5f);
+    }
+    EXPECT_GT(seen[0], 400);
+    EXPECT_GT(seen[1], 400);
 }
 
 TEST(EmitterArea, BackSideGivesNothing) {
