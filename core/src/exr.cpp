@@ -39,21 +39,30 @@ namespace facet {
 
 namespace {
 
-/// OpenEXR's output, straight into the file replace_image_file() writes and checks.
+/// OpenEXR's output, straight into the file replace_image_file() writes and checks. The first
+/// failed write is kept: OpenEXR writes the table of block offsets from its output file's
+/// destructor and swallows what that throws.
 class SinkStream : public Imf::OStream {
 public:
     explicit SinkStream(const detail::ByteSink &sink) : Imf::OStream("file"), m_sink(sink) {}
     void write(const char c[], int n) override {
         if (n <= 0) return;
-        m_sink.write_at(c, size_t(n), m_pos);
+        try {
+            m_sink.write_at(c, size_t(n), m_pos);
+        } catch (const std::exception &e) {
+            if (m_failure.empty()) m_failure = e.what();
+            throw;
+        }
         m_pos += uint64_t(n);
     }
     uint64_t tellp() override { return m_pos; }
     void seekp(uint64_t pos) override { m_pos = pos; }
+    const std::string &failure() const { return m_failure; }
 
 private:
     const detail::ByteSink &m_sink;
     uint64_t m_pos = 0;
+    std::string m_failure;
 };
 
 /// The channels of a developed film's colour (and alpha), as opposed to AOV channels.
@@ -143,6 +152,7 @@ std::string verify_written(const std::string &file, const Image &image,
             ++nchannels;
         if (nchannels != image.channels)
             return fmt::format("the written file reads back with {} channels", nchannels);
+        if (!in.isComplete()) return "the written file is incomplete";
         // In bands of rows (about 64 KiB, at least the 16 rows a ZIP block holds), so that the
         // check holds no second copy of the image: the end of a render is its peak of memory.
         const int band =
@@ -215,25 +225,29 @@ void write_exr(const std::string &path, const Image &image, const ImageWriteOpti
                                               16 * 16);
             std::vector<Imath::half> halves(size_t(std::min(band, image.height)) * row_halves);
             SinkStream stream(sink);
-            Imf::OutputFile out(stream, exr_header(image, names, types, opts), threads);
-            for (int row = 0; row < image.height; row += band) {
-                const int rows = std::min(band, image.height - row);
-                const float *in = image.data.data() + size_t(row) * image.width * image.channels;
-                for (size_t i = 0, n = size_t(rows) * image.width; i < n; ++i)
+            {
+                Imf::OutputFile out(stream, exr_header(image, names, types, opts), threads);
+                for (int row = 0; row < image.height; row += band) {
+                    const int rows = std::min(band, image.height - row);
+                    const float *in =
+                        image.data.data() + size_t(row) * image.width * image.channels;
+                    for (size_t i = 0, n = size_t(rows) * image.width; i < n; ++i)
+                        for (size_t h = 0; h < nhalf; ++h)
+                            halves[i * nhalf + h] =
+                                Imath::half(in[i * size_t(image.channels) + half_of[h]]);
+                    Imf::FrameBuffer fb =
+                        frame_buffer(image, names, image.data.data(), image.y, image.height);
                     for (size_t h = 0; h < nhalf; ++h)
-                        halves[i * nhalf + h] =
-                            Imath::half(in[i * size_t(image.channels) + half_of[h]]);
-                Imf::FrameBuffer fb =
-                    frame_buffer(image, names, image.data.data(), image.y, image.height);
-                for (size_t h = 0; h < nhalf; ++h)
-                    fb.insert(names[half_of[h]],
-                              Imf::Slice::Make(Imf::HALF, halves.data() + h,
-                                               Imath::V2i(image.x, image.y + row), image.width,
-                                               rows, sizeof(Imath::half) * nhalf,
-                                               sizeof(Imath::half) * row_halves));
-                out.setFrameBuffer(fb);
-                out.writePixels(rows);
-            }
+                        fb.insert(names[half_of[h]],
+                                  Imf::Slice::Make(Imf::HALF, halves.data() + h,
+                                                   Imath::V2i(image.x, image.y + row), image.width,
+                                                   rows, sizeof(Imath::half) * nhalf,
+                                                   sizeof(Imath::half) * row_halves));
+                    out.setFrameBuffer(fb);
+                    out.writePixels(rows);
+                }
+            } // OpenEXR writes the table of block offsets here, and keeps its failure to itself
+            if (!stream.failure().empty()) FACET_THROW("{}", stream.failure());
         } catch (const Error &) {
             throw; // the file's own write failed: its reason
         } catch (const std::exception &e) {

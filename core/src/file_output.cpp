@@ -78,6 +78,8 @@ std::string write_file(const std::string &file, const std::function<void(const B
         write(sink);
     } catch (const std::exception &e) {
         err = e.what();
+    } catch (...) {
+        err = "an unknown error";
     }
     // Some file systems (NFS, quotas, delayed allocation) report a full disk only here.
     if (err.empty() && ::fdatasync(fd) != 0 && errno != EINVAL && errno != EROFS)
