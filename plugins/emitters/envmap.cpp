@@ -137,8 +137,8 @@ public:
             // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
             // and the scale 2 max c, blended separately between pixels; radiance() multiplies
             // by D65, the spectrum of an RGB white light. The curve's coefficients replace the
-            // texel's colour (the sampling table's values were copied from the colours above),
-            // so a lookup reads the lines the density reads; the scales are a dense array beside.
+            // texel's colour (the sampling table's values were copied from the colours above,
+            // to m_weights, read beside the texels as the scales are).
             m_spectral = true;
             m_scales.resize(m_texels.size());
             for (size_t i = 0; i < m_texels.size(); ++i) {
@@ -376,6 +376,8 @@ private:
                 if (m_spectral) {
                     const float *scales = m_scales.data() + row * (W + 1);
                     prefetch_range(scales + i0, scales + i1 + 1);
+                    const float *weights = m_weights.data() + row * (W + 1);
+                    prefetch_range(weights + i0, weights + i1 + 1);
                 }
             }
         }
@@ -449,11 +451,11 @@ private:
     Vector3f m_world_rows[3], m_local_rows[3]; ///< to_world's 3x3 part and its inverse's, by rows
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
     int m_width = 0, m_height = 0;
-    std::vector<Texel> m_texels;     ///< (W + 1) x H: the pixels and the sampling table
-    bool m_spectral = false;         ///< the texels hold curves (the spectral mode)
-    std::vector<float> m_scales;     ///< the spectral mode's pixel scales, laid out as m_texels
-    std::vector<float> m_weights;    ///< the spectral mode's sampling table, laid out as m_texels
-    float m_offset = 0.f;            ///< subtracted from the luminance (MIS compensation)
+    std::vector<Texel> m_texels;  ///< (W + 1) x H: the pixels (the table's values come from them)
+    bool m_spectral = false;      ///< the texels hold curves (the spectral mode)
+    std::vector<float> m_scales;  ///< the spectral mode's pixel scales, laid out as m_texels
+    std::vector<float> m_weights; ///< the spectral mode's sampling table, laid out as m_texels
+    float m_offset = 0.f;         ///< subtracted from the luminance (MIS compensation)
     std::vector<float> m_row_weight; ///< per row: sin θ times the table's power-of-two scale
     DiscreteDistribution m_cells;
     double m_total = 0.0;
