@@ -58,7 +58,6 @@ inline M4 operator>=(F4 a, F4 b) { return {_mm_cmpge_ps(a.v, b.v)}; }
 inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
 inline M4 operator<=(F4 a, F4 b) { return {_mm_cmple_ps(a.v, b.v)}; }
 inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
-inline M4 operator!(M4 a) { return {_mm_xor_ps(a.v, _mm_castsi128_ps(_mm_set1_epi32(-1)))}; }
 /// m ? a : b, lane by lane.
 inline F4 select(M4 m, F4 a, F4 b) {
     return {_mm_or_ps(_mm_and_ps(m.v, a.v), _mm_andnot_ps(m.v, b.v))};
@@ -115,7 +114,6 @@ inline M4 operator<=(F4 a, F4 b) {
 inline M4 operator&(M4 a, M4 b) {
     return {{a.v[0] && b.v[0], a.v[1] && b.v[1], a.v[2] && b.v[2], a.v[3] && b.v[3]}};
 }
-inline M4 operator!(M4 a) { return {{!a.v[0], !a.v[1], !a.v[2], !a.v[3]}}; }
 inline F4 select(M4 m, F4 a, F4 b) {
     return {{m.v[0] ? a.v[0] : b.v[0], m.v[1] ? a.v[1] : b.v[1], m.v[2] ? a.v[2] : b.v[2],
              m.v[3] ? a.v[3] : b.v[3]}};
