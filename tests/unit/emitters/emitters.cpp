@@ -271,15 +271,23 @@ TEST(EmitterArea, SampleRayCarriesThePower) {
     EXPECT_NEAR(mean_cos, 2.0 / 3.0, 7e-3); // 4 standard errors
 }
 
-TEST(EmitterArea, TexturedRadiance) {
-    // A checkerboard radiance: sampled points and hits see the value at their own uv.
-    auto e = std::dynamic_pointer_cast<Emitter>(load_string(R"(
+namespace {
+/// An area light whose radiance is a checkerboard of (1, 2, 3) (where u and v are on the same
+/// side of 1/2) and 5.
+std::shared_ptr<Emitter> checkerboard_light() {
+    return std::dynamic_pointer_cast<Emitter>(load_string(R"(
         <emitter version="3.0.0" type="area">
             <texture type="checkerboard" name="radiance">
                 <rgb name="color0" value="1, 2, 3"/>
                 <rgb name="color1" value="5, 5, 5"/>
             </texture>
         </emitter>)"));
+}
+} // namespace
+
+TEST(EmitterArea, TexturedRadiance) {
+    // A checkerboard radiance: sampled points and hits see the value at their own uv.
+    auto e = checkerboard_light();
     ASSERT_TRUE(e);
     EXPECT_TRUE(has_flag(e->flags(), EmitterFlags::SpatiallyVarying));
     auto shape = make_shape(Properties("rectangle"), e);
@@ -306,13 +314,7 @@ TEST(EmitterArea, TexturedRadianceOnASphere) {
     // A sphere light samples its cone of directions; with a textured radiance each sample sees
     // the value at its own point's spherical uv (a uniform one may skip the uv: see
     // Shape::sample_direction()).
-    auto e = std::dynamic_pointer_cast<Emitter>(load_string(R"(
-        <emitter version="3.0.0" type="area">
-            <texture type="checkerboard" name="radiance">
-                <rgb name="color0" value="1, 2, 3"/>
-                <rgb name="color1" value="5, 5, 5"/>
-            </texture>
-        </emitter>)"));
+    auto e = checkerboard_light();
     ASSERT_TRUE(e);
     auto shape = make_shape(Properties("sphere"), e);
     Interaction ref = reference(Point3f(0.f, 0.f, 2.f), Normal3f(0.f, 0.f, -1.f));
