@@ -132,8 +132,7 @@ public:
         if (is_spectral(props.mode())) {
             m_weights.resize(m_texels.size());
             for (int j = 0; j < m_height; ++j)
-                for (int i = 0; i <= m_width; ++i)
-                    m_weights[size_t(j) * size_t(m_width + 1) + size_t(i)] = table(i, j);
+                for (int i = 0; i <= m_width; ++i) m_weights[grid_index(i, j)] = table(i, j);
             // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
             // and the scale 2 max c, blended separately between pixels; radiance() multiplies
             // by D65, the spectrum of an RGB white light. The curve's coefficients replace the
@@ -279,10 +278,11 @@ private:
             rgb[2] = c.b;
         }
     };
-    Texel &texel(int x, int y) { return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)]; }
-    const Texel &texel(int x, int y) const {
-        return m_texels[size_t(y) * size_t(m_width + 1) + size_t(x)];
-    }
+    /// Where grid point (x, y), x in [0, W], lies in the (W + 1) x H arrays (texels, scales,
+    /// weights).
+    size_t grid_index(int x, int y) const { return size_t(y) * size_t(m_width + 1) + size_t(x); }
+    Texel &texel(int x, int y) { return m_texels[grid_index(x, y)]; }
+    const Texel &texel(int x, int y) const { return m_texels[grid_index(x, y)]; }
 
     /// Pixel (x, y) for x in [0, W]: column W is column 0 again.
     Color3f pixel(int x, int y) const { return texel(x, y).radiance(); }
@@ -302,7 +302,7 @@ private:
         Color3f curve(0.f);
         float scale = 0.f;
         auto add = [&](int x, int y, float w) {
-            const size_t i = size_t(y) * size_t(m_width + 1) + size_t(x);
+            const size_t i = grid_index(x, y);
             const SigmoidPolynomial &c = m_texels[i].curve;
             curve += c(lambda) * w;
             scale += m_scales[i] * w;
@@ -334,7 +334,7 @@ private:
     /// The sampling table's value at grid point (i, j), i in [0, W]: see build_distribution(). In
     /// the spectral mode, whose texels hold curves, a stored copy.
     float table(int i, int j) const {
-        if (m_spectral) return m_weights[size_t(j) * size_t(m_width + 1) + size_t(i)];
+        if (m_spectral) return m_weights[grid_index(i, j)];
         return table_value(texel(i, j).radiance(), j);
     }
     float table_value(const Color3f &pixel, int j) const {
