@@ -110,8 +110,11 @@ public:
         m_height = img.height;
         // Grey (and grey + alpha) images are grey; an alpha channel is ignored.
         int colour_channels = img.channels >= 3 ? 3 : 1;
-        m_texels.assign(size_t(m_width + 1) * m_height, Texel{});
-        for (int y = 0; y < m_height; ++y)
+        // Written once, in order (no zero-filled array written over: the living room's
+        // 2048x1024 sky spent ~80 ms of its load on that).
+        m_texels.clear();
+        m_texels.reserve(size_t(m_width + 1) * m_height);
+        for (int y = 0; y < m_height; ++y) {
             for (int x = 0; x < m_width; ++x) {
                 auto channel = [&](int ch) {
                     float v = img.at(x, y, std::min(ch, colour_channels - 1));
@@ -125,9 +128,12 @@ public:
                 // Negative values are kept, as Mitsuba keeps them; only the sampling table
                 // clamps at zero. The mono mode renders the luminance.
                 c = in_mode(c, props.mode());
-                texel(x, y).set_radiance(c);
-                if (x == 0) texel(m_width, y).set_radiance(c); // column W is column 0 again
+                Texel t{};
+                t.set_radiance(c);
+                m_texels.push_back(t);
             }
+            m_texels.push_back(texel(0, y)); // column W is column 0 again
+        }
         build_distribution();
         if (is_spectral(props.mode())) {
             m_weights.resize(m_texels.size());
@@ -338,7 +344,10 @@ private:
         return table_value(texel(i, j).radiance(), j);
     }
     float table_value(const Color3f &pixel, int j) const {
-        return std::max(pixel.luminance() - m_offset, 0.f) * m_row_weight[size_t(j)];
+        return table_from_luminance(pixel.luminance(), j);
+    }
+    float table_from_luminance(float luminance, int j) const {
+        return std::max(luminance - m_offset, 0.f) * m_row_weight[size_t(j)];
     }
 
     Point2f sample_uv(Point2f u) const {
@@ -398,17 +407,21 @@ private:
 
     void build_distribution() {
         const int W = m_width, H = m_height;
+        // Each pixel's luminance, computed once: the table's values below come from it.
         std::vector<float> lum(size_t(W) * H);
         double sum = 0.0, sphere_sum = 0.0, sphere_weight = 0.0;
         float min_lum = Infinity;
-        for (size_t k = 0; k < lum.size(); ++k) {
-            lum[k] = pixel(int(k % size_t(W)), int(k / size_t(W))).luminance();
-            sum += double(lum[k]);
-            min_lum = std::min(min_lum, lum[k]);
+        for (int j = 0; j < H; ++j) {
             // The mean over the sphere (for power()): each pixel weighted by its row's sin θ.
-            const double sin_theta = std::sin(double(k / size_t(W)) * Pi / double(H - 1));
-            sphere_sum += std::max(double(lum[k]), 0.0) * sin_theta;
-            sphere_weight += sin_theta;
+            const double sin_theta = std::sin(double(j) * Pi / double(H - 1));
+            for (int i = 0; i < W; ++i) {
+                const size_t k = size_t(j) * size_t(W) + size_t(i);
+                lum[k] = pixel(i, j).luminance();
+                sum += double(lum[k]);
+                min_lum = std::min(min_lum, lum[k]);
+                sphere_sum += std::max(double(lum[k]), 0.0) * sin_theta;
+                sphere_weight += sin_theta;
+            }
         }
         m_mean_luminance = sphere_weight > 0.0 ? float(sphere_sum / sphere_weight) : 0.f;
         // MIS compensation (Karlík et al. 2019): sample only where the map is brighter than its
@@ -429,17 +442,28 @@ private:
             m_row_weight[size_t(j)] = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
             if (j == H - 1) m_row_weight[size_t(j)] = 0.f;
             for (int i = 0; i < W; ++i)
-                max_entry = std::max(max_entry, table_value(pixel(i, j), j));
+                max_entry = std::max(max_entry, table_from_luminance(lum[size_t(j) * W + i], j));
         }
         if (max_entry > 0.f && std::isfinite(max_entry)) {
             const float to_unit = std::ldexp(1.f, -std::ilogb(max_entry));
             for (float &w : m_row_weight) w *= to_unit;
         }
+        // The table's rows j and j + 1 (W + 1 values each: column W is column 0), as table()
+        // gives them.
+        std::vector<float> row0(size_t(W) + 1), row1(size_t(W) + 1);
+        auto table_row = [&](int j, std::vector<float> &row) {
+            for (int i = 0; i <= W; ++i)
+                row[size_t(i)] = table_from_luminance(lum[size_t(j) * W + size_t(i % W)], j);
+        };
         std::vector<float> cells(size_t(W) * size_t(H - 1));
-        for (int j = 0; j + 1 < H; ++j)
+        table_row(0, row1);
+        for (int j = 0; j + 1 < H; ++j) {
+            std::swap(row0, row1);
+            table_row(j + 1, row1);
             for (int i = 0; i < W; ++i)
-                cells[size_t(j) * W + size_t(i)] =
-                    0.25f * (table(i, j) + table(i + 1, j) + table(i, j + 1) + table(i + 1, j + 1));
+                cells[size_t(j) * W + size_t(i)] = 0.25f * (row0[size_t(i)] + row0[size_t(i) + 1] +
+                                                            row1[size_t(i)] + row1[size_t(i) + 1]);
+        }
         m_cells.build(cells.data(), cells.size());
         m_total = m_cells.sum();
         // Density over the unit square = table value / (mean cell value).
