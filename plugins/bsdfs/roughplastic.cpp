@@ -121,9 +121,17 @@ double rough_interface_energy(const MicrofacetDistribution &distr, const Vector3
         }
     }
 
+    // wi lies in the xz plane and the distribution is isotropic: the normal whose y slope is
+    // negated gives the same value (wo mirrored in y), and the rule's nodes and weights are
+    // symmetric about the middle. Half of the nodes of the variate that sets the y slope (the
+    // second for Beckmann, the first, the disk's x, for GGX) are evaluated and counted twice:
+    // the tables cost half as much (staircase's load: 125 ms) for the same rule up to
+    // rounding. n is even.
+    FACET_ASSERT(n % 2 == 0);
+    const size_t a_end = separable ? n : n / 2, b_end = separable ? n / 2 : n;
     double sum = 0.0;
-    for (size_t a = 0; a < n; ++a) {
-        for (size_t b = 0; b < n; ++b) {
+    for (size_t a = 0; a < a_end; ++a) {
+        for (size_t b = 0; b < b_end; ++b) {
             Point2f slope = separable ? Point2f(slope_x[a], slope_y[b])
                                       : distr.sample_visible_11(cos_s, Point2f(node(a), node(b)));
             Vector3f m = normalize(Vector3f(-alpha * slope.x, -alpha * slope.y, 1.f));
@@ -139,7 +147,7 @@ double rough_interface_energy(const MicrofacetDistribution &distr, const Vector3
                 if (Frame::cos_theta(wo) >= 0.f) continue;
                 f = (1.f - F) * distr.smith_g1(wo, m);
             }
-            sum += 0.25 * weights[a] * weights[b] * double(f);
+            sum += 0.5 * weights[a] * weights[b] * double(f); // 2 x the quarter of the Jacobian
         }
     }
     return sum;
