@@ -307,6 +307,9 @@ void Scene::build(const Properties &props, Scene *previous) {
             entry.mesh = static_cast<const Mesh *>(shape);
             entry.radiance = *radiance;
             entry.inv_area = 1.f / shape->surface_area();
+        } else if (shape && radiance) {
+            entry.shape = shape;
+            entry.radiance = *radiance;
         }
         emitter->set_scene_index(uint32_t(m_emitter_table.size()));
         m_emitter_table.push_back(entry);
@@ -607,6 +610,11 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
         ds.pdf = triangle_light_pdf(entry.inv_area, ds);
         if (!(ds.pdf > 0.f)) return result;
         weight = entry.radiance / ds.pdf;
+    } else if (entry.shape) {
+        // Another shape's constant light: the shape's own sample, from its front side only.
+        ds = entry.shape->sample_direction(ref, u);
+        if (!(ds.pdf > 0.f) || !(dot(ds.n, ds.d) < 0.f)) return result;
+        weight = entry.radiance / ds.pdf;
     } else {
         std::tie(ds, weight) = entry.emitter->sample_direction(ref, u);
     }
@@ -641,17 +649,20 @@ float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample
         index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter;
     if (m_emitter_uniform && !m_light_bvh) {
         const float count = float(m_emitter_table.size());
-        if (ours && m_emitter_table[index].mesh)
-            return triangle_light_pdf(m_emitter_table[index].inv_area, ds) / count;
+        if (ours) return light_pdf(m_emitter_table[index], ref, ds) / count;
         return ds.emitter->pdf_direction(ref, ds) / count;
     }
     if (!ours) return 0.f;
     const float pmf = pick_pmf(&ref, index);
     if (!(pmf > 0.f)) return 0.f;
-    const EmitterEntry &entry = m_emitter_table[index];
-    return (entry.mesh ? triangle_light_pdf(entry.inv_area, ds)
-                       : ds.emitter->pdf_direction(ref, ds)) *
-           pmf;
+    return light_pdf(m_emitter_table[index], ref, ds) * pmf;
+}
+
+float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref,
+                       const DirectionSample &ds) const {
+    if (entry.mesh) return triangle_light_pdf(entry.inv_area, ds);
+    if (entry.shape) return dot(ds.n, ds.d) < 0.f ? entry.shape->pdf_direction(ref, ds) : 0.f;
+    return ds.emitter->pdf_direction(ref, ds);
 }
 
 std::pair<size_t, float> Scene::pick_emitter(const Interaction *ref, float &u) const {

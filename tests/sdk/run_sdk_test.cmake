@@ -76,8 +76,8 @@ step("render through FACET_PLUGIN_PATH" ${CMAKE_COMMAND} -E env FACET_PLUGIN_PAT
 
 # An area light without constant_radiance() and a sampler that does not expose its generator,
 # written against the interfaces alone, render the images facet's own `area` and `independent`
-# render: the shortcuts for constant mesh lights and PCG32 samplers change nothing a user's
-# plugin can see.
+# render: the shortcuts for constant lights (meshes and other shapes) and PCG32 samplers change
+# nothing a user's plugin can see.
 build_project(${SOURCE_DIR}/tests/sdk/plain ${WORK}/plain-build -DCMAKE_BUILD_TYPE=Release)
 step("plain plugins against facet's" ${WORK}/plain-build/plain_check
      ${SOURCE_DIR}/tests/sdk/plain/scene.xml ${WORK}/plain-build)

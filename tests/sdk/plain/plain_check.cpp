@@ -1,8 +1,8 @@
 // The out-of-tree `plainarea` light and `plainsampler` against facet's `area` and `independent`:
-// a scene lit by mesh lights renders the same image whether the scene samples a light from its
-// constant_radiance() or through the emitter's own methods, and whether the render draws from
-// the sampler's generator or through next_1d()/next_2d().
-// Usage: plain_check <scene.xml> <folder of the plugins>; exits with 1 when an image differs.
+// a scene lit by mesh lights and by a sphere's and a disk's renders the same image whether the
+// scene samples a light from its constant_radiance() or through the emitter's own methods, and
+// whether the render draws from the sampler's generator or through next_1d()/next_2d(). Usage:
+// plain_check <scene.xml> <folder of the plugins>; exits with 1 when an image differs.
 
 #include <facet/plugin.h>
 #include <facet/render.h>

@@ -516,6 +516,55 @@ TEST(SceneEmitters, TriangleLightsMatchTheirEmitter) {
     EXPECT_GT(box, 100);
 }
 
+TEST(SceneEmitters, ShapeLightsMatchTheirEmitter) {
+    // A constant area light on a sphere and one on a disk (not meshes) are sampled by the scene
+    // through their shapes' own sample_direction(), without the emitter's call: the same
+    // points, pdfs and weights as the emitter's virtual methods to the last bit, nothing from
+    // behind the disk, and pdf_emitter_direction() gives exactly the pdf the sample reported.
+    Properties props = rect_and_sphere(area_light(Color3f(3.f, 2.f, 1.f)));
+    Properties disk;
+    disk.set_transform("to_world", Transform::translate(Vector3f(1.2f, -0.4f, 1.1f)) *
+                                       Transform::rotate(Vector3f(1, 0.3f, 0), 170.f) *
+                                       Transform::scale(Vector3f(0.6f)));
+    disk.set_object("light", area_light(Color3f(1.f, 4.f, 2.f)));
+    props.set_object("lamp", create(ObjectType::Shape, "disk", disk));
+    Scene scene(props);
+    ASSERT_EQ(scene.emitters().size(), 2u);
+
+    PCG32 rng(33);
+    int ball = 0, lamp = 0, behind = 0;
+    for (const Point3f &o : {Point3f(-0.6f, 0.9f, 0.f), Point3f(1.5f, -0.2f, 2.2f)}) {
+        Interaction ref;
+        ref.p = o;
+        ref.n = Normal3f(0.f, 0.f, 1.f);
+        for (int i = 0; i < 2000; ++i) {
+            const Point2f u = next_point2f(rng);
+            auto [ds, weight] = scene.sample_emitter_direction(ref, u, false);
+            Point2f v = u;
+            const auto [picked, pmf] = scene.sample_emitter(ref, v.x);
+            ASSERT_TRUE(picked);
+            auto [own, own_weight] = picked->sample_direction(ref, v);
+            if (!(own.pdf > 0.f) || own_weight.is_black()) {
+                // The emitter sends nothing this way (the disk's back): nor does the scene.
+                EXPECT_TRUE(weight.is_black());
+                ++behind;
+                continue;
+            }
+            ASSERT_EQ(ds.emitter, picked);
+            EXPECT_EQ(ds.p, own.p);
+            EXPECT_EQ(ds.d, own.d);
+            EXPECT_EQ(ds.pdf, own.pdf * pmf);
+            EXPECT_EQ(weight, own_weight / pmf);
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), ds.pdf);
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), picked->pdf_direction(ref, ds) * pmf);
+            (picked->shape() == scene.shapes()[1].get() ? ball : lamp)++;
+        }
+    }
+    EXPECT_GT(ball, 500);
+    EXPECT_GT(lamp, 500);
+    EXPECT_GT(behind, 100);
+}
+
 TEST(SceneEmitters, EnvironmentIsSeenThroughTheMissRecord) {
     Properties props = rect_and_sphere();
     Properties sky;
