@@ -125,8 +125,8 @@ double rough_interface_energy(const MicrofacetDistribution &distr, const Vector3
     // negated gives the same value (wo mirrored in y), and the rule's nodes and weights are
     // symmetric about the middle. Half of the nodes of the variate that sets the y slope (the
     // second for Beckmann, the first, the disk's x, for GGX) are evaluated and counted twice:
-    // the tables cost half as much (staircase's load: 125 ms) for the same rule up to
-    // rounding. n is even.
+    // the tables cost half as much (they were 125 ms of the staircase's load) for the same rule
+    // up to rounding. n is even.
     FACET_ASSERT(n % 2 == 0);
     const size_t a_end = separable ? n : n / 2, b_end = separable ? n / 2 : n;
     double sum = 0.0;

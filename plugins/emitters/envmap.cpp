@@ -110,8 +110,7 @@ public:
         m_height = img.height;
         // Grey (and grey + alpha) images are grey; an alpha channel is ignored.
         int colour_channels = img.channels >= 3 ? 3 : 1;
-        // Written once, in order (no zero-filled array written over: the living room's
-        // 2048x1024 sky spent ~80 ms of its load on that).
+        // Written once, in order (no zero-filled array written over).
         m_texels.clear();
         m_texels.reserve(size_t(m_width + 1) * m_height);
         for (int y = 0; y < m_height; ++y) {
