@@ -283,6 +283,14 @@ std::shared_ptr<Emitter> checkerboard_light() {
             </texture>
         </emitter>)"));
 }
+
+/// Which square of checkerboard_light() the point (u, v) lies in (0: u and v on the same side
+/// of 1/2), counted in `seen`, and the radiance there.
+Color3f checker_radiance(double u, double v, int (&seen)[2]) {
+    const int square = (u > 0.5) == (v > 0.5) ? 0 : 1;
+    ++seen[square];
+    return square == 0 ? Color3f(1.f, 2.f, 3.f) : Color3f(5.f);
+}
 } // namespace
 
 TEST(EmitterArea, TexturedRadiance) {
@@ -296,10 +304,7 @@ TEST(EmitterArea, TexturedRadiance) {
     int seen[2] = {0, 0};
     for (int i = 0; i < 1000; ++i) {
         auto [ds, weight] = e->sample_direction(ref, next_point2f(rng));
-        bool first = (ds.uv.x > 0.5f) == (ds.uv.y > 0.5f);
-        ++seen[first ? 0 : 1];
-        Color3f expected = first ? Color3f(1.f, 2.f, 3.f) : Color3f(5.f);
-        expect_color_near(weight * ds.pdf, expected, 1e-5f);
+        expect_color_near(weight * ds.pdf, checker_radiance(ds.uv.x, ds.uv.y, seen), 1e-5f);
     }
     EXPECT_GT(seen[0], 400);
     EXPECT_GT(seen[1], 400);
@@ -331,9 +336,7 @@ TEST(EmitterArea, TexturedRadianceOnASphere) {
         if (std::abs(u - 0.5) < 1e-4 || u < 1e-4 || u > 1.0 - 1e-4) continue; // on an edge
         EXPECT_NEAR(ds.uv.y, v, 1e-5);
         EXPECT_NEAR(ds.uv.x, u, 1e-5);
-        const bool first = (u > 0.5) == (v > 0.5);
-        ++seen[first ? 0 : 1];
-        expect_color_near(weight * ds.pdf, first ? Color3f(1.f, 2.f, 3.f) : Color3f(5.f), 1e-5f);
+        expect_color_near(weight * ds.pdf, checker_radiance(u, v, seen), 1e-5f);
     }
     EXPECT_GT(seen[0], 400);
     EXPECT_GT(seen[1], 400);
