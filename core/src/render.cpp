@@ -290,6 +290,7 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     uint32_t cap = 1;
     while (uint64_t(cap) * 2 * film_pixels <= (uint64_t(1) << 18) && cap < (1u << 30)) cap *= 2;
     plan(integrator, cap, "samples");
+    m_scene.prepare_light_sampling();
     integrator.begin_render(m_sensor);
     const std::vector<std::string> aov_names = integrator.aov_names();
     m_buffer = std::make_unique<FilmBuffer>(m_window.offset, m_window.size,

@@ -1,4 +1,5 @@
 #include "light_bvh.h"
+#include "light_guide.h"
 #include "mesh_inline.h"
 #include "scene_queries.h"
 #include "stats.h"
@@ -10,10 +11,12 @@
 #include <facet/logger.h>
 #include <facet/mesh.h>
 #include <facet/plugin.h>
+#include <facet/random.h>
 #include <facet/scene.h>
 #include <facet/sensor.h>
 #include <facet/shape.h>
 #include <facet/shapegroup.h>
+#include <facet/spectrum.h>
 
 #include <algorithm>
 #include <atomic>
@@ -206,6 +209,10 @@ size_t Scene::rebuild(const Properties &props) {
     std::swap(m_robust, next.m_robust);
     std::swap(m_two_level, next.m_two_level);
     std::swap(m_mode, next.m_mode);
+    std::swap(m_light_guide_enabled, next.m_light_guide_enabled);
+    // The guide surveyed the old scene: the next render surveys this one.
+    m_light_guide.reset();
+    m_light_guide_ready = false;
     return next.m_geometries_built;
 }
 
@@ -328,6 +335,7 @@ void Scene::build(const Properties &props, Scene *previous) {
     // (watertight, slower) one.
     m_robust = props.get_bool("embree_use_robust_intersections", false);
     m_two_level = props.get_bool("embree_two_level", false);
+    m_light_guide_enabled = props.get_bool("light_guide", true);
     if (previous && previous->m_rtc_scene && previous->m_shapes == m_shapes &&
         previous->m_robust == m_robust && previous->m_two_level == m_two_level) {
         // The same shapes (an update changed no geometry): the Embree scene is theirs.
@@ -594,6 +602,16 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
     Color3f &weight = result.second;
     const size_t count = m_emitter_table.size();
     if (count == 0) return result;
+    // The guide's probability of a light sample here: u.x decides, and is rescaled for the
+    // choice of the emitter.
+    float take = 1.f;
+    if (m_light_guide) {
+        take = m_light_guide->probability(ref.p);
+        if (take < 1.f) {
+            if (!(u.x < take)) return result;
+            u.x = std::min(u.x / take, OneMinusEpsilon);
+        }
+    }
     const auto [index, pmf] = pick_emitter(&ref, u.x);
     // None can reach ref, or sampling_weight 0 (never picked but by rounding).
     if (!(pmf > 0.f)) return result;
@@ -634,6 +652,11 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
         weight /= pmf;
     }
 
+    if (take < 1.f) {
+        if (!ds.delta) ds.pdf *= take;
+        weight /= take;
+    }
+
     if (test_visibility && !emitter_visible(ref, ds)) weight = Color3f(0.f);
     return result;
 }
@@ -643,6 +666,11 @@ bool Scene::emitter_visible(const Interaction &ref, const DirectionSample &ds) c
 }
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {
+    const float pdf = unguided_emitter_pdf(ref, ds);
+    return m_light_guide ? pdf * m_light_guide->probability(ref.p) : pdf;
+}
+
+float Scene::unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds) const {
     if (!ds.emitter || m_emitter_table.empty()) return 0.f;
     const uint32_t index = ds.emitter->scene_index();
     const bool ours =
@@ -656,6 +684,66 @@ float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample
     const float pmf = pick_pmf(&ref, index);
     if (!(pmf > 0.f)) return 0.f;
     return light_pdf(m_emitter_table[index], ref, ds) * pmf;
+}
+
+void Scene::prepare_light_sampling() const {
+    const std::lock_guard<std::mutex> lock(m_light_guide_mutex);
+    if (m_light_guide_ready) return;
+    if (m_light_guide_enabled && !m_emitter_table.empty() && !m_sensors.empty() && m_bbox.valid()) {
+        auto guide = std::make_unique<detail::LightGuide>(m_bbox);
+        survey_light_samples(*guide);
+        if (guide->finish()) m_light_guide = std::move(guide);
+    }
+    m_light_guide_ready = true;
+}
+
+float Scene::light_sample_probability(const Point3f &p) const {
+    return m_light_guide ? m_light_guide->probability(p) : 1.f;
+}
+
+void Scene::survey_light_samples(detail::LightGuide &guide) const {
+    // Paths from the sensors in turn, through uniform points of their films, each bounce by
+    // its BSDF's own sample, with a light sample at every vertex whose BSDF is not purely
+    // specular: what a path tracer's vertices see. One thread and a fixed generator: the
+    // survey is the same for every render of the scene.
+    constexpr uint32_t Paths = 4096, Vertices = 5;
+    const BSDFContext ctx;
+    const bool spectral = is_spectral(m_mode);
+    PCG32 rng;
+    // One draw per statement: the order of a call's arguments is the compiler's.
+    auto next_2d = [&rng] {
+        const float x = rng.next_float();
+        return Point2f(x, rng.next_float());
+    };
+    SurfaceInteraction si;
+    for (uint32_t k = 0; k < Paths; ++k) {
+        const Sensor &sensor = *m_sensors[k % m_sensors.size()];
+        const Point2f film = next_2d();
+        const Point2f aperture = next_2d();
+        Ray ray = sensor.sample_ray(0.f, film, aperture).first;
+        const float u_wavelengths = rng.next_float();
+        if (spectral) ray.wavelengths = sample_wavelengths(u_wavelengths).first;
+        for (uint32_t depth = 0; depth < Vertices; ++depth) {
+            if (!ray_intersect(ray, si) || !si.shape) break;
+            const BSDF *bsdf = si.shape->bsdf();
+            if (!bsdf) break;
+            const Point2f u_light = next_2d();
+            const float u1 = rng.next_float();
+            const Point2f u2 = next_2d();
+            if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
+                const auto [ds, weight] = sample_emitter_direction(si, u_light, false);
+                bool useful = false;
+                if (ds.pdf > 0.f && !weight.is_black()) {
+                    const Color3f f = bsdf->eval_pdf(ctx, si, si.to_local(ds.d)).first;
+                    useful = !f.is_black() && emitter_visible(si, ds);
+                }
+                guide.record(si.p, useful);
+            }
+            const auto [bs, weight] = bsdf->sample(ctx, si, u1, u2);
+            if (weight.is_black() || !(bs.pdf > 0.f)) break;
+            ray = si.spawn_ray(si.to_world(bs.wo));
+        }
+    }
 }
 
 float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref,

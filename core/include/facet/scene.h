@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -28,6 +29,7 @@ struct SceneDescription;
 namespace detail {
 class SceneQueries;
 class LightBVH;
+class LightGuide;
 } // namespace detail
 
 /// The scene: shapes in one Embree scene, emitters, sensors and the integrator.
@@ -52,18 +54,32 @@ public:
     bool ray_test(const Ray &ray) const;
     /// Picks an emitter (sample_emitter()) and samples a direction to it from ref. The weight
     /// includes the selection probability; with `test_visibility` an occluded sample gets weight
-    /// zero.
+    /// zero. Once prepare_light_sampling() has run, a point where the scene's survey found few
+    /// light samples useful takes one only with a probability q below 1 (else: no sample, pdf
+    /// 0); the weight is divided by q and the density multiplied by it, as in
+    /// pdf_emitter_direction(), so estimates keep their expectation.
     std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
                                                                  bool test_visibility) const;
     /// The visibility test of sample_emitter_direction() on its own: true when nothing blocks
     /// the segment from ref to the emitter sample ds (or the ray towards it, for an emitter at
     /// infinity). For callers that test later, once the BSDF has given the sample a weight.
     bool emitter_visible(const Interaction &ref, const DirectionSample &ds) const;
-    /// Density of sample_emitter_direction() for ds (selection probability included).
+    /// Density of sample_emitter_direction() for ds (selection probability and q included).
     float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const;
+    /// Surveys, once per scene (and again after rebuild()), where light samples are worth
+    /// taking: a few thousand paths from the scene's sensors, a light sample at each vertex,
+    /// counted per cell of a grid over the scene as useful (the emitter gives light, the BSDF
+    /// reflects it, nothing blocks it) or not. Sets sample_emitter_direction()'s q per cell
+    /// (1 where at least a quarter were useful, in proportion below that, at least 0.1). The
+    /// result depends on the scene alone, never on a render's threads, seed or split. Renders
+    /// call it; the scene option `light_guide` false (a facet extension) turns it off.
+    void prepare_light_sampling() const;
+    /// sample_emitter_direction()'s probability of a light sample at p: 1 until
+    /// prepare_light_sampling() has run, and wherever the survey found them worth it.
+    float light_sample_probability(const Point3f &p) const;
     /// Picks the emitter of a light sample for the point `ref` (sample_emitter_direction()'s
-    /// choice). Where the scene gives emitters a `sampling_weight`: in proportion to it (1 for
-    /// the others), as Mitsuba 3 does, whatever the point. Otherwise the emitters with
+    /// choice, before its q). Where the scene gives emitters a `sampling_weight`: in proportion to
+    /// it (1 for the others), as Mitsuba 3 does, whatever the point. Otherwise the emitters with
     /// light_bounds() (eight or more) share the samples the uniform choice would give them
     /// through the light hierarchy, in proportion to a bound of their importance at ref.p
     /// (power, distance, orientation, ref.n); the others keep their uniform share. Returns the
@@ -210,6 +226,17 @@ private:
     size_t m_geometries_built = 0;
     bool m_two_level = false; ///< the scene option `embree_two_level`
     ColourMode m_mode = ColourMode::RGB;
+    /// The light-sample guide (prepare_light_sampling()): null until it has run, or when it
+    /// found every cell worth a light sample at every vertex. Set before any render's threads
+    /// start, read by them.
+    mutable std::unique_ptr<detail::LightGuide> m_light_guide;
+    mutable bool m_light_guide_ready = false;
+    mutable std::mutex m_light_guide_mutex;
+    bool m_light_guide_enabled = true; ///< the scene option `light_guide`
+    /// pdf_emitter_direction() before the guide's q.
+    float unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds) const;
+    /// prepare_light_sampling()'s survey into `guide`.
+    void survey_light_samples(detail::LightGuide &guide) const;
 };
 
 /// Embree device shared by all scenes of the process; `threads` = 0 lets Embree decide.
