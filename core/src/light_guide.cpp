@@ -56,9 +56,9 @@ void LightGuide::record(const Point3f &p, bool useful) {
     }
 }
 
-bool LightGuide::finish() {
+size_t LightGuide::finish() {
     const Level &finest = m_levels[0];
-    bool changes = false;
+    size_t changed = 0;
     int c[3];
     for (c[2] = 0; c[2] < finest.dims[2]; ++c[2])
         for (c[1] = 0; c[1] < finest.dims[1]; ++c[1])
@@ -74,14 +74,14 @@ bool LightGuide::finish() {
                     break;
                 }
                 m_probability[index(finest, c, 0)] = q;
-                changes = changes || q < 1.f;
+                if (q < 1.f) ++changed;
             }
     // The counts are not needed any more.
     for (Level &level : m_levels) {
         level.records = {};
         level.useful = {};
     }
-    return changes;
+    return changed;
 }
 
 } // namespace facet::detail

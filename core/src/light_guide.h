@@ -31,9 +31,9 @@ public:
 
     /// One light sample of the survey at p: useful or not.
     void record(const Point3f &p, bool useful);
-    /// Turns the records into each cell's probability. true when some cell's is below 1 (the
-    /// guide changes something).
-    bool finish();
+    /// Turns the records into each cell's probability. Returns how many cells have one below 1
+    /// (0: the guide changes nothing).
+    size_t finish();
 
     /// The probability of taking a light sample at p, in (0, 1].
     float probability(const Point3f &p) const { return m_probability[cell(p)]; }

@@ -690,9 +690,15 @@ void Scene::prepare_light_sampling() const {
     const std::lock_guard<std::mutex> lock(m_light_guide_mutex);
     if (m_light_guide_ready) return;
     if (m_light_guide_enabled && !m_emitter_table.empty() && !m_sensors.empty() && m_bbox.valid()) {
+        const auto start = std::chrono::steady_clock::now();
         auto guide = std::make_unique<detail::LightGuide>(m_bbox);
         survey_light_samples(*guide);
-        if (guide->finish()) m_light_guide = std::move(guide);
+        const size_t guided = guide->finish();
+        if (guided > 0) m_light_guide = std::move(guide);
+        FACET_LOG(
+            Debug, "light-sample guide: survey in {:.1f} ms, q < 1 in {} cells",
+            1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+            guided);
     }
     m_light_guide_ready = true;
 }
