@@ -13,7 +13,9 @@ LightGuide::LightGuide(const BoundingBox3f &bounds) {
     m_origin = bounds.valid() ? bounds.min : Point3f(0.f);
     Level finest;
     for (int a = 0; a < 3; ++a) {
-        finest.dims[a] = std::clamp(int(std::ceil(extent[a] / size)), 1, MaxCells);
+        // Clamped as a float: a huge or non-finite extent never reaches the conversion.
+        const float cells = std::ceil(extent[a] / size);
+        finest.dims[a] = cells >= 1.f ? int(std::min(cells, float(MaxCells))) : 1;
         m_inv_cell[a] = 1.f / size;
     }
     m_levels.push_back(finest);
