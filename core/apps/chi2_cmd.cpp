@@ -256,7 +256,7 @@ struct EmitterCommand {
     CommonOptions common;
     std::string name, xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle", colour_mode;
     std::vector<std::string> params;
-    bool emission = false;
+    bool emission = false, mis = false;
 };
 
 CLI::App *add_emitter_command(CLI::App &app, EmitterCommand &c) {
@@ -272,6 +272,10 @@ CLI::App *add_emitter_command(CLI::App &app, EmitterCommand &c) {
                       "Test the directions of emitted rays (sample_ray against "
                       "pdf_ray_direction; emitters with one origin, e.g. spot) instead of "
                       "direction sampling from --ref");
+    emitter->add_flag("--mis", c.mis,
+                      "Test the light samples an integrator weights by MIS against BSDF samples "
+                      "(sample_direction_mis against pdf_direction_mis) instead of those that "
+                      "stand alone");
     emitter->add_option("--ref", c.ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
     emitter->add_option(
         "--shape", c.shape,
@@ -297,10 +301,12 @@ int run_emitter(EmitterCommand &c, const std::string &everything) {
         scene = EmitterAdapter::scene_xml(c.name, c.params, c.shape);
     }
     if (c.emission) {
+        if (c.mis) FACET_THROW("--mis tests light samples, --emission emitted rays: give one");
         EmissionAdapter adapter(scene, 0, resolve_mode(c.colour_mode));
         return run(adapter, c.common, slug("emission", c.name, everything));
     }
     EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]), 0, resolve_mode(c.colour_mode));
+    if (c.mis) adapter.set_light_sampling(LightSampling::MIS);
     return run(adapter, c.common, slug("emitter", c.name, everything));
 }
 

@@ -595,7 +595,8 @@ inline float triangle_light_pdf(float inv_area, const DirectionSample &ds) {
 } // namespace
 
 std::pair<DirectionSample, Color3f>
-Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility) const {
+Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility,
+                                LightSampling sampling) const {
     // The result is built in place (one copy of the sample less on every return).
     std::pair<DirectionSample, Color3f> result{DirectionSample(), Color3f(0.f)};
     DirectionSample &ds = result.first;
@@ -634,7 +635,9 @@ Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_vis
         if (!(ds.pdf > 0.f) || !(dot(ds.n, ds.d) < 0.f)) return result;
         weight = entry.radiance / ds.pdf;
     } else {
-        std::tie(ds, weight) = entry.emitter->sample_direction(ref, u);
+        std::tie(ds, weight) = sampling == LightSampling::MIS
+                                   ? entry.emitter->sample_direction_mis(ref, u)
+                                   : entry.emitter->sample_direction(ref, u);
     }
     ds.emitter = entry.emitter;
     if (!(ds.pdf > 0.f) || weight.is_black()) {
@@ -665,25 +668,29 @@ bool Scene::emitter_visible(const Interaction &ref, const DirectionSample &ds) c
     return !occluded(std::isfinite(ds.dist) ? ref.spawn_ray_to(ds.p) : ref.spawn_ray(ds.d));
 }
 
-float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const {
-    const float pdf = unguided_emitter_pdf(ref, ds);
+float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds,
+                                   LightSampling sampling) const {
+    const float pdf = unguided_emitter_pdf(ref, ds, sampling);
     return m_light_guide ? pdf * m_light_guide->probability(ref.p) : pdf;
 }
 
-float Scene::unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds) const {
+float Scene::unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds,
+                                  LightSampling sampling) const {
     if (!ds.emitter || m_emitter_table.empty()) return 0.f;
     const uint32_t index = ds.emitter->scene_index();
     const bool ours =
         index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter;
     if (m_emitter_uniform && !m_light_bvh) {
         const float count = float(m_emitter_table.size());
-        if (ours) return light_pdf(m_emitter_table[index], ref, ds) / count;
-        return ds.emitter->pdf_direction(ref, ds) / count;
+        if (ours) return light_pdf(m_emitter_table[index], ref, ds, sampling) / count;
+        return (sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds)
+                                               : ds.emitter->pdf_direction(ref, ds)) /
+               count;
     }
     if (!ours) return 0.f;
     const float pmf = pick_pmf(&ref, index);
     if (!(pmf > 0.f)) return 0.f;
-    return light_pdf(m_emitter_table[index], ref, ds) * pmf;
+    return light_pdf(m_emitter_table[index], ref, ds, sampling) * pmf;
 }
 
 void Scene::prepare_light_sampling() const {
@@ -710,7 +717,8 @@ float Scene::light_sample_probability(const Point3f &p) const {
 void Scene::survey_light_samples(detail::LightGuide &guide) const {
     // Paths from the sensors in turn, through uniform points of their films, each bounce by
     // its BSDF's own sample, with a light sample at every vertex whose BSDF is not purely
-    // specular: what a path tracer's vertices see. One thread and a fixed generator: the
+    // specular (the light sample a path tracer takes, for MIS): what a path tracer's vertices
+    // see. One thread and a fixed generator: the
     // survey is the same for every render of the scene.
     constexpr uint32_t Paths = 4096, Vertices = 5;
     const BSDFContext ctx;
@@ -737,7 +745,8 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
             const float u1 = rng.next_float();
             const Point2f u2 = next_2d();
             if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
-                const auto [ds, weight] = sample_emitter_direction(si, u_light, false);
+                const auto [ds, weight] =
+                    sample_emitter_direction(si, u_light, false, LightSampling::MIS);
                 bool useful = false;
                 if (ds.pdf > 0.f && !weight.is_black()) {
                     const Color3f f = bsdf->eval_pdf(ctx, si, si.to_local(ds.d)).first;
@@ -753,10 +762,11 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
 }
 
 float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref,
-                       const DirectionSample &ds) const {
+                       const DirectionSample &ds, LightSampling sampling) const {
     if (entry.mesh) return triangle_light_pdf(entry.inv_area, ds);
     if (entry.shape) return dot(ds.n, ds.d) < 0.f ? entry.shape->pdf_direction(ref, ds) : 0.f;
-    return ds.emitter->pdf_direction(ref, ds);
+    return sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds)
+                                          : ds.emitter->pdf_direction(ref, ds);
 }
 
 std::pair<size_t, float> Scene::pick_emitter(const Interaction *ref, float &u) const {

@@ -71,6 +71,8 @@ public:
         m_frac_bsdf = m_bsdf_samples / total;
         m_weight_emitter = m_emitter_samples > 0 ? 1.f / m_emitter_samples : 0.f;
         m_weight_bsdf = m_bsdf_samples > 0 ? 1.f / m_bsdf_samples : 0.f;
+        // Without BSDF samples the light samples stand alone; with them, MIS weighs the two.
+        m_light_sampling = m_bsdf_samples > 0 ? LightSampling::MIS : LightSampling::Alone;
     }
 
     Color3f sample(const Scene &scene, Sampler &sampler, const Ray &ray,
@@ -96,7 +98,8 @@ public:
                 // Up to 65535 samples: a stop (Ctrl-C, timeout) need not wait for them all.
                 if (render_should_stop(i)) return result;
                 // The shadow ray last: a sample the BSDF gives no weight costs none.
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), false);
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), false,
+                                                                      m_light_sampling);
                 if (ds.pdf == 0.f || em_weight.is_black()) continue;
                 Vector3f wo = si.to_local(ds.d);
                 auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
@@ -132,7 +135,8 @@ public:
             if (L.is_black()) continue;
             float w = 1.f;
             if (!delta) {
-                float em_pdf = scene.pdf_emitter_direction(si, direction_to(si_bsdf, si));
+                float em_pdf = scene.pdf_emitter_direction(si, direction_to(si_bsdf, si),
+                                                           LightSampling::MIS);
                 w = mis_weight(bs.pdf * m_frac_bsdf, em_pdf * m_frac_emitter);
             }
             result += bsdf_weight * L * (w * m_weight_bsdf);
@@ -150,6 +154,7 @@ private:
     uint32_t m_emitter_samples, m_bsdf_samples;
     float m_frac_emitter, m_frac_bsdf, m_weight_emitter, m_weight_bsdf;
     bool m_hide_emitters;
+    LightSampling m_light_sampling;
 };
 
 } // namespace facet

@@ -45,6 +45,15 @@ struct LightBounds {
     bool two_sided = false;
 };
 
+/// How an estimator uses a light sample (Emitter::sample_direction_mis(),
+/// Scene::sample_emitter_direction()). `Alone`: its estimate stands by itself (light tracing, an
+/// integrator that samples only the emitters), so the samples must follow the light wherever it
+/// is. `MIS`: it is weighted by multiple importance sampling against a BSDF sample of the same
+/// direction, whose density pdf_emitter_direction(..., LightSampling::MIS) gives; an emitter may
+/// then send fewer samples where BSDF sampling already does well. Both keep the expected image;
+/// an estimator must use one mode for the samples and the densities it weights them with.
+enum class LightSampling { Alone, MIS };
+
 /// A light source.
 ///
 /// Conventions: sample_direction() samples a point on the emitter as seen from `ref` and returns
@@ -61,6 +70,19 @@ public:
                                                                  const Point2f &u) const = 0;
     /// Solid-angle density of sample_direction() for the point ds.p seen from ref (0 for delta).
     virtual float pdf_direction(const Interaction &ref, const DirectionSample &ds) const = 0;
+    /// The light sample of an estimator that weights it by MIS against BSDF sampling
+    /// (LightSampling::MIS), and its density. The same conventions as sample_direction() and
+    /// pdf_direction(); the density may be zero only where BSDF sampling is expected to carry the
+    /// light, never for a whole lobe of light (some samples must still reach every direction
+    /// with light: a BSDF without a density there would otherwise lose it). Default: the
+    /// samples of sample_direction().
+    virtual std::pair<DirectionSample, Color3f> sample_direction_mis(const Interaction &ref,
+                                                                     const Point2f &u) const {
+        return sample_direction(ref, u);
+    }
+    virtual float pdf_direction_mis(const Interaction &ref, const DirectionSample &ds) const {
+        return pdf_direction(ref, ds);
+    }
     /// Emitted radiance; zero for delta emitters.
     virtual Color3f eval(const SurfaceInteraction &si) const = 0;
 

@@ -3,6 +3,7 @@
 #include <facet/bbox.h>
 #include <facet/color.h>
 #include <facet/distribution.h>
+#include <facet/emitter.h>
 #include <facet/interaction.h>
 #include <facet/object.h>
 #include <facet/properties.h>
@@ -57,15 +58,21 @@ public:
     /// zero. Once prepare_light_sampling() has run, a point where the scene's survey found few
     /// light samples useful takes one only with a probability q below 1 (else: no sample, pdf
     /// 0); the weight is divided by q and the density multiplied by it, as in
-    /// pdf_emitter_direction(), so estimates keep their expectation.
+    /// pdf_emitter_direction(), so estimates keep their expectation. `sampling` says how the
+    /// caller uses the sample (LightSampling: alone, or weighted by MIS against BSDF samples with
+    /// the densities of pdf_emitter_direction() in the same mode); emitters may sample
+    /// differently for each (Emitter::sample_direction_mis()).
     std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
-                                                                 bool test_visibility) const;
+                                                                 bool test_visibility,
+                                                                 LightSampling sampling) const;
     /// The visibility test of sample_emitter_direction() on its own: true when nothing blocks
     /// the segment from ref to the emitter sample ds (or the ray towards it, for an emitter at
     /// infinity). For callers that test later, once the BSDF has given the sample a weight.
     bool emitter_visible(const Interaction &ref, const DirectionSample &ds) const;
-    /// Density of sample_emitter_direction() for ds (selection probability and q included).
-    float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds) const;
+    /// Density of sample_emitter_direction() in the mode `sampling` for ds (selection
+    /// probability and q included).
+    float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds,
+                                LightSampling sampling) const;
     /// Surveys, once per scene (and again after rebuild()), where light samples are worth
     /// taking: a few thousand paths from the scene's sensors, a light sample at each vertex,
     /// counted per cell of a grid over the scene as useful (the emitter gives light, the BSDF
@@ -203,8 +210,8 @@ private:
     float pick_pmf(const Interaction *ref, size_t index) const;
     /// The solid-angle density of emitter `entry`'s own sample for ds seen from ref (without
     /// the selection): computed inline for triangle lights and shapes' constant lights.
-    float light_pdf(const EmitterEntry &entry, const Interaction &ref,
-                    const DirectionSample &ds) const;
+    float light_pdf(const EmitterEntry &entry, const Interaction &ref, const DirectionSample &ds,
+                    LightSampling sampling) const;
     /// Per Embree geometry id: its shape, and the same shape as a Mesh when the scene computes
     /// the hits on it itself (without this the real-scene bench ran matpreview 2.2% to 8.1%
     /// slower in three of four paired measurements).
@@ -234,7 +241,8 @@ private:
     mutable std::mutex m_light_guide_mutex;
     bool m_light_guide_enabled = true; ///< the scene option `light_guide`
     /// pdf_emitter_direction() before the guide's q.
-    float unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds) const;
+    float unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds,
+                               LightSampling sampling) const;
     /// prepare_light_sampling()'s survey into `guide`.
     void survey_light_samples(detail::LightGuide &guide) const;
 };

@@ -287,7 +287,10 @@ std::string EmitterAdapter::scene_xml(const std::string &plugin,
 
 Chi2Sample EmitterAdapter::sample(const float *u) const {
     Chi2Sample s;
-    auto [ds, weight] = m_emitter->sample_direction(m_ref, Point2f(u[0], u[1]));
+    const Point2f u2(u[0], u[1]);
+    auto [ds, weight] = m_sampling == LightSampling::MIS
+                            ? m_emitter->sample_direction_mis(m_ref, u2)
+                            : m_emitter->sample_direction(m_ref, u2);
     if (weight.is_black() || ds.pdf == 0.f) return s;
     s.has_weight = true;
     s.weight = weight;
@@ -299,8 +302,13 @@ Chi2Sample EmitterAdapter::sample(const float *u) const {
     s.kind = Chi2Sample::Kind::Smooth;
     s.sampled_pdf = ds.pdf;
     // The record's own point: a traced ray could miss the shape's edge by rounding.
-    s.pdf = m_emitter->pdf_direction(m_ref, ds);
+    s.pdf = emitter_pdf(ds);
     return s;
+}
+
+float EmitterAdapter::emitter_pdf(const DirectionSample &ds) const {
+    return m_sampling == LightSampling::MIS ? m_emitter->pdf_direction_mis(m_ref, ds)
+                                            : m_emitter->pdf_direction(m_ref, ds);
 }
 
 double EmitterAdapter::pdf(const Vector3f &d) const {
@@ -312,7 +320,7 @@ double EmitterAdapter::pdf(const Vector3f &d) const {
         ds.dist = 2.f * (radius + norm(m_ref.p));
         ds.p = m_ref.p + d * ds.dist;
         ds.n = -d;
-        return m_emitter->pdf_direction(m_ref, ds);
+        return emitter_pdf(ds);
     }
     SurfaceInteraction si;
     if (!m_scene->ray_intersect(Ray(m_ref.p, d), si) || !si.shape ||
@@ -322,11 +330,12 @@ double EmitterAdapter::pdf(const Vector3f &d) const {
     ds.n = si.n;
     ds.uv = si.uv;
     ds.dist = si.t;
-    return m_emitter->pdf_direction(m_ref, ds);
+    return emitter_pdf(ds);
 }
 
 std::string EmitterAdapter::to_string() const {
-    return fmt::format("{}, reference point {}", m_emitter->to_string(), vec_str(m_ref.p));
+    return fmt::format("{}, reference point {}{}", m_emitter->to_string(), vec_str(m_ref.p),
+                       m_sampling == LightSampling::MIS ? ", light samples for MIS" : "");
 }
 
 // -- Emission directions ----------------------------------------------------------------------

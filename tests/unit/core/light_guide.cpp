@@ -156,7 +156,7 @@ TEST(LightGuide, GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ) {
         if (q < 1.f) ++below_one;
         for (int i = 0; i < 64; ++i) {
             const Point2f u = next_point2f(rng);
-            const auto [ds, weight] = guided->sample_emitter_direction(si, u, false);
+            const auto [ds, weight] = guided->sample_emitter_direction(si, u, false, LightSampling::Alone);
             expected_taken += q;
             taken_variance += q * (1.0 - q);
             if (!(u.x < q)) { // no sample
@@ -166,15 +166,15 @@ TEST(LightGuide, GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ) {
             }
             ++taken;
             const Point2f rescaled(std::min(u.x / q, OneMinusEpsilon), u.y);
-            const auto [own, own_weight] = plain->sample_emitter_direction(si, rescaled, false);
+            const auto [own, own_weight] = plain->sample_emitter_direction(si, rescaled, false, LightSampling::Alone);
             EXPECT_EQ(ds.p, own.p);
             EXPECT_EQ(ds.d, own.d);
             EXPECT_EQ(ds.pdf, own.pdf * q);
             EXPECT_EQ(weight, own_weight / q);
             if (ds.pdf > 0.f) {
-                EXPECT_EQ(guided->pdf_emitter_direction(si, ds), ds.pdf);
-                EXPECT_EQ(guided->pdf_emitter_direction(si, ds),
-                          plain->pdf_emitter_direction(si, own) * q);
+                EXPECT_EQ(guided->pdf_emitter_direction(si, ds, LightSampling::Alone), ds.pdf);
+                EXPECT_EQ(guided->pdf_emitter_direction(si, ds, LightSampling::Alone),
+                          plain->pdf_emitter_direction(si, own, LightSampling::Alone) * q);
             }
         }
     }

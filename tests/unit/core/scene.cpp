@@ -388,13 +388,13 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
     const float sphere_pmf = scene.emitter_pmf(ref, *sphere_light);
     for (int i = 0; i < 1000; ++i) {
         Point2f u = next_point2f(rng);
-        auto [ds, weight] = scene.sample_emitter_direction(ref, u, true);
+        auto [ds, weight] = scene.sample_emitter_direction(ref, u, true, LightSampling::Alone);
         float picked_u = u.x;
         if (scene.sample_emitter(ref, picked_u).first == sphere_light) {
             ASSERT_EQ(ds.emitter, sphere_light);
             ASSERT_GT(ds.pdf, 0.f);
             ++area_samples;
-            EXPECT_NEAR(scene.pdf_emitter_direction(ref, ds), ds.pdf, 1e-5f * ds.pdf);
+            EXPECT_NEAR(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf, 1e-5f * ds.pdf);
             // The point on the ball seen from the floor is visible: the weight is L / pdf.
             EXPECT_NEAR(weight.r * ds.pdf, radiance.r, 1e-4f);
             EXPECT_NEAR(weight.b * ds.pdf, radiance.b, 1e-4f);
@@ -404,7 +404,7 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
             ASSERT_NE(ds.emitter, sphere_light);
             EXPECT_TRUE(ds.delta);
             ++point_samples;
-            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), 0.f);
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), 0.f);
             // The ball sits between the floor point and the lamp only for some points.
             Ray shadow = ref.spawn_ray_to(ds.p);
             EXPECT_EQ(weight.is_black(), scene.ray_test(shadow));
@@ -417,17 +417,17 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
     // Occluded: from (-1, -1, 0) the line to the lamp passes through the centre of the ball.
     SurfaceInteraction under;
     ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-1.f, -1.f, 1.f), Vector3f(0, 0, -1)), under));
-    auto [ds, weight] = scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), true);
+    auto [ds, weight] = scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), true, LightSampling::Alone);
     ASSERT_NE(ds.emitter, sphere_light);
     EXPECT_TRUE(weight.is_black());
-    auto [ds2, weight2] = scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), false);
+    auto [ds2, weight2] = scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), false, LightSampling::Alone);
     EXPECT_FALSE(weight2.is_black());
 }
 
 TEST(SceneEmitters, EmitterVisibleIsTheSamplesOwnShadowTest) {
     // The path tracer samples emitters without the visibility test and asks emitter_visible()
     // once the BSDF has weighted the sample: that must be exactly the test that
-    // sample_emitter_direction(..., true) applies. Floor points around and under the ball, lit
+    // sample_emitter_direction(..., true, LightSampling::Alone) applies. Floor points around and under the ball, lit
     // by the ball itself, a point lamp and a slanted directional light (a sample at infinity).
     Properties props = rect_and_sphere(area_light(Color3f(1.f)));
     Properties point;
@@ -445,8 +445,8 @@ TEST(SceneEmitters, EmitterVisibleIsTheSamplesOwnShadowTest) {
         SurfaceInteraction ref;
         ASSERT_TRUE(scene.ray_intersect(Ray(o, Vector3f(0, 0, -1)), ref));
         const Point2f u = next_point2f(rng);
-        auto [ds, weight] = scene.sample_emitter_direction(ref, u, false);
-        auto [tested, tested_weight] = scene.sample_emitter_direction(ref, u, true);
+        auto [ds, weight] = scene.sample_emitter_direction(ref, u, false, LightSampling::Alone);
+        auto [tested, tested_weight] = scene.sample_emitter_direction(ref, u, true, LightSampling::Alone);
         if (weight.is_black()) {
             EXPECT_TRUE(tested_weight.is_black());
             continue;
@@ -496,10 +496,10 @@ TEST(SceneEmitters, TriangleLightsMatchTheirEmitter) {
     int panel = 0, box = 0;
     for (int i = 0; i < 2000; ++i) {
         Point2f u = next_point2f(rng);
-        auto [ds, weight] = scene.sample_emitter_direction(ref, u, false);
+        auto [ds, weight] = scene.sample_emitter_direction(ref, u, false, LightSampling::Alone);
         if (!(ds.pdf > 0.f)) continue;
         ASSERT_TRUE(ds.emitter);
-        EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), ds.pdf);
+        EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf);
         // The emitter's own answer for the same sample (stretched back as the scene does).
         Point2f v = u;
         const auto [picked, pmf] = scene.sample_emitter(ref, v.x);
@@ -539,7 +539,7 @@ TEST(SceneEmitters, ShapeLightsMatchTheirEmitter) {
         ref.n = Normal3f(0.f, 0.f, 1.f);
         for (int i = 0; i < 2000; ++i) {
             const Point2f u = next_point2f(rng);
-            auto [ds, weight] = scene.sample_emitter_direction(ref, u, false);
+            auto [ds, weight] = scene.sample_emitter_direction(ref, u, false, LightSampling::Alone);
             Point2f v = u;
             const auto [picked, pmf] = scene.sample_emitter(ref, v.x);
             ASSERT_TRUE(picked);
@@ -555,8 +555,8 @@ TEST(SceneEmitters, ShapeLightsMatchTheirEmitter) {
             EXPECT_EQ(ds.d, own.d);
             EXPECT_EQ(ds.pdf, own.pdf * pmf);
             EXPECT_EQ(weight, own_weight / pmf);
-            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), ds.pdf);
-            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds), picked->pdf_direction(ref, ds) * pmf);
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf);
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), picked->pdf_direction(ref, ds) * pmf);
             (picked->shape() == scene.shapes()[1].get() ? ball : lamp)++;
         }
     }

@@ -231,6 +231,10 @@ public:
     static std::string scene_xml(const std::string &plugin, const std::vector<std::string> &entries,
                                  const std::string &shape = "rectangle");
 
+    /// Which of the emitter's samplings to test: sample_direction() and pdf_direction()
+    /// (LightSampling::Alone, the default) or sample_direction_mis() and pdf_direction_mis().
+    void set_light_sampling(LightSampling sampling) { m_sampling = sampling; }
+
     int sample_dim() const override { return 2; }
     Chi2Sample sample(const float *u) const override;
     double pdf(const Vector3f &d) const override;
@@ -238,9 +242,11 @@ public:
 
 private:
     void init();
+    float emitter_pdf(const DirectionSample &ds) const;
     std::shared_ptr<Scene> m_scene;
     std::shared_ptr<Emitter> m_emitter;
     Interaction m_ref;
+    LightSampling m_sampling = LightSampling::Alone;
 };
 
 /// The directions of an emitter's emitted rays (sample_ray()) against pdf_ray_direction(), for
