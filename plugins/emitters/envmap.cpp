@@ -11,9 +11,16 @@ exactly the +Y pole and the last row the -Y pole. An image needs at least 2x3 pi
 Negative pixel values are kept.
 
 Directions are sampled in proportion to the luminance times sin θ on the same grid,
-interpolated bilinearly between grid points. With `mis_compensation` the map's mean luminance
-is subtracted first (clamped at zero; Karlík et al. 2019), which helps when the emitter is
-combined with BSDF sampling by MIS; it is skipped for near-constant maps. Emitted rays (for the
+interpolated bilinearly between grid points. With `mis_compensation` true the map's mean
+luminance is subtracted first (clamped at zero; Karlík et al. 2019) for every sample, which
+helps when the emitter is combined with BSDF sampling by MIS; it is skipped for near-constant
+maps. false samples the plain luminance. Unset (facet's default; Mitsuba's is false): the light
+samples an integrator weights by MIS against BSDF samples (the path tracer's; the direct
+integrator's when it takes BSDF samples) follow a mix, 90% of them the compensated table and 10%
+the plain one (one table, their weighted sum), so that most go where the map is brighter than
+its mean while some still reach every direction with light; every other use (emitted rays,
+light samples that stand alone) follows the plain luminance, that table built on first use. The
+expected image is the same in all three. Emitted rays (for the
 particle tracer) come from a direction drawn the same way and a uniform point of the disk of the
 scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba.
 
@@ -22,7 +29,7 @@ scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba
 | filename            | string    | —        | Latitude-longitude image (required)                                |
 | scale               | float     | 1        | Multiplies the radiance                                            |
 | to_world            | transform | identity | Orientation of the map (rotation only)                             |
-| mis_compensation    | boolean   | false    | Sample only where the map is brighter than its mean luminance      |
+| mis_compensation    | boolean   | unset    | true: sample only where the map is brighter than its mean luminance; false: the plain luminance; unset: MIS's light samples a 90/10 mix of the two, the others plain |
 | filter_type         | string    | bilinear | Lookup filter: bilinear or nearest (facet extension)               |
 | importance_sampling | boolean   | true     | false: sample directions uniformly (facet extension, for testing)  |
 | sampling_weight | float | — | How often light samples pick this emitter, relative to the others (Mitsuba 3's; unset: facet's choice, see README) |
@@ -52,6 +59,8 @@ scene's bounding-sphere radius facing it, just outside the sphere, as in Mitsuba
 
 #include <algorithm>
 #include <cctype>
+#include <memory>
+#include <mutex>
 
 namespace facet {
 
@@ -83,6 +92,8 @@ public:
             m_world_rows[r] = Vector3f(m[r][0], m[r][1], m[r][2]);
             m_local_rows[r] = Vector3f(inv[r][0], inv[r][1], inv[r][2]);
         }
+        // Unset: facet's mix of the compensated and the plain tables (see the DOC).
+        m_mis_given = props.has("mis_compensation");
         m_mis_compensation = props.get_bool("mis_compensation", false);
         std::string filter = props.get_string("filter_type", "bilinear");
         if (filter != "bilinear" && filter != "nearest")
@@ -135,14 +146,15 @@ public:
         }
         build_distribution();
         if (is_spectral(props.mode())) {
-            m_weights.resize(m_texels.size());
+            m_luminance.resize(m_texels.size());
             for (int j = 0; j < m_height; ++j)
-                for (int i = 0; i <= m_width; ++i) m_weights[grid_index(i, j)] = table(i, j);
+                for (int i = 0; i <= m_width; ++i)
+                    m_luminance[grid_index(i, j)] = luminance_at(i, j);
             // Each pixel's spectrum, RGBSpectrum's scaled form: the curve of c / (2 max c)
             // and the scale 2 max c, blended separately between pixels; radiance() multiplies
             // by D65, the spectrum of an RGB white light. The curve's coefficients replace the
             // texel's colour (the sampling table's values were copied from the colours above,
-            // to m_weights, read beside the texels as the scales are).
+            // as luminances to m_luminance, read beside the texels as the scales are).
             m_spectral = true;
             m_scales.resize(m_texels.size());
             for (size_t i = 0; i < m_texels.size(); ++i) {
@@ -161,27 +173,18 @@ public:
 
     std::pair<DirectionSample, Color3f> sample_direction(const Interaction &ref,
                                                          const Point2f &u) const override {
-        DirectionSample ds;
-        Vector3f local =
-            sampling_enabled() ? uv_to_direction(sample_uv(u)) : warp::square_to_uniform_sphere(u);
-        ds.d = to_world(local);
-        ds.dist = Infinity;
-        ds.p = ref.p + ds.d * (2.f * m_radius + norm(ref.p - m_center));
-        ds.n = -ds.d;
-        ds.emitter = this;
-        // Density and radiance of the direction as pdf_direction() and eval() will see it, so
-        // the three agree to the last bit even where rounding moves it across a cell border.
-        local = to_local(ds.d);
-        const GridPoint g = grid_point(local); // one atan2 and acos for both
-        ds.pdf = pdf_local(local, g);
-        if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
-        return {ds, radiance(g, ref.wavelengths) / ds.pdf};
+        return sample_with(ref, u, alone_sampling());
+    }
+    std::pair<DirectionSample, Color3f> sample_direction_mis(const Interaction &ref,
+                                                             const Point2f &u) const override {
+        return sample_with(ref, u, m_sampling);
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
-        if (!sampling_enabled()) return InvFourPi;
-        const Vector3f local = to_local(ds.d);
-        return pdf_local(local, grid_point(local));
+        return pdf_with(ds, alone_sampling());
+    }
+    float pdf_direction_mis(const Interaction &, const DirectionSample &ds) const override {
+        return pdf_with(ds, m_sampling);
     }
 
     /// A ray entering the bounding sphere (the particle tracer): the direction it comes from is
@@ -189,12 +192,15 @@ public:
     /// radius facing that direction, just outside the sphere. Power per ray: L / pdf · π r².
     std::pair<Ray, Color3f> sample_ray(const Point2f &u_pos, const Point2f &u_dir,
                                        const Wavelengths &wavelengths) const override {
-        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir))
+        // Light leaves towards every direction it has (unless the scene asked for compensation
+        // throughout): the rays follow the plain luminance, as light samples that stand alone.
+        const Sampling &sampling = alone_sampling();
+        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir, sampling))
                                             : warp::square_to_uniform_sphere(u_dir);
         const Vector3f from = to_world(local);
         local = to_local(from);
         const GridPoint g = grid_point(local);
-        const float pdf = pdf_local(local, g);
+        const float pdf = pdf_local(local, g, sampling);
         if (!(pdf > 0.f)) return {Ray(), Color3f(0.f)};
         const float radius = m_radius * (1.f + RayEpsilon);
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
@@ -217,10 +223,49 @@ public:
 
     std::string to_string() const override {
         return fmt::format("EnvironmentMap[\"{}\", {}x{}, scale={}, mis_compensation={}]", m_path,
-                           m_width, m_height, m_scale, m_mis_compensation);
+                           m_width, m_height, m_scale,
+                           m_mis_given ? (m_mis_compensation ? "true" : "false") : "mix");
     }
 
 private:
+    /// A sampling table and the distribution of its cells. The table's value at grid point
+    /// (i, j) is (compensated_weight · max(L - offset, 0) + plain_weight · max(L, 0)) ·
+    /// row_weight[j] for the pixel's luminance L: (0, 1) is the plain table, (1, 0) Mitsuba's
+    /// compensation, both positive the mix.
+    struct Sampling {
+        float offset = 0.f, compensated_weight = 0.f, plain_weight = 1.f;
+        std::vector<float> row_weight; ///< per row: sin θ times the table's power-of-two scale
+        DiscreteDistribution cells;
+        double total = 0.0;
+        float density_scale = 0.f; ///< density over the unit square = value · density_scale
+    };
+
+    /// sample_direction() with the table `sampling`.
+    std::pair<DirectionSample, Color3f> sample_with(const Interaction &ref, const Point2f &u,
+                                                    const Sampling &sampling) const {
+        DirectionSample ds;
+        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u, sampling))
+                                            : warp::square_to_uniform_sphere(u);
+        ds.d = to_world(local);
+        ds.dist = Infinity;
+        ds.p = ref.p + ds.d * (2.f * m_radius + norm(ref.p - m_center));
+        ds.n = -ds.d;
+        ds.emitter = this;
+        // Density and radiance of the direction as pdf_direction() and eval() will see it, so
+        // the three agree to the last bit even where rounding moves it across a cell border.
+        local = to_local(ds.d);
+        const GridPoint g = grid_point(local); // one atan2 and acos for both
+        ds.pdf = pdf_local(local, g, sampling);
+        if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
+        return {ds, radiance(g, ref.wavelengths) / ds.pdf};
+    }
+    /// pdf_direction() with the table `sampling`.
+    float pdf_with(const DirectionSample &ds, const Sampling &sampling) const {
+        if (!sampling_enabled()) return InvFourPi;
+        const Vector3f local = to_local(ds.d);
+        return pdf_local(local, grid_point(local), sampling);
+    }
+
     /// The map's frame (to_world's rotation), applied inline: every direction of a sample, a
     /// density and a lookup passes through it, with the arithmetic of Transform::apply_vector().
     static Vector3f rotate(const Vector3f (&rows)[3], const Vector3f &v) {
@@ -334,29 +379,34 @@ private:
     // to the bilinear patch. In solid angle, dω = 2π² sin θ du dv. With nearest lookups the
     // same density still covers every direction whose radiance is not zero.
 
-    bool sampling_enabled() const { return m_importance && m_total > 0.0; }
+    bool sampling_enabled() const { return m_importance && m_sampling.total > 0.0; }
 
-    /// The sampling table's value at grid point (i, j), i in [0, W]: see build_distribution(). In
-    /// the spectral mode, whose texels hold curves, a stored copy.
-    float table(int i, int j) const {
-        if (m_spectral) return m_weights[grid_index(i, j)];
-        return table_value(texel(i, j).radiance(), j);
+
+    /// The luminance of grid point (i, j), i in [0, W]: from the pixel, or in the spectral mode
+    /// (whose texels hold curves) a stored copy.
+    float luminance_at(int i, int j) const {
+        if (m_spectral) return m_luminance[grid_index(i, j)];
+        return texel(i, j).radiance().luminance();
     }
-    float table_value(const Color3f &pixel, int j) const {
-        return table_from_luminance(pixel.luminance(), j);
+    /// The table's value at grid point (i, j): see Sampling.
+    float table(int i, int j, const Sampling &sampling) const {
+        return table_from_luminance(luminance_at(i, j), j, sampling);
     }
-    float table_from_luminance(float luminance, int j) const {
-        return std::max(luminance - m_offset, 0.f) * m_row_weight[size_t(j)];
+    static float table_from_luminance(float luminance, int j, const Sampling &sampling) {
+        return (sampling.compensated_weight * std::max(luminance - sampling.offset, 0.f) +
+                sampling.plain_weight * std::max(luminance, 0.f)) *
+               sampling.row_weight[size_t(j)];
     }
 
-    Point2f sample_uv(Point2f u) const {
+    Point2f sample_uv(Point2f u, const Sampling &sampling) const {
         float uc = u.x;
         // While the distribution reads the block its cell comes from, the texels of that
         // block's cells (in one row or two, but for maps under 12 pixels wide) are fetched.
-        size_t index = m_cells.sample_reuse(
+        size_t index = sampling.cells.sample_reuse(
             uc, [this](size_t first, size_t last) { prefetch_cells(first, last); });
         int i = int(index % size_t(m_width)), j = int(index / size_t(m_width));
-        float a = table(i, j), b = table(i + 1, j), c = table(i, j + 1), d = table(i + 1, j + 1);
+        float a = table(i, j, sampling), b = table(i + 1, j, sampling),
+              c = table(i, j + 1, sampling), d = table(i + 1, j + 1, sampling);
         // A cell next to a pole has a zero row (sin θ = 0): at t = 0 both ends of the s line
         // are zero, and interval_to_linear() samples it uniformly.
         float t = warp::interval_to_linear(0.5f * (a + b), 0.5f * (c + d), u.y);
@@ -366,7 +416,6 @@ private:
         return {std::min(uu, OneMinusEpsilon), (float(j) + t) / float(m_height - 1)};
     }
 
-    /// Starts fetching the texel rows that sampling cells first..last reads.
     /// Starts fetching every cache line of [begin, end).
     static void prefetch_range(const void *begin, const void *end) {
         const char *b = static_cast<const char *>(begin), *e = static_cast<const char *>(end);
@@ -374,6 +423,7 @@ private:
         prefetch_line(e - 1);
     }
 
+    /// Starts fetching the texel rows that sampling cells first..last reads.
     void prefetch_cells(size_t first, size_t last) const {
         const size_t W = size_t(m_width);
         for (size_t j = first / W; j <= last / W; ++j) {
@@ -384,24 +434,25 @@ private:
                 if (m_spectral) {
                     const float *scales = m_scales.data() + row * (W + 1);
                     prefetch_range(scales + i0, scales + i1 + 1);
-                    const float *weights = m_weights.data() + row * (W + 1);
-                    prefetch_range(weights + i0, weights + i1 + 1);
+                    const float *luminance = m_luminance.data() + row * (W + 1);
+                    prefetch_range(luminance + i0, luminance + i1 + 1);
                 }
             }
         }
     }
 
     /// Density of the local direction `local`, whose grid point is g.
-    float pdf_local(const Vector3f &local, const GridPoint &g) const {
+    float pdf_local(const Vector3f &local, const GridPoint &g, const Sampling &sampling) const {
         if (!sampling_enabled()) return InvFourPi;
         const int i = g.i, j = g.j;
         const float s = g.s, t = g.t;
-        float value = (table(i, j) * (1.f - s) + table(i + 1, j) * s) * (1.f - t) +
-                      (table(i, j + 1) * (1.f - s) + table(i + 1, j + 1) * s) * t;
+        float value =
+            (table(i, j, sampling) * (1.f - s) + table(i + 1, j, sampling) * s) * (1.f - t) +
+            (table(i, j + 1, sampling) * (1.f - s) + table(i + 1, j + 1, sampling) * s) * t;
         // sin θ straight from the direction (acos near the poles would lose precision),
         // floored as in Mitsuba so that the poles keep a finite density.
         float sin_theta = std::max(std::sqrt(local.x * local.x + local.z * local.z), SinThetaFloor);
-        return value * m_density_scale / (2.f * Pi * Pi * sin_theta);
+        return value * sampling.density_scale / (2.f * Pi * Pi * sin_theta);
     }
 
     void build_distribution() {
@@ -415,7 +466,7 @@ private:
             const double sin_theta = std::sin(double(j) * Pi / double(H - 1));
             for (int i = 0; i < W; ++i) {
                 const size_t k = size_t(j) * size_t(W) + size_t(i);
-                lum[k] = pixel(i, j).luminance();
+                lum[k] = luminance_at(i, j);
                 sum += double(lum[k]);
                 min_lum = std::min(min_lum, lum[k]);
                 sphere_sum += std::max(double(lum[k]), 0.0) * sin_theta;
@@ -425,34 +476,72 @@ private:
         m_mean_luminance = sphere_weight > 0.0 ? float(sphere_sum / sphere_weight) : 0.f;
         // MIS compensation (Karlík et al. 2019): sample only where the map is brighter than its
         // mean; skipped for near-constant maps, where it would leave (almost) nothing.
-        m_offset = 0.f;
-        if (m_mis_compensation) {
-            m_offset = float(sum / double(lum.size()));
-            if (m_offset - min_lum <= 0.01f * m_offset) m_offset = 0.f;
+        Sampling &sampling = m_sampling;
+        if (m_mis_compensation || !m_mis_given) {
+            const float mean = float(sum / double(lum.size()));
+            if (mean - min_lum > 0.01f * mean) sampling.offset = mean;
         }
+        if (sampling.offset > 0.f && m_mis_compensation) {
+            sampling.compensated_weight = 1.f;
+            sampling.plain_weight = 0.f;
+        } else if (sampling.offset > 0.f) {
+            // The mix: each table scaled to its own total (rows weighted by sin θ), then
+            // MixedShare of the samples from the compensated one and the rest from the plain
+            // one, which keeps every direction with light sampled.
+            double compensated = 0.0, plain = 0.0;
+            for (int j = 0; j < H; ++j) {
+                const double sin_theta = std::sin(double(j) * Pi / double(H - 1));
+                for (int i = 0; i < W; ++i) {
+                    const float l = lum[size_t(j) * size_t(W) + size_t(i)];
+                    compensated += double(std::max(l - sampling.offset, 0.f)) * sin_theta;
+                    plain += double(std::max(l, 0.f)) * sin_theta;
+                }
+            }
+            const float compensated_weight =
+                compensated > 0.0 ? float(MixedShare / compensated) : 0.f;
+            const float plain_weight = plain > 0.0 ? float((1.0 - MixedShare) / plain) : 0.f;
+            // Not where either total is zero or a weight leaves the floats (a map too dark or
+            // too bright for them): the plain table then.
+            if (compensated_weight > 0.f && plain_weight > 0.f && std::isfinite(compensated_weight) &&
+                std::isfinite(plain_weight)) {
+                sampling.compensated_weight = compensated_weight;
+                sampling.plain_weight = plain_weight;
+            } else {
+                sampling.offset = 0.f;
+            }
+        }
+        build_cells(sampling, lum);
+    }
+
+    /// The row weights, the cells' distribution and the density's scale of `sampling`, whose
+    /// offset and weights are set, from the pixels' luminances `lum` (W x H).
+    void build_cells(Sampling &sampling, const std::vector<float> &lum) const {
+        const int W = m_width, H = m_height;
         // Row j's factor: sin θ (zero on the pole rows: sin of a float π is slightly negative)
         // times a power of two that puts the largest entry in [1, 2): the density is unchanged
         // to the last bit (every operation on the table scales exactly), and the sampling's
         // squares neither underflow for a very dark map nor overflow for a very bright one, nor
         // does the density's normalisation (cells / total) overflow.
-        m_row_weight.assign(size_t(H), 0.f);
+        sampling.row_weight.assign(size_t(H), 0.f);
         float max_entry = 0.f;
         for (int j = 0; j < H; ++j) {
-            m_row_weight[size_t(j)] = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
-            if (j == H - 1) m_row_weight[size_t(j)] = 0.f;
+            sampling.row_weight[size_t(j)] = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
+            if (j == H - 1) sampling.row_weight[size_t(j)] = 0.f;
             for (int i = 0; i < W; ++i)
-                max_entry = std::max(max_entry, table_from_luminance(lum[size_t(j) * W + i], j));
+                max_entry = std::max(max_entry,
+                                     table_from_luminance(lum[size_t(j) * W + i], j, sampling));
         }
         if (max_entry > 0.f && std::isfinite(max_entry)) {
             const float to_unit = std::ldexp(1.f, -std::ilogb(max_entry));
-            for (float &w : m_row_weight) w *= to_unit;
+            for (float &w : sampling.row_weight) w *= to_unit;
         }
         // The table's rows j and j + 1 (W + 1 values each: column W is column 0), as table()
         // gives them.
         std::vector<float> row0(size_t(W) + 1), row1(size_t(W) + 1);
         auto table_row = [&](int j, std::vector<float> &row) {
             for (int i = 0; i <= W; ++i)
-                row[size_t(i)] = table_from_luminance(lum[size_t(j) * W + size_t(i % W)], j);
+                row[size_t(i)] =
+                    table_from_luminance(lum[size_t(j) * W + size_t(i % W)], j, sampling);
         };
         std::vector<float> cells(size_t(W) * size_t(H - 1));
         table_row(0, row1);
@@ -463,26 +552,46 @@ private:
                 cells[size_t(j) * W + size_t(i)] = 0.25f * (row0[size_t(i)] + row0[size_t(i) + 1] +
                                                             row1[size_t(i)] + row1[size_t(i) + 1]);
         }
-        m_cells.build(cells.data(), cells.size());
-        m_total = m_cells.sum();
+        sampling.cells.build(cells.data(), cells.size());
+        sampling.total = sampling.cells.sum();
         // Density over the unit square = table value / (mean cell value).
-        m_density_scale = m_total > 0.0 ? float(double(cells.size()) / m_total) : 0.f;
+        sampling.density_scale =
+            sampling.total > 0.0 ? float(double(cells.size()) / sampling.total) : 0.f;
+    }
+
+    /// What light samples that stand alone and emitted rays follow: m_sampling, or, when that
+    /// is the mix, the plain table, built on first use (most renders never ask for it and keep
+    /// the memory).
+    const Sampling &alone_sampling() const {
+        if (!(m_sampling.compensated_weight > 0.f && m_sampling.plain_weight > 0.f))
+            return m_sampling;
+        std::call_once(m_plain_once, [this] {
+            std::vector<float> lum(size_t(m_width) * size_t(m_height));
+            for (int j = 0; j < m_height; ++j)
+                for (int i = 0; i < m_width; ++i)
+                    lum[size_t(j) * size_t(m_width) + size_t(i)] = luminance_at(i, j);
+            auto plain = std::make_unique<Sampling>();
+            build_cells(*plain, lum);
+            m_plain = std::move(plain);
+        });
+        return *m_plain;
     }
 
     std::string m_path;
     float m_scale = 1.f;
     Vector3f m_world_rows[3], m_local_rows[3]; ///< to_world's 3x3 part and its inverse's, by rows
     bool m_bilinear = true, m_importance = true, m_mis_compensation = false;
+    bool m_mis_given = false; ///< the scene set mis_compensation (else: the mix)
+    /// The mix's share of light samples from the compensated table.
+    static constexpr double MixedShare = 0.9;
     int m_width = 0, m_height = 0;
-    std::vector<Texel> m_texels;  ///< (W + 1) x H: the pixels (the table's values come from them)
-    bool m_spectral = false;      ///< the texels hold curves (the spectral mode)
-    std::vector<float> m_scales;  ///< the spectral mode's pixel scales, laid out as m_texels
-    std::vector<float> m_weights; ///< the spectral mode's sampling table, laid out as m_texels
-    float m_offset = 0.f;         ///< subtracted from the luminance (MIS compensation)
-    std::vector<float> m_row_weight; ///< per row: sin θ times the table's power-of-two scale
-    DiscreteDistribution m_cells;
-    double m_total = 0.0;
-    float m_density_scale = 0.f;
+    std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels (the table's values come from them)
+    bool m_spectral = false;     ///< the texels hold curves (the spectral mode)
+    std::vector<float> m_scales; ///< the spectral mode's pixel scales, laid out as m_texels
+    std::vector<float> m_luminance; ///< the spectral mode's pixel luminances, laid out as m_texels
+    Sampling m_sampling; ///< what light samples for MIS follow (and, but for the mix, all)
+    mutable std::once_flag m_plain_once;
+    mutable std::unique_ptr<Sampling> m_plain; ///< see alone_sampling()
     float m_mean_luminance = 0.f; ///< over the sphere of directions, for power()
     Point3f m_center;
     float m_radius = 1.f;

@@ -189,6 +189,59 @@ TEST(EnvironmentMap, MisCompensationSamplesOnlyAboveTheMean) {
     }
 }
 
+TEST(EnvironmentMap, UnsetCompensationMixesMisSamplesOnly) {
+    // mis_compensation unset: the light samples weighted by MIS (sample_direction_mis()) follow
+    // 90% the compensated table and 10% the plain one, so that their density is that mix of the
+    // two emitters' densities; everything else (light samples alone, emitted rays) is the plain
+    // table's, bit for bit. Set either way, both samplings are the one table (Mitsuba's).
+    std::string map = write_map("halves-mix.exr", 16, 9,
+                                [](int x, int) { return x < 8 ? Color3f(1.f) : Color3f(3.f); });
+    auto plain = load(scene_with(map, R"(<boolean name="mis_compensation" value="false"/>)"));
+    auto comp = load(scene_with(map, R"(<boolean name="mis_compensation" value="true"/>)"));
+    auto mix = load(scene_with(map));
+    const Emitter &ep = *plain->environment_emitters().at(0);
+    const Emitter &ec = *comp->environment_emitters().at(0);
+    const Emitter &em = *mix->environment_emitters().at(0);
+    Interaction ref;
+    for (float ux : {0.02f, 0.2f, 0.45f, 0.7f, 0.93f, 0.999f})
+        for (float uy : {0.05f, 0.3f, 0.6f, 0.95f}) {
+            SCOPED_TRACE(testing::Message() << "u = (" << ux << ", " << uy << ")");
+            const Point2f u(ux, uy);
+            auto [dp, wp] = ep.sample_direction(ref, u);
+            auto [da, wa] = em.sample_direction(ref, u);
+            EXPECT_EQ(da.d, dp.d);
+            EXPECT_EQ(da.pdf, dp.pdf);
+            EXPECT_EQ(wa, wp);
+            EXPECT_EQ(ep.sample_direction_mis(ref, u).first.d, dp.d);
+            auto [rp, pp] = ep.sample_ray(Point2f(0.3f, 0.6f), u, Wavelengths());
+            auto [ra, pa] = em.sample_ray(Point2f(0.3f, 0.6f), u, Wavelengths());
+            EXPECT_EQ(ra.d, rp.d);
+            EXPECT_EQ(pa, pp);
+            auto [dc, wc] = ec.sample_direction(ref, u);
+            EXPECT_EQ(ec.sample_direction_mis(ref, u).first.d, dc.d);
+            EXPECT_EQ(ec.pdf_direction_mis(ref, dc), dc.pdf);
+
+            auto [dm, wm] = em.sample_direction_mis(ref, u);
+            ASSERT_GT(dm.pdf, 0.f);
+            EXPECT_EQ(em.pdf_direction_mis(ref, dm), dm.pdf);
+            const float expected =
+                0.9f * ec.pdf_direction(ref, dm) + 0.1f * ep.pdf_direction(ref, dm);
+            EXPECT_NEAR(dm.pdf, expected, 1e-4f * expected);
+            EXPECT_NEAR(wm.r * dm.pdf, look(em, dm.d).r, 1e-5f);
+        }
+    // The directions compensation never samples get a tenth of the plain table's share of the
+    // MIS samples (counted over a fine grid of the variate that picks the cell).
+    const int n = 4000;
+    int dark_plain = 0, dark_mix = 0;
+    for (int k = 0; k < n; ++k) {
+        const Point2f u((float(k) + 0.5f) / float(n), 0.5f);
+        if (ec.pdf_direction(ref, ep.sample_direction(ref, u).first) == 0.f) ++dark_plain;
+        if (ec.pdf_direction(ref, em.sample_direction_mis(ref, u).first) == 0.f) ++dark_mix;
+    }
+    EXPECT_GT(dark_plain, n / 10);
+    EXPECT_NEAR(double(dark_mix) / n, 0.1 * dark_plain / n, 0.005);
+}
+
 TEST(EnvironmentMap, MisCompensationIsSkippedForNearConstantMaps) {
     // mean - min = 0.5 % of the mean: compensation would leave almost nothing, so it is off.
     std::string map = write_map("nearly-flat.exr", 8, 5, [](int x, int y) {
@@ -269,6 +322,9 @@ TEST(EnvironmentMap, SamplesOnTheEdgesOfTheSquareAreValid) {
                 auto [ds, w] = env.sample_direction(ref, Point2f(ux, uy));
                 expect_valid_direction_sample(ds, w, ux, uy);
                 EXPECT_EQ(env.pdf_direction(ref, ds), ds.pdf);
+                auto [dm, wm] = env.sample_direction_mis(ref, Point2f(ux, uy));
+                expect_valid_direction_sample(dm, wm, ux, uy);
+                EXPECT_EQ(env.pdf_direction_mis(ref, dm), dm.pdf);
                 auto [ray, power] =
                     env.sample_ray(Point2f(0.5f, 0.5f), Point2f(ux, uy), Wavelengths());
                 EXPECT_TRUE(std::isfinite(ray.d.x) && std::isfinite(ray.o.x));
@@ -299,6 +355,11 @@ TEST(EnvironmentMap, VeryDarkAndVeryBrightMapsSampleLikeTheirUnitTwin) {
                 expect_valid_direction_sample(ds, ws, ux, uy);
                 EXPECT_EQ(ds.d, d1.d) << "u = (" << ux << ", " << uy << ")";
                 EXPECT_EQ(ds.pdf, d1.pdf) << "u = (" << ux << ", " << uy << ")";
+                auto [m1, v1] = e1.sample_direction_mis(ref, Point2f(ux, uy));
+                auto [ms, vs] = es.sample_direction_mis(ref, Point2f(ux, uy));
+                expect_valid_direction_sample(ms, vs, ux, uy);
+                EXPECT_EQ(ms.d, m1.d) << "MIS, u = (" << ux << ", " << uy << ")";
+                EXPECT_EQ(ms.pdf, m1.pdf) << "MIS, u = (" << ux << ", " << uy << ")";
             }
     }
 }
