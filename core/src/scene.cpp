@@ -594,9 +594,9 @@ inline float triangle_light_pdf(float inv_area, const DirectionSample &ds) {
 
 } // namespace
 
-std::pair<DirectionSample, Color3f>
-Scene::sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility,
-                                LightSampling sampling) const {
+std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Interaction &ref,
+                                                                    Point2f u, bool test_visibility,
+                                                                    LightSampling sampling) const {
     // The result is built in place (one copy of the sample less on every return).
     std::pair<DirectionSample, Color3f> result{DirectionSample(), Color3f(0.f)};
     DirectionSample &ds = result.first;
@@ -761,8 +761,8 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
     }
 }
 
-float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref,
-                       const DirectionSample &ds, LightSampling sampling) const {
+float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref, const DirectionSample &ds,
+                       LightSampling sampling) const {
     if (entry.mesh) return triangle_light_pdf(entry.inv_area, ds);
     if (entry.shape) return dot(ds.n, ds.d) < 0.f ? entry.shape->pdf_direction(ref, ds) : 0.f;
     return sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds)

@@ -381,7 +381,6 @@ private:
 
     bool sampling_enabled() const { return m_importance && m_sampling.total > 0.0; }
 
-
     /// The luminance of grid point (i, j), i in [0, W]: from the pixel, or in the spectral mode
     /// (whose texels hold curves) a stored copy.
     float luminance_at(int i, int j) const {
@@ -502,8 +501,8 @@ private:
             const float plain_weight = plain > 0.0 ? float((1.0 - MixedShare) / plain) : 0.f;
             // Not where either total is zero or a weight leaves the floats (a map too dark or
             // too bright for them): the plain table then.
-            if (compensated_weight > 0.f && plain_weight > 0.f && std::isfinite(compensated_weight) &&
-                std::isfinite(plain_weight)) {
+            if (compensated_weight > 0.f && plain_weight > 0.f &&
+                std::isfinite(compensated_weight) && std::isfinite(plain_weight)) {
                 sampling.compensated_weight = compensated_weight;
                 sampling.plain_weight = plain_weight;
             } else {
@@ -528,8 +527,8 @@ private:
             sampling.row_weight[size_t(j)] = std::max(std::sin(float(j) * Pi / float(H - 1)), 0.f);
             if (j == H - 1) sampling.row_weight[size_t(j)] = 0.f;
             for (int i = 0; i < W; ++i)
-                max_entry = std::max(max_entry,
-                                     table_from_luminance(lum[size_t(j) * W + i], j, sampling));
+                max_entry =
+                    std::max(max_entry, table_from_luminance(lum[size_t(j) * W + i], j, sampling));
         }
         if (max_entry > 0.f && std::isfinite(max_entry)) {
             const float to_unit = std::ldexp(1.f, -std::ilogb(max_entry));
@@ -585,14 +584,14 @@ private:
     /// The mix's share of light samples from the compensated table.
     static constexpr double MixedShare = 0.9;
     int m_width = 0, m_height = 0;
-    std::vector<Texel> m_texels; ///< (W + 1) x H: the pixels (the table's values come from them)
-    bool m_spectral = false;     ///< the texels hold curves (the spectral mode)
-    std::vector<float> m_scales; ///< the spectral mode's pixel scales, laid out as m_texels
+    std::vector<Texel> m_texels;    ///< (W + 1) x H: the pixels (the table's values come from them)
+    bool m_spectral = false;        ///< the texels hold curves (the spectral mode)
+    std::vector<float> m_scales;    ///< the spectral mode's pixel scales, laid out as m_texels
     std::vector<float> m_luminance; ///< the spectral mode's pixel luminances, laid out as m_texels
     Sampling m_sampling; ///< what light samples for MIS follow (and, but for the mix, all)
     mutable std::once_flag m_plain_once;
     mutable std::unique_ptr<Sampling> m_plain; ///< see alone_sampling()
-    float m_mean_luminance = 0.f; ///< over the sphere of directions, for power()
+    float m_mean_luminance = 0.f;              ///< over the sphere of directions, for power()
     Point3f m_center;
     float m_radius = 1.f;
 };

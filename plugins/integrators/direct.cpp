@@ -98,8 +98,8 @@ public:
                 // Up to 65535 samples: a stop (Ctrl-C, timeout) need not wait for them all.
                 if (render_should_stop(i)) return result;
                 // The shadow ray last: a sample the BSDF gives no weight costs none.
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), false,
-                                                                      m_light_sampling);
+                auto [ds, em_weight] =
+                    scene.sample_emitter_direction(si, sampler.next_2d(), false, m_light_sampling);
                 if (ds.pdf == 0.f || em_weight.is_black()) continue;
                 Vector3f wo = si.to_local(ds.d);
                 auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
@@ -135,8 +135,8 @@ public:
             if (L.is_black()) continue;
             float w = 1.f;
             if (!delta) {
-                float em_pdf = scene.pdf_emitter_direction(si, direction_to(si_bsdf, si),
-                                                           LightSampling::MIS);
+                float em_pdf =
+                    scene.pdf_emitter_direction(si, direction_to(si_bsdf, si), LightSampling::MIS);
                 w = mis_weight(bs.pdf * m_frac_bsdf, em_pdf * m_frac_emitter);
             }
             result += bsdf_weight * L * (w * m_weight_bsdf);

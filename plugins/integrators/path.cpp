@@ -123,9 +123,8 @@ private:
                     if (!L.is_black()) {
                         float w = 1.f;
                         if (!prev_bsdf_delta) {
-                            float em_pdf =
-                                scene.pdf_emitter_direction(prev_si, direction_to(si, prev_si),
-                                                            LightSampling::MIS);
+                            float em_pdf = scene.pdf_emitter_direction(
+                                prev_si, direction_to(si, prev_si), LightSampling::MIS);
                             w = mis_weight(prev_bsdf_pdf, em_pdf);
                         }
                         add_emission(result, throughput, L * w);
@@ -164,8 +163,8 @@ private:
             // The shadow ray comes last: a sample the BSDF gives no weight (an emitter behind
             // the surface) costs none.
             if (sample_emitter) {
-                auto [ds, em_weight] = scene.sample_emitter_direction(si, emitter_sample, false,
-                                                                      LightSampling::MIS);
+                auto [ds, em_weight] =
+                    scene.sample_emitter_direction(si, emitter_sample, false, LightSampling::MIS);
                 FACET_ASSERT(ds.pdf >= 0.f && em_weight.is_finite());
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);

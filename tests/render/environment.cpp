@@ -57,7 +57,8 @@ std::string scene_xml(const std::string &sky, bool importance,
                       const std::string &integrator = R"(<integrator type="direct"/>)",
                       const std::string &extra = "") {
     return R"(<scene version="3.0.0">
-    )" + integrator + R"(
+    )" + integrator +
+           R"(
     <sensor type="orthographic">
         <transform name="to_world">
             <scale value="0.5"/>

@@ -366,9 +366,11 @@ void expect_hierarchy_agrees_with_its_pmf(int lamps) {
         // A light sample's density is what pdf_emitter_direction() gives the same point.
         for (int k = 0; k < 32; ++k) {
             const Point2f u(rng.next_float(), rng.next_float());
-            const auto [ds, weight] = scene->sample_emitter_direction(ref, u, false, LightSampling::Alone);
+            const auto [ds, weight] =
+                scene->sample_emitter_direction(ref, u, false, LightSampling::Alone);
             if (!(ds.pdf > 0.f) || ds.delta) continue;
-            EXPECT_NEAR(scene->pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf, 1e-5f * ds.pdf);
+            EXPECT_NEAR(scene->pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf,
+                        1e-5f * ds.pdf);
         }
         // An emitter the hierarchy never picks for ref sends it no light: its own samples from
         // ref all have weight 0, or arrive along ref's plane.

@@ -156,7 +156,8 @@ TEST(LightGuide, GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ) {
         if (q < 1.f) ++below_one;
         for (int i = 0; i < 64; ++i) {
             const Point2f u = next_point2f(rng);
-            const auto [ds, weight] = guided->sample_emitter_direction(si, u, false, LightSampling::Alone);
+            const auto [ds, weight] =
+                guided->sample_emitter_direction(si, u, false, LightSampling::Alone);
             expected_taken += q;
             taken_variance += q * (1.0 - q);
             if (!(u.x < q)) { // no sample
@@ -166,7 +167,8 @@ TEST(LightGuide, GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ) {
             }
             ++taken;
             const Point2f rescaled(std::min(u.x / q, OneMinusEpsilon), u.y);
-            const auto [own, own_weight] = plain->sample_emitter_direction(si, rescaled, false, LightSampling::Alone);
+            const auto [own, own_weight] =
+                plain->sample_emitter_direction(si, rescaled, false, LightSampling::Alone);
             EXPECT_EQ(ds.p, own.p);
             EXPECT_EQ(ds.d, own.d);
             EXPECT_EQ(ds.pdf, own.pdf * q);

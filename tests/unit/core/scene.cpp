@@ -394,7 +394,8 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
             ASSERT_EQ(ds.emitter, sphere_light);
             ASSERT_GT(ds.pdf, 0.f);
             ++area_samples;
-            EXPECT_NEAR(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf, 1e-5f * ds.pdf);
+            EXPECT_NEAR(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf,
+                        1e-5f * ds.pdf);
             // The point on the ball seen from the floor is visible: the weight is L / pdf.
             EXPECT_NEAR(weight.r * ds.pdf, radiance.r, 1e-4f);
             EXPECT_NEAR(weight.b * ds.pdf, radiance.b, 1e-4f);
@@ -417,18 +418,21 @@ TEST(SceneEmitters, SampleAndPdfAgree) {
     // Occluded: from (-1, -1, 0) the line to the lamp passes through the centre of the ball.
     SurfaceInteraction under;
     ASSERT_TRUE(scene.ray_intersect(Ray(Point3f(-1.f, -1.f, 1.f), Vector3f(0, 0, -1)), under));
-    auto [ds, weight] = scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), true, LightSampling::Alone);
+    auto [ds, weight] =
+        scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), true, LightSampling::Alone);
     ASSERT_NE(ds.emitter, sphere_light);
     EXPECT_TRUE(weight.is_black());
-    auto [ds2, weight2] = scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), false, LightSampling::Alone);
+    auto [ds2, weight2] =
+        scene.sample_emitter_direction(under, Point2f(0.999f, 0.5f), false, LightSampling::Alone);
     EXPECT_FALSE(weight2.is_black());
 }
 
 TEST(SceneEmitters, EmitterVisibleIsTheSamplesOwnShadowTest) {
     // The path tracer samples emitters without the visibility test and asks emitter_visible()
     // once the BSDF has weighted the sample: that must be exactly the test that
-    // sample_emitter_direction(..., true, LightSampling::Alone) applies. Floor points around and under the ball, lit
-    // by the ball itself, a point lamp and a slanted directional light (a sample at infinity).
+    // sample_emitter_direction(..., true, LightSampling::Alone) applies. Floor points around and
+    // under the ball, lit by the ball itself, a point lamp and a slanted directional light (a
+    // sample at infinity).
     Properties props = rect_and_sphere(area_light(Color3f(1.f)));
     Properties point;
     point.set_vector("position", Vector3f(0.3f, -0.2f, 4.f));
@@ -446,7 +450,8 @@ TEST(SceneEmitters, EmitterVisibleIsTheSamplesOwnShadowTest) {
         ASSERT_TRUE(scene.ray_intersect(Ray(o, Vector3f(0, 0, -1)), ref));
         const Point2f u = next_point2f(rng);
         auto [ds, weight] = scene.sample_emitter_direction(ref, u, false, LightSampling::Alone);
-        auto [tested, tested_weight] = scene.sample_emitter_direction(ref, u, true, LightSampling::Alone);
+        auto [tested, tested_weight] =
+            scene.sample_emitter_direction(ref, u, true, LightSampling::Alone);
         if (weight.is_black()) {
             EXPECT_TRUE(tested_weight.is_black());
             continue;
@@ -556,7 +561,8 @@ TEST(SceneEmitters, ShapeLightsMatchTheirEmitter) {
             EXPECT_EQ(ds.pdf, own.pdf * pmf);
             EXPECT_EQ(weight, own_weight / pmf);
             EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), ds.pdf);
-            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone), picked->pdf_direction(ref, ds) * pmf);
+            EXPECT_EQ(scene.pdf_emitter_direction(ref, ds, LightSampling::Alone),
+                      picked->pdf_direction(ref, ds) * pmf);
             (picked->shape() == scene.shapes()[1].get() ? ball : lamp)++;
         }
     }
