@@ -5,7 +5,7 @@
 
 namespace facet::detail {
 
-LightGuide::LightGuide(const BoundingBox3f &bounds) {
+LightGuide::LightGuide(const BoundingBox3f &bounds, size_t emitters) {
     const Vector3f extent = bounds.valid() ? bounds.max - bounds.min : Vector3f(0.f);
     const float longest = std::max({extent.x, extent.y, extent.z});
     // Cubic cells, MaxCells along the longest axis; a flat axis gets one.
@@ -25,10 +25,20 @@ LightGuide::LightGuide(const BoundingBox3f &bounds) {
         for (int a = 0; a < 3; ++a) next.dims[a] = (m_levels.back().dims[a] + 1) / 2;
         m_levels.push_back(next);
     }
-    for (Level &level : m_levels) {
+    if (emitters > 1 && emitters <= MaxChoiceEmitters) {
+        m_emitters = emitters;
+        while (m_choice_level + 1 < m_levels.size() &&
+               std::max({m_levels[m_choice_level].dims[0], m_levels[m_choice_level].dims[1],
+                         m_levels[m_choice_level].dims[2]}) > ChoiceCells)
+            ++m_choice_level;
+    }
+    for (size_t l = 0; l < m_levels.size(); ++l) {
+        Level &level = m_levels[l];
         const size_t cells = size_t(level.dims[0]) * size_t(level.dims[1]) * size_t(level.dims[2]);
         level.records.assign(cells, 0);
         level.useful.assign(cells, 0);
+        if (m_emitters > 0 && l >= m_choice_level)
+            level.contribution.assign(cells * m_emitters, 0.0);
     }
     m_probability.assign(m_levels[0].records.size(), 1.f);
 }
@@ -47,18 +57,22 @@ size_t LightGuide::index(const Level &level, const int (&c)[3], int shift) const
            size_t(c[0] >> shift);
 }
 
-void LightGuide::record(const Point3f &p, bool useful) {
+void LightGuide::record(const Point3f &p, bool useful, size_t emitter, float contribution) {
     int c[3];
     coordinates(p, c);
+    const bool counts =
+        useful && emitter < m_emitters && contribution > 0.f && std::isfinite(contribution);
     for (size_t l = 0; l < m_levels.size(); ++l) {
         Level &level = m_levels[l];
         const size_t i = index(level, c, int(l));
         ++level.records[i];
         if (useful) ++level.useful[i];
+        if (counts && l >= m_choice_level)
+            level.contribution[i * m_emitters + emitter] += double(contribution);
     }
 }
 
-size_t LightGuide::finish() {
+size_t LightGuide::finish(const std::vector<float> &fixed) {
     const Level &finest = m_levels[0];
     size_t changed = 0;
     int c[3];
@@ -78,12 +92,78 @@ size_t LightGuide::finish() {
                 m_probability[index(finest, c, 0)] = q;
                 if (q < 1.f) ++changed;
             }
+    if (m_emitters > 0) changed += finish_choice(fixed);
     // The counts are not needed any more.
     for (Level &level : m_levels) {
         level.records = {};
         level.useful = {};
+        level.contribution = {};
     }
     return changed;
+}
+
+size_t LightGuide::finish_choice(const std::vector<float> &fixed) {
+    const Level &base = m_levels[m_choice_level];
+    const size_t E = m_emitters;
+    // The probability the learned emitters share, and how many there are: fewer than two
+    // leave nothing to choose.
+    auto is_fixed = [&](size_t e) { return e < fixed.size() && fixed[e] >= 0.f; };
+    double free_share = 1.0;
+    size_t learned = 0;
+    for (size_t e = 0; e < E; ++e) {
+        if (is_fixed(e))
+            free_share -= double(fixed[e]);
+        else
+            ++learned;
+    }
+    if (learned < 2 || !(free_share > 0.0)) return 0;
+    m_choice_offset.assign(base.records.size(), -1);
+    // Per level and cell: where its choice starts once made (cells that fall back to the same
+    // coarser cell share it).
+    std::vector<std::vector<int32_t>> made(m_levels.size());
+    for (size_t l = m_choice_level; l < m_levels.size(); ++l)
+        made[l].assign(m_levels[l].records.size(), -1);
+    size_t chosen = 0;
+    int c[3];
+    for (c[2] = 0; c[2] < base.dims[2]; ++c[2])
+        for (c[1] = 0; c[1] < base.dims[1]; ++c[1])
+            for (c[0] = 0; c[0] < base.dims[0]; ++c[0]) {
+                // Coordinates of the finest level, as index() shifts them.
+                const int shift = int(m_choice_level);
+                int f[3] = {c[0] << shift, c[1] << shift, c[2] << shift};
+                for (size_t l = m_choice_level; l < m_levels.size(); ++l) {
+                    const Level &level = m_levels[l];
+                    const size_t i = index(level, f, int(l));
+                    if (level.records[i] < MinChoiceRecords) continue;
+                    // Each emitter in proportion to the square root of its second moment,
+                    // which minimises the variance of a one-emitter sample of their sum.
+                    double total = 0.0;
+                    for (size_t e = 0; e < E; ++e)
+                        if (!is_fixed(e)) total += std::sqrt(level.contribution[i * E + e]);
+                    if (!(total > 0.0) || !std::isfinite(total)) continue;
+                    ++chosen;
+                    if (made[l][i] >= 0) {
+                        m_choice_offset[index(base, c, 0)] = made[l][i];
+                        break;
+                    }
+                    made[l][i] = int32_t(m_choice.size());
+                    m_choice_offset[index(base, c, 0)] = int32_t(m_choice.size());
+                    const size_t start = m_choice.size();
+                    m_choice.resize(start + 2 * E);
+                    float sum = 0.f;
+                    for (size_t e = 0; e < E; ++e) {
+                        m_choice[start + e] =
+                            is_fixed(e) ? fixed[e]
+                                        : float(free_share *
+                                                std::sqrt(level.contribution[i * E + e]) / total);
+                        sum += m_choice[start + e];
+                        m_choice[start + E + e] = sum;
+                    }
+                    break;
+                }
+            }
+    if (chosen == 0) m_choice_offset.clear();
+    return chosen;
 }
 
 } // namespace facet::detail

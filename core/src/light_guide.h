@@ -6,6 +6,14 @@
 // sample's weight is divided by q and its density multiplied by it, so the estimate keeps its
 // expectation and MIS stays balanced. What changes is the cost: the samples that would have
 // been blocked are mostly not drawn.
+//
+// The same survey also learns which emitters are worth a light sample, per cell of a coarser
+// grid: each emitter's second moment there (the square of BSDF times radiance over density of its
+// useful samples, over the probability its choice had), whose square root is the share that
+// minimises the variance of a one-emitter sample. The scene then picks an emitter half of the
+// time by its own rule and half of the time by those shares, and gives every sample the density
+// of that mixture: no emitter gets less than half the share it had, and the ones the cell's
+// points actually see get more. Emitters at infinity keep their share (finish()'s `fixed`).
 #pragma once
 
 #include <facet/bbox.h>
@@ -27,25 +35,57 @@ public:
     static constexpr float FullRate = 0.25f;
     static constexpr float MinProbability = 0.1f;
 
-    explicit LightGuide(const BoundingBox3f &bounds);
+    /// Cells per axis of the grid the choice of emitters is learned on, at most.
+    static constexpr int ChoiceCells = 16;
+    /// Light samples a cell needs before its own sums decide; with fewer, the coarser level's.
+    static constexpr uint32_t MinChoiceRecords = 64;
+    /// The choice is learned for scenes with this many emitters, or fewer (and at least two).
+    static constexpr size_t MaxChoiceEmitters = 32;
+    /// The share of light samples that keep the scene's own choice of emitter.
+    static constexpr float OwnChoiceShare = 0.5f;
 
-    /// One light sample of the survey at p: useful or not.
-    void record(const Point3f &p, bool useful);
-    /// Turns the records into each cell's probability. Returns how many cells have one below 1
-    /// (0: the guide changes nothing).
-    size_t finish();
+    /// A guide over `bounds`; `emitters` > 1 (at most MaxChoiceEmitters) also learns which
+    /// emitters to choose.
+    LightGuide(const BoundingBox3f &bounds, size_t emitters);
+
+    /// One light sample of the survey at p: useful or not; `emitter` (its scene index) and
+    /// `contribution` (>= 0) for the choice of emitters.
+    void record(const Point3f &p, bool useful, size_t emitter = 0, float contribution = 0.f);
+    /// Turns the records into each cell's probability and choice. Returns how many cells have a
+    /// probability below 1 or a choice (0: the guide changes nothing). `fixed` (empty, or one
+    /// value per emitter): an emitter's probability in every choice where it is >= 0 (the
+    /// emitters at infinity, whose light reaches points at scales finer than a cell); the others
+    /// share the rest by what the survey learned.
+    size_t finish(const std::vector<float> &fixed = {});
 
     /// The probability of taking a light sample at p, in (0, 1].
     float probability(const Point3f &p) const { return m_probability[cell(p)]; }
+    /// The learned choice of emitters for p: per scene index its probability (they sum to 1),
+    /// then their running sums; null where none was learned.
+    const float *choice(const Point3f &p) const {
+        if (m_choice_offset.empty()) return nullptr;
+        int c[3];
+        coordinates(p, c);
+        const int32_t offset =
+            m_choice_offset[index(m_levels[m_choice_level], c, int(m_choice_level))];
+        return offset >= 0 ? m_choice.data() + offset : nullptr;
+    }
+    /// The number of emitters a choice covers.
+    size_t emitters() const { return m_emitters; }
+    /// Whether a choice was learned anywhere.
+    bool chooses() const { return !m_choice_offset.empty(); }
 
 private:
     struct Level {
         int dims[3];
         std::vector<uint32_t> records, useful;
+        std::vector<double> contribution; ///< per cell, per emitter (choice levels only)
     };
     /// The finest cell's coordinates of p (points outside the box, or not finite, clamp).
     void coordinates(const Point3f &p, int (&c)[3]) const;
     size_t index(const Level &level, const int (&c)[3], int shift) const;
+    /// finish()'s part for the choice of emitters; returns the cells that have one.
+    size_t finish_choice(const std::vector<float> &fixed);
     size_t cell(const Point3f &p) const {
         int c[3];
         coordinates(p, c);
@@ -56,6 +96,11 @@ private:
     float m_inv_cell[3] = {0.f, 0.f, 0.f};
     std::vector<Level> m_levels; ///< finest first; each next one halves every axis (rounding up)
     std::vector<float> m_probability; ///< per finest cell, after finish()
+    size_t m_emitters = 0;            ///< emitters the choice covers (0: no choice learned)
+    size_t m_choice_level = 0;        ///< the finest level the choice is learned on
+    /// Per cell of the choice level: where its choice starts in m_choice, or -1.
+    std::vector<int32_t> m_choice_offset;
+    std::vector<float> m_choice; ///< per choice: the emitters' probabilities, then their sums
 };
 
 } // namespace facet::detail

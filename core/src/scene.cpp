@@ -199,6 +199,7 @@ size_t Scene::rebuild(const Properties &props) {
     std::swap(m_emitter_distr, next.m_emitter_distr);
     std::swap(m_light_bvh, next.m_light_bvh);
     std::swap(m_hierarchy_share, next.m_hierarchy_share);
+    std::swap(m_emitter_weights_given, next.m_emitter_weights_given);
     std::swap(m_outside_pmf, next.m_outside_pmf);
     std::swap(m_outside_hierarchy, next.m_outside_hierarchy);
     std::swap(m_geometries, next.m_geometries);
@@ -646,7 +647,7 @@ std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Intera
     }
     // Delta emitters report pdf 1 (not a density): it is left as returned, as in
     // pdf_emitter_direction() which gives them 0. The weight always carries the selection.
-    if (m_emitter_uniform && !m_light_bvh) {
+    if (uniform_selection()) {
         // The uniform choice keeps its arithmetic (images as before to the last bit).
         if (!ds.delta) ds.pdf /= float(count);
         weight *= float(count);
@@ -680,7 +681,7 @@ float Scene::unguided_emitter_pdf(const Interaction &ref, const DirectionSample 
     const uint32_t index = ds.emitter->scene_index();
     const bool ours =
         index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter;
-    if (m_emitter_uniform && !m_light_bvh) {
+    if (uniform_selection()) {
         const float count = float(m_emitter_table.size());
         if (ours) return light_pdf(m_emitter_table[index], ref, ds, sampling) / count;
         return (sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds)
@@ -698,14 +699,25 @@ void Scene::prepare_light_sampling() const {
     if (m_light_guide_ready) return;
     if (m_light_guide_enabled && !m_emitter_table.empty() && !m_sensors.empty() && m_bbox.valid()) {
         const auto start = std::chrono::steady_clock::now();
-        auto guide = std::make_unique<detail::LightGuide>(m_bbox);
+        // The choice of emitters is learned unless the scene gave its own (sampling_weight).
+        auto guide = std::make_unique<detail::LightGuide>(
+            m_bbox, m_emitter_weights_given ? 0 : m_emitter_table.size());
         survey_light_samples(*guide);
-        const size_t guided = guide->finish();
+        // The emitters at infinity keep the probability the scene's own rule gives them
+        // everywhere (as in the light hierarchy): their light reaches points at scales finer
+        // than the guide's cells (a sky seen past a pillar), and a share learned per cell
+        // starved such points.
+        std::vector<float> fixed(m_emitter_table.size(), -1.f);
+        for (size_t i = 0; i < m_emitter_table.size(); ++i)
+            if (m_emitter_table[i].emitter->is_infinite())
+                fixed[i] = m_light_bvh ? m_outside_pmf : m_emitter_table[i].pmf;
+        const size_t guided = guide->finish(fixed);
+        const bool chooses = guide->chooses();
         if (guided > 0) m_light_guide = std::move(guide);
         FACET_LOG(
-            Debug, "light-sample guide: survey in {:.1f} ms, q < 1 in {} cells",
+            Debug, "light-sample guide: survey in {:.1f} ms, {} cells with q < 1 or a choice{}",
             1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-            guided);
+            guided, chooses ? " (emitters chosen as learned)" : "");
     }
     m_light_guide_ready = true;
 }
@@ -748,11 +760,21 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
                 const auto [ds, weight] =
                     sample_emitter_direction(si, u_light, false, LightSampling::MIS);
                 bool useful = false;
+                float contribution = 0.f;
                 if (ds.pdf > 0.f && !weight.is_black()) {
                     const Color3f f = bsdf->eval_pdf(ctx, si, si.to_local(ds.d)).first;
                     useful = !f.is_black() && emitter_visible(si, ds);
+                    if (useful) {
+                        // The emitter's light through the BSDF, without its choice: X · pmf
+                        // for the sample's X = f · weight. Its square over pmf estimates the
+                        // emitter's second moment at the cell's points, whatever the choice.
+                        const float pmf = emitter_pmf(si, *ds.emitter);
+                        const float y = std::max((f * weight).luminance(), 0.f) * pmf;
+                        contribution = pmf > 0.f ? y * y / pmf : 0.f;
+                    }
                 }
-                guide.record(si.p, useful);
+                guide.record(si.p, useful, ds.emitter ? ds.emitter->scene_index() : 0,
+                             contribution);
             }
             const auto [bs, weight] = bsdf->sample(ctx, si, u1, u2);
             if (weight.is_black() || !(bs.pdf > 0.f)) break;
@@ -769,7 +791,53 @@ float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref, const 
                                           : ds.emitter->pdf_direction(ref, ds);
 }
 
+bool Scene::uniform_selection() const {
+    return m_emitter_uniform && !m_light_bvh && !(m_light_guide && m_light_guide->chooses());
+}
+
 std::pair<size_t, float> Scene::pick_emitter(const Interaction *ref, float &u) const {
+    const float *choice = ref && m_light_guide ? m_light_guide->choice(ref->p) : nullptr;
+    if (!choice) return own_pick(ref, u);
+    // The mixture: OwnChoiceShare of the picks by the scene's own rule, the rest by the
+    // guide's learned probabilities (then running sums) for this cell; each pick's probability
+    // is the mixture's, as pick_pmf() computes it.
+    constexpr float Own = detail::LightGuide::OwnChoiceShare;
+    const size_t count = m_light_guide->emitters();
+    size_t index;
+    float own = 0.f;
+    if (u < Own) {
+        u = std::min(u / Own, OneMinusEpsilon);
+        std::tie(index, own) = own_pick(ref, u);
+        // The own rule found no emitter that can reach ref: no sample (index is no pick).
+        if (!(own > 0.f)) return {index, 0.f};
+    } else {
+        const float v = std::min((u - Own) / (1.f - Own), OneMinusEpsilon);
+        const float *sums = choice + count;
+        index = count;
+        for (size_t e = 0; e < count; ++e)
+            if (v < sums[e]) {
+                index = e;
+                break;
+            }
+        if (index == count) // past the last sum by rounding: the last emitter with a share
+            for (index = count - 1; index > 0 && !(choice[index] > 0.f); --index) {}
+        const float below = index > 0 ? sums[index - 1] : 0.f;
+        u = choice[index] > 0.f ? std::clamp((v - below) / choice[index], 0.f, OneMinusEpsilon)
+                                : 0.f;
+        own = own_pmf(ref, index);
+    }
+    // pick_pmf()'s arithmetic (own_pick() gives own_pmf()'s value to the last bit).
+    return {index, Own * own + (1.f - Own) * choice[index]};
+}
+
+float Scene::pick_pmf(const Interaction *ref, size_t index) const {
+    const float *choice = ref && m_light_guide ? m_light_guide->choice(ref->p) : nullptr;
+    if (!choice) return own_pmf(ref, index);
+    constexpr float Own = detail::LightGuide::OwnChoiceShare;
+    return Own * own_pmf(ref, index) + (1.f - Own) * choice[index];
+}
+
+std::pair<size_t, float> Scene::own_pick(const Interaction *ref, float &u) const {
     const size_t count = m_emitter_table.size();
     if (ref && m_light_bvh) {
         if (u < m_hierarchy_share) {
@@ -794,7 +862,7 @@ std::pair<size_t, float> Scene::pick_emitter(const Interaction *ref, float &u) c
     return {index, m_emitter_table[index].pmf};
 }
 
-float Scene::pick_pmf(const Interaction *ref, size_t index) const {
+float Scene::own_pmf(const Interaction *ref, size_t index) const {
     if (ref && m_light_bvh)
         return m_emitter_table[index].in_hierarchy
                    ? m_hierarchy_share * m_light_bvh->pmf(ref->p, ref->n, uint32_t(index))
@@ -836,6 +904,7 @@ void Scene::build_emitter_selection() {
     bool given = false;
     for (const EmitterEntry &entry : m_emitter_table)
         given = given || entry.emitter->sampling_weight() >= 0.f;
+    m_emitter_weights_given = given;
     if (!given) build_light_hierarchy();
     build_emitter_distribution(given);
 }

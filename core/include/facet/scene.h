@@ -77,7 +77,9 @@ public:
     /// taking: a few thousand paths from the scene's sensors, a light sample at each vertex,
     /// counted per cell of a grid over the scene as useful (the emitter gives light, the BSDF
     /// reflects it, nothing blocks it) or not. Sets sample_emitter_direction()'s q per cell
-    /// (1 where at least a quarter were useful, in proportion below that, at least 0.1). The
+    /// (1 where at least a quarter were useful, in proportion below that, at least 0.1) and,
+    /// for scenes of 2 to 32 emitters without sampling weights, the choice of emitters per
+    /// cell of a coarser grid (sample_emitter()). The
     /// result depends on the scene alone, never on a render's threads, seed or split. Renders
     /// call it; the scene option `light_guide` false (a facet extension) turns it off.
     void prepare_light_sampling() const;
@@ -89,7 +91,11 @@ public:
     /// it (1 for the others), as Mitsuba 3 does, whatever the point. Otherwise the emitters with
     /// light_bounds() (eight or more) share the samples the uniform choice would give them
     /// through the light hierarchy, in proportion to a bound of their importance at ref.p
-    /// (power, distance, orientation, ref.n); the others keep their uniform share. Returns the
+    /// (power, distance, orientation, ref.n); the others keep their uniform share. Once
+    /// prepare_light_sampling() has run (scenes without weights, 2 to 32 emitters), half of the
+    /// picks follow that rule and half what the survey learned near ref (the emitters at
+    /// infinity keep their share; the others in proportion to the root mean square of the light
+    /// their samples brought there), and the probability is that mixture's. Returns the
     /// emitter and the probability it had (null and 0 when none can reach ref); `u` becomes a
     /// fresh uniform variate for the emitter's own sample.
     std::pair<const Emitter *, float> sample_emitter(const Interaction &ref, float &u) const;
@@ -198,6 +204,9 @@ private:
     std::unique_ptr<detail::LightBVH> m_light_bvh;
     float m_hierarchy_share = 0.f, m_outside_pmf = 0.f;
     std::vector<uint32_t> m_outside_hierarchy;
+    /// The scene gives emitters a `sampling_weight`: its choice is kept everywhere (the light
+    /// guide learns none).
+    bool m_emitter_weights_given = false;
     /// Sets the entries' pmf, the distribution and the hierarchy once the emitters know the
     /// scene: build_light_hierarchy() (unless the scene gives sampling weights) and
     /// build_emitter_distribution().
@@ -208,6 +217,12 @@ private:
     /// and its probability (0: none).
     std::pair<size_t, float> pick_emitter(const Interaction *ref, float &u) const;
     float pick_pmf(const Interaction *ref, size_t index) const;
+    /// pick_emitter() and pick_pmf() without the light guide's learned choice.
+    std::pair<size_t, float> own_pick(const Interaction *ref, float &u) const;
+    float own_pmf(const Interaction *ref, size_t index) const;
+    /// The selection keeps the uniform choice's arithmetic (no distribution, hierarchy or
+    /// learned choice).
+    bool uniform_selection() const;
     /// The solid-angle density of emitter `entry`'s own sample for ds seen from ref (without
     /// the selection): computed inline for triangle lights and shapes' constant lights.
     float light_pdf(const EmitterEntry &entry, const Interaction &ref, const DirectionSample &ds,

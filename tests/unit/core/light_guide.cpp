@@ -1,7 +1,8 @@
 // The light-sample guide (Scene::prepare_light_sampling()): where the scene's survey found few
 // light samples useful, a point takes one with probability q < 1, its weight divided by q and
-// its density multiplied by it. The samples it takes are the unguided ones, the expected image
-// is the same, and the guide depends on the scene alone.
+// its density multiplied by it; and the emitter it samples is chosen half by the scene's own rule,
+// half by what the survey learned there. The densities are those of that sampling, the expected
+// image is the same, and the guide depends on the scene alone.
 #include "draws.h"
 
 #include <facet/integrator.h>
@@ -135,7 +136,7 @@ std::vector<SurfaceInteraction> seen_points(const Scene &scene, int n) {
 
 } // namespace
 
-TEST(LightGuide, GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ) {
+TEST(LightGuide, GuidedSamplesAreTakenAtRateQWithTheirDensities) {
     auto guided = load(maze_xml(true)), plain = load(maze_xml(false));
     ASSERT_TRUE(guided && plain);
     const std::vector<SurfaceInteraction> points = seen_points(*guided, 12);
@@ -166,24 +167,90 @@ TEST(LightGuide, GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ) {
                 continue;
             }
             ++taken;
-            const Point2f rescaled(std::min(u.x / q, OneMinusEpsilon), u.y);
-            const auto [own, own_weight] =
-                plain->sample_emitter_direction(si, rescaled, false, LightSampling::Alone);
-            EXPECT_EQ(ds.p, own.p);
-            EXPECT_EQ(ds.d, own.d);
-            EXPECT_EQ(ds.pdf, own.pdf * q);
-            EXPECT_EQ(weight, own_weight / q);
-            if (ds.pdf > 0.f) {
-                EXPECT_EQ(guided->pdf_emitter_direction(si, ds, LightSampling::Alone), ds.pdf);
-                EXPECT_EQ(guided->pdf_emitter_direction(si, ds, LightSampling::Alone),
-                          plain->pdf_emitter_direction(si, own, LightSampling::Alone) * q);
-            }
+            if (!(ds.pdf > 0.f)) continue;
+            // The sample of the emitter the guided choice picked, taken at rate q: its density
+            // is q times the emitter's probability there times the emitter's own density, and
+            // its weight the radiance (1 everywhere in the furnace) over that density.
+            ASSERT_TRUE(ds.emitter);
+            EXPECT_EQ(guided->pdf_emitter_direction(si, ds, LightSampling::Alone), ds.pdf);
+            const float pmf = guided->emitter_pmf(si, *ds.emitter);
+            const float own = ds.emitter->pdf_direction(si, ds);
+            EXPECT_NEAR(ds.pdf, q * pmf * own, 1e-5f * ds.pdf);
+            EXPECT_NEAR(weight.g * ds.pdf, 1.f, 1e-5f);
+            // The choice keeps at least the scene's own rule's share of it, whatever it learned.
+            const Emitter &twin = *plain->emitters().at(ds.emitter->scene_index());
+            EXPECT_GE(pmf, 0.5f * plain->emitter_pmf(si, twin) * (1.f - 1e-6f));
         }
     }
     // The maze makes most light samples useless somewhere the camera looks.
     EXPECT_GT(below_one, points.size() / 4) << "the guide changed nothing";
     // Samples are taken at the rate q (a binomial count).
     EXPECT_NEAR(taken, expected_taken, 4.0 * std::sqrt(taken_variance) + 1.0);
+}
+
+TEST(LightGuide, TheLearnedChoiceOfEmittersIsTheOneSampled) {
+    // The lamps in the maze: from most points only the lamps of the same room give light, and
+    // the survey learns it. At every point the choice's probabilities sum to 1, sample_emitter()
+    // picks each emitter as often as emitter_pmf() says and reports that probability, and the
+    // choice differs from the scene's own rule (the guide turned off) somewhere.
+    auto guided = load(maze_xml(true, true)), plain = load(maze_xml(false, true));
+    guided->prepare_light_sampling();
+    plain->prepare_light_sampling();
+    const auto &emitters = guided->emitters();
+    ASSERT_EQ(emitters.size(), 7u);
+    const std::vector<SurfaceInteraction> points = seen_points(*guided, 8);
+    ASSERT_GT(points.size(), 40u);
+    PCG32 rng(11);
+    size_t learned = 0;
+    for (const SurfaceInteraction &si : points) {
+        double sum = 0.0;
+        bool differs = false;
+        for (const auto &e : emitters) {
+            const float pmf = guided->emitter_pmf(si, *e);
+            const float own = plain->emitter_pmf(si, *plain->emitters().at(e->scene_index()));
+            sum += pmf;
+            differs = differs || std::abs(pmf - own) > 1e-3f;
+        }
+        EXPECT_NEAR(sum, 1.0, 1e-5);
+        if (differs) ++learned;
+    }
+    EXPECT_GT(learned, points.size() / 2) << "the guide learned no choice";
+    // Frequencies at a few points: each emitter's count against its binomial bounds.
+    const int n = 20000;
+    for (size_t k = 0; k < points.size(); k += points.size() / 4) {
+        const SurfaceInteraction &si = points[k];
+        std::vector<int> count(emitters.size(), 0);
+        for (int i = 0; i < n; ++i) {
+            float u = rng.next_float();
+            const auto [emitter, pmf] = guided->sample_emitter(si, u);
+            ASSERT_TRUE(emitter);
+            ASSERT_TRUE(u >= 0.f && u < 1.f);
+            EXPECT_EQ(pmf, guided->emitter_pmf(si, *emitter));
+            ++count[emitter->scene_index()];
+        }
+        for (const auto &e : emitters) {
+            const double p = guided->emitter_pmf(si, *e);
+            EXPECT_NEAR(count[e->scene_index()], n * p, 5.0 * std::sqrt(n * p * (1.0 - p)) + 1.0)
+                << "emitter " << e->scene_index() << " at point " << k;
+        }
+    }
+}
+
+TEST(LightGuide, SamplingWeightsKeepTheScenesChoice) {
+    // A scene that gives its emitters a sampling_weight asks for Mitsuba's choice: the survey
+    // learns none (the probability q still applies).
+    std::string xml = maze_xml(true, true);
+    const std::string lamp = R"(<emitter type="area"><rgb name="radiance" value="10"/></emitter>)";
+    const std::string weighted =
+        R"(<emitter type="area"><rgb name="radiance" value="10"/><float name="sampling_weight" value="1"/></emitter>)";
+    for (size_t at = xml.find(lamp); at != std::string::npos; at = xml.find(lamp, at))
+        xml.replace(at, lamp.size(), weighted);
+    auto scene = load(xml);
+    scene->prepare_light_sampling();
+    const auto &emitters = scene->emitters();
+    ASSERT_EQ(emitters.size(), 7u);
+    for (const SurfaceInteraction &si : seen_points(*scene, 8))
+        for (const auto &e : emitters) EXPECT_EQ(scene->emitter_pmf(si, *e), 1.f / 7.f);
 }
 
 TEST(LightGuide, DependsOnTheSceneAlone) {
@@ -195,8 +262,11 @@ TEST(LightGuide, DependsOnTheSceneAlone) {
     opts.threads = 1;
     const RenderResult one = render(*a, *a->sensors().at(0), opts);
     b->prepare_light_sampling();
-    for (const SurfaceInteraction &si : seen_points(*a, 16))
+    for (const SurfaceInteraction &si : seen_points(*a, 16)) {
         EXPECT_EQ(a->light_sample_probability(si.p), b->light_sample_probability(si.p));
+        for (size_t e = 0; e < a->emitters().size(); ++e)
+            EXPECT_EQ(a->emitter_pmf(si, *a->emitters()[e]), b->emitter_pmf(si, *b->emitters()[e]));
+    }
     opts.threads = 2;
     const RenderResult two = render(*a, *a->sensors().at(0), opts);
     ASSERT_EQ(one.image.data.size(), two.image.data.size());
@@ -232,7 +302,7 @@ TEST(LightGuide, LampsInTheMazeGiveTheSameImage) {
     const double error = std::hypot(g.error, p.error);
     // A bias of 20% would show. (Light samples that are skipped are mostly useless ones, so a
     // wrong weight or density of the skipping moves this image by only ~8%: the exact checks of
-    // GuidedSamplesAreTheUnguidedOnesTakenWithProbabilityQ catch those.)
+    // GuidedSamplesAreTakenAtRateQWithTheirDensities catch those.)
     EXPECT_LT(error, 0.05 * p.mean);
     EXPECT_NEAR(g.mean, p.mean, 4.0 * error);
 }
