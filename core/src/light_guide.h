@@ -9,11 +9,12 @@
 //
 // The same survey also learns which emitters are worth a light sample, per cell of a coarser
 // grid: each emitter's second moment there (the square of BSDF times radiance over density of its
-// useful samples, over the probability its choice had), whose square root is the share that
-// minimises the variance of a one-emitter sample. The scene then picks an emitter half of the
-// time by its own rule and half of the time by those shares, and gives every sample the density
-// of that mixture: no emitter gets less than half the share it had, and the ones the cell's
-// points actually see get more. Emitters at infinity keep their share (finish()'s `fixed`).
+// useful samples, times their MIS weight, over the probability its choice had), whose square root
+// is the share that minimises the variance of a one-emitter sample. The scene then picks an
+// emitter half of the time by its own rule and half of the time by those shares, and gives every
+// sample the density of that mixture: no emitter gets less than half the share it had, and the
+// ones the cell's points actually see get more. Emitters at infinity keep their share
+// (finish()'s `fixed`).
 #pragma once
 
 #include <facet/bbox.h>

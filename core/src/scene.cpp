@@ -10,6 +10,7 @@
 #include <facet/integrator.h>
 #include <facet/logger.h>
 #include <facet/mesh.h>
+#include <facet/mis.h>
 #include <facet/plugin.h>
 #include <facet/random.h>
 #include <facet/scene.h>
@@ -762,14 +763,17 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
                 bool useful = false;
                 float contribution = 0.f;
                 if (ds.pdf > 0.f && !weight.is_black()) {
-                    const Color3f f = bsdf->eval_pdf(ctx, si, si.to_local(ds.d)).first;
+                    const auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, si.to_local(ds.d));
                     useful = !f.is_black() && emitter_visible(si, ds);
                     if (useful) {
-                        // The emitter's light through the BSDF, without its choice: X · pmf
-                        // for the sample's X = f · weight. Its square over pmf estimates the
+                        // The emitter's light through the BSDF as the path tracer counts it
+                        // (times its MIS weight: light a BSDF sample finds better is not the
+                        // light sample's to carry), without its choice: X · pmf for the
+                        // sample's X = f · weight · w. Its square over pmf estimates the
                         // emitter's second moment at the cell's points, whatever the choice.
+                        const float w = ds.delta ? 1.f : mis_weight(ds.pdf, bsdf_pdf);
                         const float pmf = emitter_pmf(si, *ds.emitter);
-                        const float y = std::max((f * weight).luminance(), 0.f) * pmf;
+                        const float y = std::max((f * weight).luminance(), 0.f) * pmf * w;
                         contribution = pmf > 0.f ? y * y / pmf : 0.f;
                     }
                 }
