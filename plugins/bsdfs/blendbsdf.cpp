@@ -78,7 +78,9 @@ public:
         std::vector<BSDFFlags> components;
         for (const auto &b : m_nested)
             for (size_t i = 0; i < b->component_count(); ++i) {
-                BSDFFlags f = b->flags(i);
+                // A delta sample here carries the other BSDF's value too (as in Mitsuba), not
+                // its lobe's weight alone: not separable.
+                BSDFFlags f = b->flags(i) & ~BSDFFlags::SeparableDelta;
                 if (m_weight->is_spatially_varying()) f |= BSDFFlags::SpatiallyVarying;
                 components.push_back(f);
             }

@@ -64,7 +64,10 @@ public:
         float s_mean = m_specular_reflectance ? m_specular_reflectance->mean().mean() : 1.f;
         m_specular_sampling_weight = d_mean + s_mean > 0.f ? s_mean / (d_mean + s_mean) : 0.5f;
 
-        BSDFFlags spec = BSDFFlags::DeltaReflection | BSDFFlags::FrontSide;
+        // The coat sampled alone weighs its reflection by F (times specular_reflectance), what
+        // sample() brings through it on average: separable.
+        BSDFFlags spec =
+            BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide;
         BSDFFlags diff = BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide;
         if (m_specular_reflectance && m_specular_reflectance->is_spatially_varying())
             spec |= BSDFFlags::SpatiallyVarying;

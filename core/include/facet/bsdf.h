@@ -53,6 +53,13 @@ enum class BSDFFlags : uint32_t {
     /// The BSDF's value depends on the polarisation of light, or changes it: the polarized mode
     /// asks it for Mueller matrices. Others depolarise (mueller::depolarizer()).
     Polarizing = 0x40000,
+    /// On a delta component: sampled alone (BSDFContext::component), it returns the lobe's whole
+    /// weight, the light the BSDF's own samples bring through it on average (they pick it with
+    /// the probability they divide by). An integrator may then count what the lobe sees in every
+    /// sample, whichever lobe the sample follows (the path tracer does, for a BSDF with smooth
+    /// lobes too, when every delta component says so). Adapters pass it on from the BSDFs they
+    /// nest; blendbsdf clears it (its delta samples are weighted with the other BSDF's value).
+    SeparableDelta = 0x80000,
 
     Reflection = DiffuseReflection | DeltaReflection | Delta1DReflection | GlossyReflection,
     Transmission =

@@ -137,6 +137,23 @@ TEST(BlendBSDF, DeltaSamplesAreWeightedByTheBlend) {
     EXPECT_NEAR(bs_d.pdf, (1.f - w) * bs_d.wo.z * InvPi, 1e-5f);
 }
 
+TEST(BlendBSDF, DeltaLobesAreNotSeparable) {
+    // For the same reason a blend's delta lobe sampled alone (w times the mirror) is not what
+    // its samples bring through it on average (they add the other BSDF's value): the blend
+    // clears SeparableDelta from the nested plastic's coat, so that no integrator counts the
+    // coat's light by its lobe alone.
+    auto plastic = make_bsdf("plastic");
+    ASSERT_TRUE(has_flag(plastic->flags(0), BSDFFlags::SeparableDelta));
+    auto bsdf = make_nested("blendbsdf", {make_bsdf("diffuse", {{"reflectance", 0.8}}), plastic},
+                            {{"weight", 0.3}});
+    for (uint32_t k = 0; k < bsdf->component_count(); ++k)
+        EXPECT_FALSE(has_flag(bsdf->flags(k), BSDFFlags::SeparableDelta)) << k;
+    const SurfaceInteraction si = make_si(direction_from_angles(30.f, 10.f));
+    const Color3f alone = bsdf->sample(component_ctx(1), si, 0.5f, Point2f(0.5f)).second;
+    const Color3f share = delta_share(*bsdf, si, 1);
+    EXPECT_GT(share.r, 1.2f * alone.r) << "the blend's coat samples carry the diffuse too";
+}
+
 TEST(BlendBSDF, ComponentsAreRouted) {
     auto first = make_bsdf("plastic");
     auto second = rough_conductor(0.3);

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -197,6 +198,55 @@ inline double pdf_sphere_integral(const BSDF &bsdf, const BSDFContext &ctx,
             sum += double(bsdf.pdf(ctx, si, warp::square_to_uniform_sphere(cell)));
         }
     return sum * 4.0 * double(Pi) / (double(res) * double(res));
+}
+
+/// What the BSDF's own samples bring through delta component `k` from si.wi, on average: the
+/// mean over `count` samples (sample1 stratified) of the weight of those that follow it. A
+/// SeparableDelta component sampled alone must return this as its weight.
+inline Color3f delta_share(const BSDF &bsdf, const SurfaceInteraction &si, uint32_t k,
+                           int count = 65536, uint64_t seed = 8) {
+    PCG32 rng(seed);
+    const BSDFContext ctx;
+    double sum[3] = {0, 0, 0};
+    for (int i = 0; i < count; ++i) {
+        const float s1 = (float(i) + rng.next_float()) / float(count);
+        auto [bs, weight] = bsdf.sample(ctx, si, s1, next_point2f(rng));
+        if (bs.sampled_component != k || weight.is_black()) continue;
+        for (int c = 0; c < 3; ++c) sum[c] += double(weight[c]);
+    }
+    return Color3f(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
+}
+
+/// Every component flagged SeparableDelta keeps its promise for `count` random incident
+/// directions (upper hemisphere unless `both_sides`): sampled alone, its weight is
+/// delta_share() (relative `tol`), and its direction the one the BSDF's samples take. Returns
+/// the number of (direction, component) pairs checked with light through the lobe.
+inline int check_separable_delta(const BSDF &bsdf, bool both_sides, int count = 24,
+                                 uint64_t seed = 3, float tol = 1e-2f) {
+    PCG32 rng(seed);
+    int checked = 0;
+    for (int n = 0; n < count; ++n) {
+        const SurfaceInteraction si = make_si(random_direction(rng, !both_sides));
+        for (uint32_t k = 0; k < uint32_t(bsdf.component_count()); ++k) {
+            if (!has_flag(bsdf.flags(k), BSDFFlags::SeparableDelta)) continue;
+            EXPECT_TRUE(
+                has_flag(bsdf.flags(k), BSDFFlags::DeltaReflection | BSDFFlags::DeltaTransmission))
+                << "component " << k << " is flagged SeparableDelta but is not a delta lobe";
+            auto [lobe, weight] = bsdf.sample(component_ctx(k), si, 0.5f, Point2f(0.5f));
+            const Color3f share = delta_share(bsdf, si, k);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(weight[c], share[c], tol * std::max(share[c], 1e-4f))
+                    << "component " << k << ", cos θi = " << si.wi.z << ", channel " << c;
+            if (weight.is_black()) continue;
+            ++checked;
+            auto [bs, full] = bsdf.sample(BSDFContext(), si, 0.f, Point2f(0.5f));
+            for (float s1 = 0.f; bs.sampled_component != k && s1 < 1.f; s1 += 1.f / 4096.f)
+                std::tie(bs, full) = bsdf.sample(BSDFContext(), si, s1, Point2f(0.5f));
+            EXPECT_EQ(bs.sampled_component, k);
+            EXPECT_TRUE(bs.wo == lobe.wo) << "component " << k << ", cos θi = " << si.wi.z;
+        }
+    }
+    return checked;
 }
 
 /// Fraction of `count` samples from si.wi with a non-zero weight.

@@ -19,7 +19,8 @@ std::shared_ptr<BSDF> rough_conductor() { return make_bsdf("roughconductor", {{"
 TEST(Mask, CreationAndFlags) {
     auto bsdf = make_nested("mask", {make_bsdf("plastic")});
     ASSERT_EQ(bsdf->component_count(), 3u);
-    EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(0),
+              BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(2), BSDFFlags::Null | BSDFFlags::FrontSide | BSDFFlags::BackSide);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1) | bsdf->flags(2));

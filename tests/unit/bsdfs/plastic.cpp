@@ -43,7 +43,8 @@ std::vector<Config> configs() {
 TEST(Plastic, CreationAndFlags) {
     auto bsdf = make_bsdf("plastic");
     ASSERT_EQ(bsdf->component_count(), 2u);
-    EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(0),
+              BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1));
     EXPECT_NE(bsdf->to_string().find("Plastic"), std::string::npos);
@@ -203,3 +204,20 @@ TEST(Plastic, WhiteFurnace) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(Plastic, CoatSampledAloneCarriesWhatSamplesBringThroughIt) {
+    // SeparableDelta: the coat sampled alone weighs the mirror direction by what the plastic's
+    // own samples (which pick the coat with probability p and divide by it) bring on average,
+    // F times specular_reflectance; the path tracer counts it in every sample on that promise.
+    // Also through the adapters that pass the flag on.
+    for (const auto &config : configs()) {
+        SCOPED_TRACE(config.name);
+        auto bsdf = make_bsdf("plastic", config.params);
+        EXPECT_GT(check_separable_delta(*bsdf, false), 20);
+        auto twosided = make_nested("twosided", {bsdf});
+        EXPECT_TRUE(has_flag(twosided->flags(2), BSDFFlags::SeparableDelta));
+        EXPECT_GT(check_separable_delta(*twosided, true), 20); // one side's coat is lit
+        auto mask = make_nested("mask", {bsdf}, {{"opacity", 0.3}});
+        EXPECT_GT(check_separable_delta(*mask, false), 20);
+    }
+}

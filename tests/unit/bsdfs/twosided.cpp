@@ -34,7 +34,8 @@ TEST(TwoSided, CreationAndFlags) {
 
     auto two = make_nested("twosided", {make_bsdf("plastic"), rough_conductor(0.2)});
     ASSERT_EQ(two->component_count(), 3u);
-    EXPECT_EQ(two->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(two->flags(0),
+              BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide);
     EXPECT_EQ(two->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
     EXPECT_EQ(two->flags(2),
               BSDFFlags::GlossyReflection | BSDFFlags::BackSide | BSDFFlags::Polarizing);
