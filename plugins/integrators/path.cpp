@@ -98,6 +98,82 @@ private:
         return true;
     }
 
+    /// A plastic's coat (or any BSDF with a delta lobe and a smooth one) is followed only as
+    /// often as the path's sample picks it, so the bright sky its mirror direction shows arrives
+    /// in a few samples with a large weight. Instead, the light each delta lobe's one direction
+    /// sees directly is added here to `result` (through `throughput`), with the lobe's whole
+    /// weight, whichever lobe the path's sample `bs` follows; the path then does not count it
+    /// again when it follows the lobe (`follows`). The lobe's ray is the next segment's when
+    /// the path follows it: its hit is written to `next_si` and `next_hit`, and the function
+    /// returns true. Otherwise one more ray (a visibility test where the scene's emitters are
+    /// all at infinity). Only where every delta lobe is separable (BSDFFlags::SeparableDelta):
+    /// sampled alone, it carries what the BSDF's own samples bring through it on average. Glass
+    /// (delta lobes only) keeps its one random lobe: its second ray cost more than it saved.
+    template <bool Polarized, typename Value, typename Throughput>
+    bool count_delta_lobes(const Scene &scene, const BSDF &bsdf, const SurfaceInteraction &si,
+                           const BSDFSample &bs, bool follows, float sample1,
+                           const Point2f &sample2, bool polarizing, const Throughput &throughput,
+                           Value &result, SurfaceInteraction &next_si, bool &next_hit) const {
+        // Emitters that are neither at infinity nor surfaces (points, spots) count as surfaces
+        // here: a lobe that is not followed then needs its closest hit.
+        const bool surface_emitters = scene.emitters().size() > scene.environment_emitters().size();
+        BSDFContext lobe_ctx;
+        bool next_known = false;
+        SurfaceInteraction lobe_si;
+        for (uint32_t k = 0; k < uint32_t(bsdf.component_count()); ++k) {
+            if (!has_flag(bsdf.flags(k), DeltaLobes)) continue;
+            lobe_ctx.component = k;
+            BSDFSample lobe;
+            Color3f lobe_weight;
+            Mueller lobe_mueller;
+            if (polarizing) {
+                std::tie(lobe, lobe_mueller) =
+                    bsdf.sample_polarized(lobe_ctx, si, sample1, sample2);
+                lobe_weight = lobe_mueller.unpolarized();
+            } else {
+                std::tie(lobe, lobe_weight) = bsdf.sample(lobe_ctx, si, sample1, sample2);
+            }
+            FACET_ASSERT(lobe_weight.is_finite());
+            if (lobe_weight.is_black()) continue;
+            // The same ray as the path's next segment: the same hit.
+            const bool next = follows && !next_known && lobe.wo == bs.wo;
+            const Ray lobe_ray = si.spawn_ray(si.to_world(lobe.wo));
+            SurfaceInteraction &seen = next ? next_si : lobe_si;
+            bool hit;
+            if (next || surface_emitters) {
+                hit = scene.ray_intersect(lobe_ray, seen);
+            } else {
+                // Only the sky can give light here: whether the ray leaves is enough.
+                if (scene.ray_test(lobe_ray)) continue;
+                hit = false;
+                Scene::escaped(lobe_ray, seen);
+                seen.wavelengths = lobe_ray.wavelengths; // as ray_intersect() sets them
+            }
+            if (next) {
+                next_known = true;
+                next_hit = hit;
+            }
+            Color3f L(0.f);
+            if (!hit)
+                L = environment_mis(scene, seen, si, 1.f, true);
+            else if (const Emitter *emitter = seen.shape ? seen.shape->emitter() : nullptr)
+                L = emitter->eval(seen);
+            if (L.is_black()) continue;
+            if constexpr (Polarized) {
+                if (polarizing)
+                    result +=
+                        throughput *
+                        (mueller::to_world(si.sh_frame, lobe_mueller, -lobe.wo, si.wi).column(0) *
+                         L);
+                else
+                    result += throughput.column(0) * (lobe_weight * L);
+            } else {
+                result += throughput * lobe_weight * L;
+            }
+        }
+        return next_known;
+    }
+
     /// The path's radiance: a colour, or in the polarized mode (Polarized) the Stokes vector of
     /// the light arriving along the camera ray. The polarized path's throughput is a Mueller
     /// matrix in the world's implicit frames (mueller.h): the product of the BSDF matrices along
@@ -125,10 +201,11 @@ private:
         float prev_bsdf_pdf = 1.f;
         bool prev_bsdf_delta = true;
 
-        // The light a delta lobe sees may be counted already (below): the next vertex, found
-        // by the lobe's ray, is then known (next_si), and its emission is not counted again.
+        // The light a delta lobe sees may be counted already (count_delta_lobes()): the next
+        // vertex, found by the lobe's ray, is then known (next_si), and its emission is not
+        // counted again.
         bool next_known = false, next_hit = false, emission_counted = false;
-        SurfaceInteraction next_si, lobe_si;
+        SurfaceInteraction next_si;
 
         for (;;) {
             bool hit;
@@ -233,78 +310,13 @@ private:
                 }
             }
 
-            // ---- Light seen through a delta lobe beside smooth ones ----
-            // A plastic's coat (or any BSDF with a delta lobe and a smooth one) is followed only
-            // as often as the sample above picks it, so the bright sky its mirror direction
-            // shows arrives in a few samples with a large weight. Instead, the light a delta
-            // lobe's one direction sees directly is counted here, with the lobe's whole weight,
-            // whichever lobe the path follows; the path then no longer counts it when it
-            // follows that lobe. The lobe's ray is the next segment's when the path follows it
-            // (traced once); otherwise one more ray. Only where every delta lobe is separable
-            // (BSDFFlags::SeparableDelta): sampled alone, it carries what the BSDF's own
-            // samples bring through it on average. Glass (delta lobes only) keeps its one
-            // random lobe: its second ray cost more than it saved.
+            // ---- Light seen through a delta lobe beside smooth ones (count_delta_lobes()) ----
             if (sample_emitter && has_flag(bsdf->flags(), DeltaLobes) && separable(*bsdf)) {
-                // Emitters that are neither at infinity nor surfaces (points, spots) count as
-                // surfaces here: a lobe that is not followed then needs its closest hit.
-                const bool surface_emitters =
-                    scene.emitters().size() > scene.environment_emitters().size();
                 // Every delta lobe is counted: if the path follows one, its light is.
-                const bool follows_delta =
-                    !bsdf_weight.is_black() && has_flag(bs.sampled_type, DeltaLobes);
-                emission_counted = follows_delta;
-                for (uint32_t k = 0; k < uint32_t(bsdf->component_count()); ++k) {
-                    if (!has_flag(bsdf->flags(k), DeltaLobes)) continue;
-                    BSDFContext lobe_ctx = ctx;
-                    lobe_ctx.component = k;
-                    BSDFSample lobe;
-                    Color3f lobe_weight;
-                    Mueller lobe_mueller;
-                    if (polarizing) {
-                        std::tie(lobe, lobe_mueller) =
-                            bsdf->sample_polarized(lobe_ctx, si, sample1, sample2);
-                        lobe_weight = lobe_mueller.unpolarized();
-                    } else {
-                        std::tie(lobe, lobe_weight) = bsdf->sample(lobe_ctx, si, sample1, sample2);
-                    }
-                    FACET_ASSERT(lobe_weight.is_finite());
-                    if (lobe_weight.is_black()) continue;
-                    // The same ray as the path's next segment: the same hit.
-                    const bool next = follows_delta && !next_known && lobe.wo == bs.wo;
-                    const Ray lobe_ray = si.spawn_ray(si.to_world(lobe.wo));
-                    SurfaceInteraction &seen = next ? next_si : lobe_si;
-                    bool lobe_hit;
-                    if (next || surface_emitters) {
-                        lobe_hit = scene.ray_intersect(lobe_ray, seen);
-                    } else {
-                        // Only the sky can give light here: whether the ray leaves is enough.
-                        lobe_hit = scene.ray_test(lobe_ray);
-                        if (lobe_hit) continue;
-                        Scene::escaped(lobe_ray, seen);
-                        seen.wavelengths = lobe_ray.wavelengths; // as ray_intersect() sets them
-                    }
-                    if (next) {
-                        next_known = true;
-                        next_hit = lobe_hit;
-                    }
-                    Color3f L(0.f);
-                    if (!lobe_hit)
-                        L = environment_mis(scene, seen, si, 1.f, true);
-                    else if (const Emitter *emitter = seen.shape ? seen.shape->emitter() : nullptr)
-                        L = emitter->eval(seen);
-                    if (L.is_black()) continue;
-                    if constexpr (Polarized) {
-                        if (polarizing)
-                            result += throughput *
-                                      (mueller::to_world(si.sh_frame, lobe_mueller, -lobe.wo, si.wi)
-                                           .column(0) *
-                                       L);
-                        else
-                            result += throughput.column(0) * (lobe_weight * L);
-                    } else {
-                        result += throughput * lobe_weight * L;
-                    }
-                }
+                emission_counted = !bsdf_weight.is_black() && has_flag(bs.sampled_type, DeltaLobes);
+                next_known = count_delta_lobes<Polarized>(scene, *bsdf, si, bs, emission_counted,
+                                                          sample1, sample2, polarizing, throughput,
+                                                          result, next_si, next_hit);
             }
 
             // ---- BSDF sampling: the next segment of the path ----
