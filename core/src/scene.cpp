@@ -995,7 +995,8 @@ void Scene::escaped(const Ray &ray, SurfaceInteraction &si) {
     si.sh_frame = Frame();
     si.uv = Point2f(0.f, 0.f);
     si.dp_du = si.dp_dv = Vector3f(0.f);
-    si.wi = -ray.d; // local: the frame is the identity
+    si.wi = -ray.d;                   // local: the frame is the identity
+    si.wavelengths = ray.wavelengths; // what an environment emitter's eval() reads
     si.shape = nullptr;
     si.prim_index = 0;
     si.instance_index = uint32_t(-1);

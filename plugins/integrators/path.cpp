@@ -147,7 +147,6 @@ private:
                 if (scene.ray_test(lobe_ray)) continue;
                 hit = false;
                 Scene::escaped(lobe_ray, seen);
-                seen.wavelengths = lobe_ray.wavelengths; // as ray_intersect() sets them
             }
             if (next) {
                 next_known = true;

@@ -392,9 +392,11 @@ MeanAndVariance independent_means(const Scene &scene, int spp, int k) {
 /// peer rule (facet compare): z = |ptracer - path| sqrt(N / var) per pixel and XYZ channel with
 /// N the light paths per pixel, where var holds both renders' noise (the path tracer's scaled
 /// to N samples), and 99.75 % of the channels must pass the Sidak-corrected level.
-void expect_agreement(const std::string &emitter) {
-    auto pt = load_temp_scene("env-pt", environment_scene("ptracer", emitter));
-    auto path = load_temp_scene("env-path", environment_scene("path", emitter));
+void expect_agreement(const std::string &emitter, const std::string &mode = "") {
+    LoadOptions opts;
+    opts.mode = mode;
+    auto pt = load_temp_scene("env-pt", environment_scene("ptracer", emitter), opts);
+    auto path = load_temp_scene("env-path", environment_scene("path", emitter), opts);
     // Directly visible environment pixels receive a few of the emitter connections of each
     // render: enough light paths per render keep those counts away from the small, skewed
     // Poisson counts that would make the variance estimate of 16 renders too low.
@@ -426,6 +428,16 @@ TEST(ParticleTracer, EnvironmentMapAgreesWithThePathTracer) {
         <transform name="to_world"><rotate y="1" angle="40"/></transform>
     </emitter>)",
                                  FACET_SOURCE_DIR));
+}
+
+TEST(ParticleTracer, EnvironmentMapAgreesWithThePathTracerInSpectral) {
+    // The sky seen directly is the map's radiance at the light path's wavelengths (the record
+    // of the connection's escaped ray carries them; it once rendered black).
+    expect_agreement(fmt::format(R"(<emitter type="envmap">
+        <string name="filename" value="{}/tests/chi2/envmap_sky.exr"/>
+    </emitter>)",
+                                 FACET_SOURCE_DIR),
+                     "scalar_spectral");
 }
 
 TEST(ParticleTracer, HiddenEnvironmentLeavesTheSkyBlack) {

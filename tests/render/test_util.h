@@ -54,12 +54,13 @@ inline std::vector<std::string> lines(const std::string &text) {
 
 /// Writes `xml` to <name>.xml in a temporary folder, loads it with the XML loader (as a scene
 /// file, so relative paths resolve against that folder) and removes the folder.
-inline std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::string &xml) {
+inline std::shared_ptr<Scene> load_temp_scene(const std::string &name, const std::string &xml,
+                                              const LoadOptions &opts = {}) {
     fs::path dir = fs::temp_directory_path() / fmt::format("facet-render-test-{}", ::getpid());
     fs::create_directories(dir);
     fs::path file = dir / (name + ".xml");
     std::ofstream(file) << xml;
-    auto scene = load_scene(file.string());
+    auto scene = load_scene(file.string(), opts);
     fs::remove_all(dir);
     return scene;
 }

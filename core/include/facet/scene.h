@@ -49,7 +49,8 @@ public:
     bool ray_intersect(const Ray &ray, SurfaceInteraction &si) const;
     /// The record of a ray that left the scene, the one route to the environment emitters: t =
     /// Infinity, no shape, p = the ray's origin, the identity shading frame and wi = -ray.d in it
-    /// (local, like every wi; the world direction towards the origin is si.to_world(si.wi)).
+    /// (local, like every wi; the world direction towards the origin is si.to_world(si.wi)), and
+    /// the ray's wavelengths.
     static void escaped(const Ray &ray, SurfaceInteraction &si);
     /// Any hit in [ray.mint, ray.maxt] (rtcOccluded1).
     bool ray_test(const Ray &ray) const;
