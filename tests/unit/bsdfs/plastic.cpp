@@ -203,8 +203,6 @@ TEST(Plastic, WhiteFurnace) {
     }
 }
 
-// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
-
 TEST(Plastic, CoatSampledAloneCarriesWhatSamplesBringThroughIt) {
     // SeparableDelta: the coat sampled alone weighs the mirror direction by what the plastic's
     // own samples (which pick the coat with probability p and divide by it) bring on average,
@@ -221,3 +219,5 @@ TEST(Plastic, CoatSampledAloneCarriesWhatSamplesBringThroughIt) {
         EXPECT_GT(check_separable_delta(*mask, false), 20);
     }
 }
+
+// Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
