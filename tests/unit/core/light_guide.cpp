@@ -1,8 +1,10 @@
 // The light-sample guide (Scene::prepare_light_sampling()): where the scene's survey found few
 // light samples useful, a point takes one with probability q < 1, its weight divided by q and
-// its density multiplied by it; and the emitter it samples is chosen half by the scene's own rule,
-// half by what the survey learned there. The densities are those of that sampling, the expected
-// image is the same, and the guide depends on the scene alone.
+// its density multiplied by it; and the emitter it samples is chosen a tenth of the time by the
+// scene's own rule, otherwise by what the survey learned there. The densities are those of that
+// sampling, the expected image is the same, and the guide depends on the scene alone.
+#include "light_guide.h"
+
 #include "draws.h"
 
 #include <facet/integrator.h>
@@ -177,9 +179,11 @@ TEST(LightGuide, GuidedSamplesAreTakenAtRateQWithTheirDensities) {
             const float own = ds.emitter->pdf_direction(si, ds);
             EXPECT_NEAR(ds.pdf, q * pmf * own, 1e-5f * ds.pdf);
             EXPECT_NEAR(weight.g * ds.pdf, 1.f, 1e-5f);
-            // The choice keeps at least the scene's own rule's share of it, whatever it learned.
+            // The choice keeps at least OwnChoiceShare of the scene's own rule's probability,
+            // whatever it learned.
             const Emitter &twin = *plain->emitters().at(ds.emitter->scene_index());
-            EXPECT_GE(pmf, 0.5f * plain->emitter_pmf(si, twin) * (1.f - 1e-6f));
+            EXPECT_GE(pmf, detail::LightGuide::OwnChoiceShare * plain->emitter_pmf(si, twin) *
+                               (1.f - 1e-6f));
         }
     }
     // The maze makes most light samples useless somewhere the camera looks.
