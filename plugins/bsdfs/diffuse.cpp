@@ -30,7 +30,8 @@ class Diffuse final : public BSDF {
 public:
     explicit Diffuse(const Properties &props) {
         m_reflectance = props.texture("reflectance", 0.5f);
-        BSDFFlags flags = BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide;
+        BSDFFlags flags =
+            BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly;
         if (m_reflectance->is_spatially_varying()) flags |= BSDFFlags::SpatiallyVarying;
         set_components({flags});
     }

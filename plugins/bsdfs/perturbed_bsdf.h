@@ -162,7 +162,8 @@ protected:
         BSDFFlags extra = varying ? BSDFFlags::SpatiallyVarying : BSDFFlags::Empty;
         std::vector<BSDFFlags> components;
         for (size_t i = 0; i < m_nested->component_count(); ++i)
-            components.push_back(m_nested->flags(i) | extra);
+            // Not WiSideOnly: the nested BSDF's sides are those of the perturbed frame.
+            components.push_back((m_nested->flags(i) & ~BSDFFlags::WiSideOnly) | extra);
         set_components(std::move(components));
     }
 

@@ -66,9 +66,10 @@ public:
 
         // The coat sampled alone weighs its reflection by F (times specular_reflectance), what
         // sample() brings through it on average: separable.
-        BSDFFlags spec =
-            BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide;
-        BSDFFlags diff = BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide;
+        BSDFFlags spec = BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta |
+                         BSDFFlags::FrontSide | BSDFFlags::WiSideOnly;
+        BSDFFlags diff =
+            BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly;
         if (m_specular_reflectance && m_specular_reflectance->is_spatially_varying())
             spec |= BSDFFlags::SpatiallyVarying;
         if (m_diffuse_reflectance->is_spatially_varying()) diff |= BSDFFlags::SpatiallyVarying;

@@ -77,9 +77,10 @@ public:
         const float s_mean = m_specular_reflectance ? m_specular_reflectance->mean().mean() : 1.f;
         m_specular_sampling_weight = d_mean + s_mean > 0.f ? s_mean / (d_mean + s_mean) : 0.5f;
 
-        BSDFFlags spec = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
-        BSDFFlags diff =
-            BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
+        BSDFFlags spec = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
+                         BSDFFlags::Polarizing | BSDFFlags::WiSideOnly;
+        BSDFFlags diff = BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide |
+                         BSDFFlags::Polarizing | BSDFFlags::WiSideOnly;
         if (m_microfacet.is_anisotropic()) spec |= BSDFFlags::Anisotropic;
         if (m_microfacet.is_spatially_varying() || varies(m_specular_reflectance))
             spec |= BSDFFlags::SpatiallyVarying;

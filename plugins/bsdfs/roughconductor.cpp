@@ -52,8 +52,8 @@ public:
         m_k = ior.k;
         m_specular_reflectance = props.texture("specular_reflectance", 1.f);
 
-        BSDFFlags flags =
-            BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing;
+        BSDFFlags flags = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
+                          BSDFFlags::Polarizing | BSDFFlags::WiSideOnly;
         if (m_microfacet.is_anisotropic()) flags |= BSDFFlags::Anisotropic;
         if (m_microfacet.is_spatially_varying() || varies(m_eta) || varies(m_k) ||
             varies(m_specular_reflectance))

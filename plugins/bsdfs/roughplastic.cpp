@@ -227,8 +227,9 @@ public:
         m_external_transmittance = tables.external_transmittance;
         m_internal_reflectance = tables.internal_reflectance;
 
-        BSDFFlags spec = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide;
-        BSDFFlags diff = BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide;
+        BSDFFlags spec = BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly;
+        BSDFFlags diff =
+            BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly;
         if (m_specular_reflectance && m_specular_reflectance->is_spatially_varying())
             spec |= BSDFFlags::SpatiallyVarying;
         if (m_diffuse_reflectance->is_spatially_varying()) diff |= BSDFFlags::SpatiallyVarying;

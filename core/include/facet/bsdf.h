@@ -60,6 +60,13 @@ enum class BSDFFlags : uint32_t {
     /// lobes too, when every delta component says so). Adapters pass it on from the BSDFs they
     /// nest; blendbsdf clears it (its delta samples are weighted with the other BSDF's value).
     SeparableDelta = 0x80000,
+    /// The BSDF's value is zero wherever wo lies on the other side of the shading frame's plane
+    /// from wi (Frame::cos_theta(wi) * Frame::cos_theta(wo) <= 0): it reflects, and only to the
+    /// side light comes from. An integrator may then tell light samples that no light counts
+    /// from the other side (Emitter::sample_direction_mis()'s `side`). Reflecting BSDFs that
+    /// test both cosines in the frame they are given say so; adapters that evaluate a nested BSDF
+    /// in another frame (normalmap, bumpmap) do not pass it on.
+    WiSideOnly = 0x100000,
 
     Reflection = DiffuseReflection | DeltaReflection | Delta1DReflection | GlossyReflection,
     Transmission =
@@ -166,7 +173,8 @@ public:
     bool needs_differentials() const { return has_flag(m_flags, BSDFFlags::NeedsDifferentials); }
 
 protected:
-    /// Sets the per-component flags and their union.
+    /// Sets the per-component flags and their union, but for WiSideOnly, which the BSDF has
+    /// only when every component has it.
     void set_components(std::vector<BSDFFlags> components) {
         if (components.size() > MaxBSDFComponents)
             FACET_THROW("the BSDF would have {} components, more than the {} facet supports "
@@ -175,11 +183,27 @@ protected:
                         components.size(), MaxBSDFComponents);
         m_components = std::move(components);
         m_flags = BSDFFlags::Empty;
-        for (BSDFFlags f : m_components) m_flags |= f;
+        bool wi_side_only = !m_components.empty();
+        for (BSDFFlags f : m_components) {
+            m_flags |= f;
+            wi_side_only = wi_side_only && has_flag(f, BSDFFlags::WiSideOnly);
+        }
+        if (!wi_side_only) m_flags = m_flags & ~BSDFFlags::WiSideOnly;
     }
     BSDFFlags m_flags = BSDFFlags::Empty;
     std::vector<BSDFFlags> m_components;
 };
+
+/// The side of the light samples at si (Scene::sample_emitter_direction()): the shading normal
+/// towards wi for a BSDF that reflects only to wi's side (BSDFFlags::WiSideOnly), else none
+/// (zero: light may count from every direction).
+inline Vector3f light_side(const BSDF &bsdf, const SurfaceInteraction &si) {
+    if (!has_flag(bsdf.flags(), BSDFFlags::WiSideOnly)) return Vector3f(0.f);
+    const float cos_i = Frame::cos_theta(si.wi);
+    if (cos_i > 0.f) return si.sh_frame.n;
+    if (cos_i < 0.f) return -si.sh_frame.n;
+    return Vector3f(0.f);
+}
 
 /**
  * For BSDFs written once for both value types (adapters that combine nested BSDFs): `V` =

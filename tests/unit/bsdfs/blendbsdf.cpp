@@ -23,11 +23,17 @@ TEST(BlendBSDF, CreationAndFlags) {
     auto bsdf =
         make_nested("blendbsdf", {make_bsdf("plastic"), rough_conductor()}, {{"weight", 0.3}});
     ASSERT_EQ(bsdf->component_count(), 3u);
-    EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(2),
-              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
+    EXPECT_EQ(bsdf->flags(0),
+              BSDFFlags::DeltaReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(1),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(2), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
+                                  BSDFFlags::Polarizing | BSDFFlags::WiSideOnly);
+    // Both reflect only to wi's side: so does the blend.
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1) | bsdf->flags(2));
+    auto with_glass = make_nested("blendbsdf", {make_bsdf("diffuse"), make_bsdf("dielectric")},
+                                  {{"weight", 0.3}});
+    EXPECT_FALSE(has_flag(with_glass->flags(), BSDFFlags::WiSideOnly));
     EXPECT_NE(bsdf->to_string().find("BlendBSDF"), std::string::npos);
 
     Properties textured("blendbsdf");
@@ -260,3 +266,9 @@ TEST(BlendBSDF, LoadsFromXml) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(BlendBSDF, ReflectsOnlyToWiSide) {
+    EXPECT_GT(check_wi_side_only(*make_nested(
+                  "blendbsdf", {make_bsdf("diffuse"), rough_conductor(0.6)}, {{"weight", 0.4}})),
+              500);
+}

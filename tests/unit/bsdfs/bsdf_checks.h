@@ -111,6 +111,33 @@ inline Vector3f random_direction(PCG32 &rng, bool upper_only) {
     }
 }
 
+/// The promise of BSDFFlags::WiSideOnly, which `bsdf` must have: for `count` random incident
+/// directions (both sides) and outgoing ones on the other side of the shading plane, eval(),
+/// eval_pdf() and eval_pdf_polarized() give no light. Returns how many of the mirrored outgoing
+/// directions (on wi's side) have light, so callers can make sure the check was not vacuous.
+inline int check_wi_side_only(const BSDF &bsdf, int count = 2000, uint64_t seed = 11) {
+    EXPECT_TRUE(has_flag(bsdf.flags(), BSDFFlags::WiSideOnly)) << bsdf.to_string();
+    PCG32 rng(seed);
+    const BSDFContext ctx;
+    int lit = 0;
+    for (int n = 0; n < count; ++n) {
+        const Vector3f wi = random_direction(rng, false);
+        const SurfaceInteraction si = make_si(wi);
+        Vector3f other = random_direction(rng, false);
+        if (Frame::cos_theta(other) * Frame::cos_theta(wi) > 0.f) other.z = -other.z;
+        EXPECT_TRUE(bsdf.eval(ctx, si, other).is_black())
+            << bsdf.to_string() << " wi " << wi << " wo " << other;
+        EXPECT_TRUE(bsdf.eval_pdf(ctx, si, other).first.is_black()) << bsdf.to_string();
+        if (has_flag(bsdf.flags(), BSDFFlags::Polarizing)) {
+            EXPECT_TRUE(bsdf.eval_pdf_polarized(ctx, si, other).first.unpolarized().is_black())
+                << bsdf.to_string();
+        }
+        const Vector3f same(other.x, other.y, -other.z);
+        if (!bsdf.eval(ctx, si, same).is_black()) ++lit;
+    }
+    return lit;
+}
+
 /// Each channel of a within `rel` (relative to b, at least 1e-6 absolute) of b.
 inline void expect_color_near(const Color3f &a, const Color3f &b, float rel) {
     for (int c = 0; c < 3; ++c)

@@ -31,8 +31,10 @@ TEST(BSDFCreation, Diffuse) {
     auto bsdf = make_bsdf("diffuse");
     ASSERT_TRUE(bsdf);
     EXPECT_EQ(bsdf->component_count(), 1u);
-    EXPECT_EQ(bsdf->flags(), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(0), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(0),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
     EXPECT_FALSE(bsdf->needs_differentials());
     EXPECT_FALSE(bsdf->to_string().empty());
 
@@ -244,3 +246,5 @@ TEST(BSDFEval, DiffuseTakesAnyTexturesConstantTheSameWay) {
         expect_color_near(user_varying->eval_diffuse_reflectance(si), rho * u, 1e-7f);
     }
 }
+
+TEST(Diffuse, ReflectsOnlyToWiSide) { EXPECT_GT(check_wi_side_only(*make_bsdf("diffuse")), 500); }

@@ -19,11 +19,14 @@ std::shared_ptr<BSDF> rough_conductor() { return make_bsdf("roughconductor", {{"
 TEST(Mask, CreationAndFlags) {
     auto bsdf = make_nested("mask", {make_bsdf("plastic")});
     ASSERT_EQ(bsdf->component_count(), 3u);
-    EXPECT_EQ(bsdf->flags(0),
-              BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta |
+                                  BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(1),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
     EXPECT_EQ(bsdf->flags(2), BSDFFlags::Null | BSDFFlags::FrontSide | BSDFFlags::BackSide);
-    EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1) | bsdf->flags(2));
+    // Light passes through: not WiSideOnly, though the plastic's components are.
+    EXPECT_EQ(bsdf->flags(),
+              (bsdf->flags(0) | bsdf->flags(1) | bsdf->flags(2)) & ~BSDFFlags::WiSideOnly);
     EXPECT_NE(bsdf->to_string().find("Mask"), std::string::npos);
     EXPECT_NE(bsdf->to_string().find("Plastic"), std::string::npos);
 

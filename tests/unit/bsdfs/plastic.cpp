@@ -43,9 +43,10 @@ std::vector<Config> configs() {
 TEST(Plastic, CreationAndFlags) {
     auto bsdf = make_bsdf("plastic");
     ASSERT_EQ(bsdf->component_count(), 2u);
-    EXPECT_EQ(bsdf->flags(0),
-              BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta |
+                                  BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(1),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1));
     EXPECT_NE(bsdf->to_string().find("Plastic"), std::string::npos);
     EXPECT_EQ(bsdf->eval_diffuse_reflectance(make_si(Vector3f(0.f, 0.f, 1.f))), Color3f(0.5f));
@@ -221,3 +222,9 @@ TEST(Plastic, CoatSampledAloneCarriesWhatSamplesBringThroughIt) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(Plastic, ReflectsOnlyToWiSide) {
+    EXPECT_GT(check_wi_side_only(*make_bsdf("plastic")), 500);
+    EXPECT_GT(check_wi_side_only(*make_bsdf("plastic", {{"nonlinear", true}, {"int_ior", 1.9}})),
+              500);
+}

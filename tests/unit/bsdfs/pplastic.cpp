@@ -48,10 +48,10 @@ std::vector<Params> configs() {
 TEST(PPlastic, CreationAndFlags) {
     auto bsdf = make_bsdf("pplastic");
     ASSERT_EQ(bsdf->component_count(), 2u);
-    EXPECT_EQ(bsdf->flags(0),
-              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
-    EXPECT_EQ(bsdf->flags(1),
-              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
+    EXPECT_EQ(bsdf->flags(0), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
+                                  BSDFFlags::Polarizing | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide |
+                                  BSDFFlags::Polarizing | BSDFFlags::WiSideOnly);
     auto aniso = make_bsdf("pplastic", {{"alpha_u", 0.1}, {"alpha_v", 0.3}});
     EXPECT_TRUE(has_flag(aniso->flags(0), BSDFFlags::Anisotropic));
     expect_error("pplastic", {{"int_ior", 1.3}, {"ext_ior", 1.3}}, "must differ");
@@ -159,3 +159,7 @@ TEST(PPlastic, TheDiffuseBasePolarisesLightLeavingAtGrazingAngles) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(PPlastic, ReflectsOnlyToWiSide) {
+    EXPECT_GT(check_wi_side_only(*make_bsdf("pplastic", {{"alpha", 0.5}})), 500);
+}

@@ -55,11 +55,12 @@ std::vector<Config> configs() {
 TEST(RoughConductor, CreationAndFlags) {
     auto bsdf = make_bsdf("roughconductor");
     ASSERT_EQ(bsdf->component_count(), 1u);
-    EXPECT_EQ(bsdf->flags(),
-              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::Polarizing);
+    EXPECT_EQ(bsdf->flags(), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
+                                 BSDFFlags::Polarizing | BSDFFlags::WiSideOnly);
     auto aniso = make_bsdf("roughconductor", {{"alpha_u", 0.1}, {"alpha_v", 0.3}});
     EXPECT_EQ(aniso->flags(), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide |
-                                  BSDFFlags::Anisotropic | BSDFFlags::Polarizing);
+                                  BSDFFlags::Anisotropic | BSDFFlags::Polarizing |
+                                  BSDFFlags::WiSideOnly);
     auto equal = make_bsdf("roughconductor", {{"alpha_u", 0.2}, {"alpha_v", 0.2}});
     EXPECT_FALSE(has_flag(equal->flags(), BSDFFlags::Anisotropic));
     EXPECT_NE(bsdf->to_string().find("RoughConductor"), std::string::npos);
@@ -197,3 +198,12 @@ TEST(RoughConductor, TexturedRoughnessIsEvaluatedPerPoint) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(RoughConductor, ReflectsOnlyToWiSide) {
+    // A wide lobe, so that many mirrored directions have light; and an anisotropic one.
+    EXPECT_GT(check_wi_side_only(*make_bsdf("roughconductor", {{"alpha", 0.8}})), 500);
+    EXPECT_GT(check_wi_side_only(*make_bsdf(
+                  "roughconductor",
+                  {{"alpha_u", 0.9}, {"alpha_v", 0.4}, {"distribution", std::string("ggx")}})),
+              500);
+}

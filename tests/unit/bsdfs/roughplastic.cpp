@@ -41,8 +41,10 @@ std::vector<Config> configs() {
 TEST(RoughPlastic, CreationAndFlags) {
     auto bsdf = make_bsdf("roughplastic");
     ASSERT_EQ(bsdf->component_count(), 2u);
-    EXPECT_EQ(bsdf->flags(0), BSDFFlags::GlossyReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(bsdf->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
+    EXPECT_EQ(bsdf->flags(0),
+              BSDFFlags::GlossyReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(bsdf->flags(1),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
     EXPECT_EQ(bsdf->flags(), bsdf->flags(0) | bsdf->flags(1));
     EXPECT_NE(bsdf->to_string().find("RoughPlastic"), std::string::npos);
     EXPECT_NE(bsdf->to_string().find("beckmann"), std::string::npos);
@@ -227,3 +229,10 @@ TEST(RoughPlastic, WhiteFurnaceAtMostOne) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(RoughPlastic, ReflectsOnlyToWiSide) {
+    EXPECT_GT(check_wi_side_only(*make_bsdf("roughplastic")), 500);
+    EXPECT_GT(check_wi_side_only(*make_bsdf(
+                  "roughplastic", {{"alpha", 0.6}, {"distribution", std::string("ggx")}})),
+              500);
+}

@@ -25,20 +25,23 @@ TEST(TwoSided, CreationAndFlags) {
     auto diffuse = make_bsdf("diffuse");
     auto one = make_nested("twosided", {diffuse});
     ASSERT_EQ(one->component_count(), 2u);
-    EXPECT_EQ(one->flags(0), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(one->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::BackSide);
-    EXPECT_EQ(one->flags(),
-              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::BackSide);
+    EXPECT_EQ(one->flags(0),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(one->flags(1),
+              BSDFFlags::DiffuseReflection | BSDFFlags::BackSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(one->flags(), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide |
+                                BSDFFlags::BackSide | BSDFFlags::WiSideOnly);
     EXPECT_NE(one->to_string().find("TwoSided"), std::string::npos);
     EXPECT_NE(one->to_string().find("Diffuse"), std::string::npos);
 
     auto two = make_nested("twosided", {make_bsdf("plastic"), rough_conductor(0.2)});
     ASSERT_EQ(two->component_count(), 3u);
-    EXPECT_EQ(two->flags(0),
-              BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta | BSDFFlags::FrontSide);
-    EXPECT_EQ(two->flags(1), BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide);
-    EXPECT_EQ(two->flags(2),
-              BSDFFlags::GlossyReflection | BSDFFlags::BackSide | BSDFFlags::Polarizing);
+    EXPECT_EQ(two->flags(0), BSDFFlags::DeltaReflection | BSDFFlags::SeparableDelta |
+                                 BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(two->flags(1),
+              BSDFFlags::DiffuseReflection | BSDFFlags::FrontSide | BSDFFlags::WiSideOnly);
+    EXPECT_EQ(two->flags(2), BSDFFlags::GlossyReflection | BSDFFlags::BackSide |
+                                 BSDFFlags::Polarizing | BSDFFlags::WiSideOnly);
     EXPECT_NE(two->to_string().find("back"), std::string::npos);
 
     // A front-and-back BSDF has its side flags replaced per half.
@@ -218,3 +221,13 @@ TEST(TwoSided, LoadsFromXml) {
 }
 
 // Chi-square tests of this plugin's sampling: tests/chi2/configs.txt (label chi2).
+
+TEST(TwoSided, ReflectsOnlyToWiSide) {
+    // Both sides reflect: light leaves to the side wi comes from, whichever it is.
+    EXPECT_GT(check_wi_side_only(*make_nested("twosided", {make_bsdf("diffuse")})), 1000);
+    EXPECT_GT(
+        check_wi_side_only(*make_nested("twosided", {make_bsdf("plastic"), rough_conductor(0.7)})),
+        1000);
+    auto glass = make_nested("twosided", {make_bsdf("dielectric")}, {{"allow_transmission", true}});
+    EXPECT_FALSE(has_flag(glass->flags(), BSDFFlags::WiSideOnly));
+}
