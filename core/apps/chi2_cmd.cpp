@@ -254,7 +254,7 @@ int run_bsdf(BsdfCommand &c, const std::string &everything) {
 
 struct EmitterCommand {
     CommonOptions common;
-    std::string name, xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle", colour_mode;
+    std::string name, xml, ref_text = "0.25,-0.5,1.5", shape = "rectangle", colour_mode, side_text;
     std::vector<std::string> params;
     bool emission = false, mis = false;
 };
@@ -276,6 +276,9 @@ CLI::App *add_emitter_command(CLI::App &app, EmitterCommand &c) {
                       "Test the light samples an integrator weights by MIS against BSDF samples "
                       "(sample_direction_mis against pdf_direction_mis) instead of those that "
                       "stand alone");
+    emitter->add_option("--side", c.side_text,
+                        "With --mis: the side x,y,z the light samples are told no light counts "
+                        "beyond (directions d with dot(d, side) <= 0; a reflecting BSDF's side)");
     emitter->add_option("--ref", c.ref_text, "Reference point x,y,z (default 0.25,-0.5,1.5)");
     emitter->add_option(
         "--shape", c.shape,
@@ -307,6 +310,13 @@ int run_emitter(EmitterCommand &c, const std::string &everything) {
     }
     EmitterAdapter adapter(scene, Point3f(r[0], r[1], r[2]), 0, resolve_mode(c.colour_mode));
     if (c.mis) adapter.set_light_sampling(LightSampling::MIS);
+    if (!c.side_text.empty()) {
+        if (!c.mis) FACET_THROW("--side is the side of the light samples --mis tests: give both");
+        auto s = parse_floats(c.side_text, 3, "--side");
+        if (!(s[0] * s[0] + s[1] * s[1] + s[2] * s[2] > 0.f))
+            FACET_THROW("--side must not be the zero vector");
+        adapter.set_side(Vector3f(s[0], s[1], s[2]));
+    }
     return run(adapter, c.common, slug("emitter", c.name, everything));
 }
 

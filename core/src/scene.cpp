@@ -598,7 +598,8 @@ inline float triangle_light_pdf(float inv_area, const DirectionSample &ds) {
 
 std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Interaction &ref,
                                                                     Point2f u, bool test_visibility,
-                                                                    LightSampling sampling) const {
+                                                                    LightSampling sampling,
+                                                                    const Vector3f &side) const {
     // The result is built in place (one copy of the sample less on every return).
     std::pair<DirectionSample, Color3f> result{DirectionSample(), Color3f(0.f)};
     DirectionSample &ds = result.first;
@@ -638,7 +639,7 @@ std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Intera
         weight = entry.radiance / ds.pdf;
     } else {
         std::tie(ds, weight) = sampling == LightSampling::MIS
-                                   ? entry.emitter->sample_direction_mis(ref, u)
+                                   ? entry.emitter->sample_direction_mis(ref, u, side)
                                    : entry.emitter->sample_direction(ref, u);
     }
     ds.emitter = entry.emitter;
@@ -671,28 +672,28 @@ bool Scene::emitter_visible(const Interaction &ref, const DirectionSample &ds) c
 }
 
 float Scene::pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds,
-                                   LightSampling sampling) const {
-    const float pdf = unguided_emitter_pdf(ref, ds, sampling);
+                                   LightSampling sampling, const Vector3f &side) const {
+    const float pdf = unguided_emitter_pdf(ref, ds, side, sampling);
     return m_light_guide ? pdf * m_light_guide->probability(ref.p) : pdf;
 }
 
 float Scene::unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds,
-                                  LightSampling sampling) const {
+                                  const Vector3f &side, LightSampling sampling) const {
     if (!ds.emitter || m_emitter_table.empty()) return 0.f;
     const uint32_t index = ds.emitter->scene_index();
     const bool ours =
         index < m_emitter_table.size() && m_emitter_table[index].emitter == ds.emitter;
     if (uniform_selection()) {
         const float count = float(m_emitter_table.size());
-        if (ours) return light_pdf(m_emitter_table[index], ref, ds, sampling) / count;
-        return (sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds)
+        if (ours) return light_pdf(m_emitter_table[index], ref, ds, side, sampling) / count;
+        return (sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds, side)
                                                : ds.emitter->pdf_direction(ref, ds)) /
                count;
     }
     if (!ours) return 0.f;
     const float pmf = pick_pmf(&ref, index);
     if (!(pmf > 0.f)) return 0.f;
-    return light_pdf(m_emitter_table[index], ref, ds, sampling) * pmf;
+    return light_pdf(m_emitter_table[index], ref, ds, side, sampling) * pmf;
 }
 
 void Scene::prepare_light_sampling() const {
@@ -758,8 +759,9 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
             const float u1 = rng.next_float();
             const Point2f u2 = next_2d();
             if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
-                const auto [ds, weight] =
-                    sample_emitter_direction(si, u_light, false, LightSampling::MIS);
+                // As the path tracer samples: told the side the BSDF reflects to.
+                const auto [ds, weight] = sample_emitter_direction(
+                    si, u_light, false, LightSampling::MIS, light_side(*bsdf, si));
                 bool useful = false;
                 float contribution = 0.f;
                 if (ds.pdf > 0.f && !weight.is_black()) {
@@ -788,10 +790,10 @@ void Scene::survey_light_samples(detail::LightGuide &guide) const {
 }
 
 float Scene::light_pdf(const EmitterEntry &entry, const Interaction &ref, const DirectionSample &ds,
-                       LightSampling sampling) const {
+                       const Vector3f &side, LightSampling sampling) const {
     if (entry.mesh) return triangle_light_pdf(entry.inv_area, ds);
     if (entry.shape) return dot(ds.n, ds.d) < 0.f ? entry.shape->pdf_direction(ref, ds) : 0.f;
-    return sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds)
+    return sampling == LightSampling::MIS ? ds.emitter->pdf_direction_mis(ref, ds, side)
                                           : ds.emitter->pdf_direction(ref, ds);
 }
 

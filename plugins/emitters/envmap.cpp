@@ -176,15 +176,17 @@ public:
         return sample_with(ref, u, alone_sampling());
     }
     std::pair<DirectionSample, Color3f> sample_direction_mis(const Interaction &ref,
-                                                             const Point2f &u) const override {
-        return sample_with(ref, u, m_sampling);
+                                                             const Point2f &u,
+                                                             const Vector3f &side) const override {
+        return sample_with(ref, u, m_sampling, side_bin(side));
     }
 
     float pdf_direction(const Interaction &, const DirectionSample &ds) const override {
         return pdf_with(ds, alone_sampling());
     }
-    float pdf_direction_mis(const Interaction &, const DirectionSample &ds) const override {
-        return pdf_with(ds, m_sampling);
+    float pdf_direction_mis(const Interaction &, const DirectionSample &ds,
+                            const Vector3f &side) const override {
+        return pdf_with(ds, m_sampling, side_bin(side));
     }
 
     /// A ray entering the bounding sphere (the particle tracer): the direction it comes from is
@@ -195,12 +197,12 @@ public:
         // Light leaves towards every direction it has (unless the scene asked for compensation
         // throughout): the rays follow the plain luminance, as light samples that stand alone.
         const Sampling &sampling = alone_sampling();
-        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir, sampling))
+        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u_dir, sampling, NoSide))
                                             : warp::square_to_uniform_sphere(u_dir);
         const Vector3f from = to_world(local);
         local = to_local(from);
         const GridPoint g = grid_point(local);
-        const float pdf = pdf_local(local, g, sampling);
+        const float pdf = pdf_local(local, g, sampling, NoSide);
         if (!(pdf > 0.f)) return {Ray(), Color3f(0.f)};
         const float radius = m_radius * (1.f + RayEpsilon);
         const Point2f disk = warp::square_to_uniform_disk_concentric(u_pos);
@@ -235,17 +237,36 @@ private:
     struct Sampling {
         float offset = 0.f, compensated_weight = 0.f, plain_weight = 1.f;
         std::vector<float> row_weight; ///< per row: sin θ times the table's power-of-two scale
-        DiscreteDistribution cells;
+        DiscreteDistribution cells;    ///< in the blocks' order (see block_count())
         double total = 0.0;
         float density_scale = 0.f; ///< density over the unit square = value · density_scale
+        /// Per block: where its cells start in the CDF of `cells` (blocks + 1 values) and its
+        /// share of the table's total. Only for a table light samples with a side follow.
+        std::vector<double> block_start;
+        std::vector<float> block_share, block_inv_share; ///< 1 / share (0 for an empty block)
+        /// Per bin of sides, the CDF over the blocks in units of 1 / SideQuanta (block_count()
+        /// values each; all zero for a bin whose every block lies behind its sides).
+        std::vector<uint16_t> side_cdf;
+        /// Per bin, SideGuides + 1 entries: entry g is the block for u = g / SideGuides (the
+        /// first whose CDF exceeds it), so that the block of any u in [g, g + 1) / SideGuides
+        /// lies between entries g and g + 1.
+        std::vector<uint16_t> side_guide;
     };
 
-    /// sample_direction() with the table `sampling`.
+    /// sample_direction() with the table `sampling`, for sides in bin `bin` (or NoSide).
     std::pair<DirectionSample, Color3f> sample_with(const Interaction &ref, const Point2f &u,
-                                                    const Sampling &sampling) const {
+                                                    const Sampling &sampling,
+                                                    int bin = NoSide) const {
         DirectionSample ds;
-        Vector3f local = sampling_enabled() ? uv_to_direction(sample_uv(u, sampling))
-                                            : warp::square_to_uniform_sphere(u);
+        if (bin != NoSide && !sampling_enabled()) bin = NoSide;
+        Vector3f local;
+        if (sampling_enabled()) {
+            const Point2f uv = sample_uv(u, sampling, bin);
+            if (!(uv.y >= 0.f)) return {ds, Color3f(0.f)}; // every block behind the side
+            local = uv_to_direction(uv);
+        } else {
+            local = warp::square_to_uniform_sphere(u);
+        }
         ds.d = to_world(local);
         ds.dist = Infinity;
         ds.p = ref.p + ds.d * (2.f * m_radius + norm(ref.p - m_center));
@@ -255,15 +276,15 @@ private:
         // the three agree to the last bit even where rounding moves it across a cell border.
         local = to_local(ds.d);
         const GridPoint g = grid_point(local); // one atan2 and acos for both
-        ds.pdf = pdf_local(local, g, sampling);
+        ds.pdf = pdf_local(local, g, sampling, bin);
         if (!(ds.pdf > 0.f)) return {ds, Color3f(0.f)};
         return {ds, radiance(g, ref.wavelengths) / ds.pdf};
     }
-    /// pdf_direction() with the table `sampling`.
-    float pdf_with(const DirectionSample &ds, const Sampling &sampling) const {
+    /// pdf_direction() with the table `sampling`, for sides in bin `bin` (or NoSide).
+    float pdf_with(const DirectionSample &ds, const Sampling &sampling, int bin = NoSide) const {
         if (!sampling_enabled()) return InvFourPi;
         const Vector3f local = to_local(ds.d);
-        return pdf_local(local, grid_point(local), sampling);
+        return pdf_local(local, grid_point(local), sampling, bin);
     }
 
     /// The map's frame (to_world's rotation), applied inline: every direction of a sample, a
@@ -397,13 +418,48 @@ private:
                sampling.row_weight[size_t(j)];
     }
 
-    Point2f sample_uv(Point2f u, const Sampling &sampling) const {
+    /// A point of the map's square drawn from the table (restricted to what sides in `bin`
+    /// see, unless NoSide); v < 0 when the bin sees no light.
+    Point2f sample_uv(Point2f u, const Sampling &sampling, int bin) const {
         float uc = u.x;
+        size_t block;
+        if (bin == NoSide) {
+            block = 0;
+        } else {
+            // The block, by the bin's CDF; then u is rescaled into the block's range of the
+            // table's own CDF, whose sample is the cell.
+            const size_t blocks = block_count();
+            const uint16_t *cdf = sampling.side_cdf.data() + size_t(bin) * blocks;
+            if (cdf[blocks - 1] == 0) return {0.f, -1.f};
+            const float x = uc * float(SideQuanta); // below SideQuanta
+            // The first block whose CDF exceeds x, from the guide's entry below x on (its CDF
+            // is an integer: it exceeds x exactly when it exceeds floor(x)).
+            const uint32_t below = uint32_t(x);
+            const uint16_t *guide =
+                sampling.side_guide.data() + size_t(bin) * size_t(SideGuides + 1);
+            block = guide[std::min(size_t(uc * float(SideGuides)), size_t(SideGuides) - 1)];
+            while (block + 1 < blocks && cdf[block] <= below) ++block;
+            const float c0 = block > 0 ? float(cdf[block - 1]) : 0.f;
+            const double v = std::clamp(double(x - c0) / double(float(cdf[block]) - c0), 0.0, 1.0);
+            const double b0 = sampling.block_start[block], b1 = sampling.block_start[block + 1];
+            uc = std::min(float(b0 + v * (b1 - b0)), OneMinusEpsilon);
+        }
         // While the distribution reads the block its cell comes from, the texels of that
-        // block's cells (in one row or two, but for maps under 12 pixels wide) are fetched.
-        size_t index = sampling.cells.sample_reuse(
-            uc, [this](size_t first, size_t last) { prefetch_cells(first, last); });
-        int i = int(index % size_t(m_width)), j = int(index / size_t(m_width));
+        // block's cells are fetched.
+        size_t index = sampling.cells.sample_reuse(uc, [&](size_t first, size_t last) {
+            prefetch_cells(first, last, bin == NoSide ? block_of_index(first) : block);
+        });
+        if (bin == NoSide) {
+            block = block_of_index(index);
+        } else if (index < m_block_first[block] || index >= m_block_first[block + 1]) {
+            // The rescaled u rounded into a neighbouring block: its nearest cell instead.
+            index = std::clamp(index, size_t(m_block_first[block]),
+                               size_t(m_block_first[block + 1]) - 1);
+        }
+        const int bx = int(block % size_t(m_blocks_x)), by = int(block / size_t(m_blocks_x));
+        const int x0 = m_block_x[size_t(bx)], w = m_block_x[size_t(bx) + 1] - x0;
+        const size_t local = index - m_block_first[block];
+        int i = x0 + int(local % size_t(w)), j = m_block_y[size_t(by)] + int(local / size_t(w));
         float a = table(i, j, sampling), b = table(i + 1, j, sampling),
               c = table(i, j + 1, sampling), d = table(i + 1, j + 1, sampling);
         // A cell next to a pole has a zero row (sin θ = 0): at t = 0 both ends of the s line
@@ -422,12 +478,22 @@ private:
         prefetch_line(e - 1);
     }
 
-    /// Starts fetching the texel rows that sampling cells first..last reads.
-    void prefetch_cells(size_t first, size_t last) const {
+    /// Starts fetching the texel rows that sampling cells first..last (in the blocks' order)
+    /// reads: the rows of their blocks' cells, from the first cell's column to the last's (the
+    /// lines of a block's row, for a range across rows).
+    void prefetch_cells(size_t first, size_t last, size_t block) const {
         const size_t W = size_t(m_width);
-        for (size_t j = first / W; j <= last / W; ++j) {
-            const size_t i0 = j == first / W ? first % W : 0;
-            const size_t i1 = j == last / W ? last % W + 1 : W;
+        first = std::max(first, size_t(m_block_first[block]));
+        if (first > last || first >= m_block_first[block + 1]) return;
+        const size_t bx = block % size_t(m_blocks_x), by = block / size_t(m_blocks_x);
+        const size_t x0 = size_t(m_block_x[bx]), w = size_t(m_block_x[bx + 1]) - x0;
+        const size_t y0 = size_t(m_block_y[by]), y_end = size_t(m_block_y[by + 1]);
+        const size_t f = first - m_block_first[block];
+        const size_t l =
+            std::min(last, size_t(m_block_first[block + 1]) - 1) - m_block_first[block];
+        for (size_t j = y0 + f / w; j <= std::min(y0 + l / w, y_end - 1); ++j) {
+            const size_t i0 = j == y0 + f / w ? x0 + f % w : x0;
+            const size_t i1 = j == y0 + l / w ? x0 + l % w + 1 : x0 + w;
             for (size_t row = j; row <= j + 1; ++row) {
                 prefetch_range(&texel(int(i0), int(row)), &texel(int(i1), int(row)) + 1);
                 if (m_spectral) {
@@ -440,8 +506,10 @@ private:
         }
     }
 
-    /// Density of the local direction `local`, whose grid point is g.
-    float pdf_local(const Vector3f &local, const GridPoint &g, const Sampling &sampling) const {
+    /// Density of the local direction `local`, whose grid point is g, for sides in bin `bin`
+    /// (or NoSide).
+    float pdf_local(const Vector3f &local, const GridPoint &g, const Sampling &sampling,
+                    int bin) const {
         if (!sampling_enabled()) return InvFourPi;
         const int i = g.i, j = g.j;
         const float s = g.s, t = g.t;
@@ -451,10 +519,19 @@ private:
         // sin θ straight from the direction (acos near the poles would lose precision),
         // floored as in Mitsuba so that the poles keep a finite density.
         float sin_theta = std::max(std::sqrt(local.x * local.x + local.z * local.z), SinThetaFloor);
-        return value * sampling.density_scale / (2.f * Pi * Pi * sin_theta);
+        const float pdf = value * sampling.density_scale / (2.f * Pi * Pi * sin_theta);
+        if (bin == NoSide) return pdf;
+        // The block's probability for the bin over its share of the table.
+        const size_t blocks = block_count();
+        const size_t block =
+            size_t(m_row_block[size_t(j)]) * size_t(m_blocks_x) + size_t(m_column_block[size_t(i)]);
+        const uint16_t *cdf = sampling.side_cdf.data() + size_t(bin) * blocks;
+        const int quanta = int(cdf[block]) - (block > 0 ? int(cdf[block - 1]) : 0);
+        return pdf * (float(quanta) * (1.f / float(SideQuanta))) * sampling.block_inv_share[block];
     }
 
     void build_distribution() {
+        build_blocks();
         const int W = m_width, H = m_height;
         // Each pixel's luminance, computed once: the table's values below come from it.
         std::vector<float> lum(size_t(W) * H);
@@ -509,12 +586,12 @@ private:
                 sampling.offset = 0.f;
             }
         }
-        build_cells(sampling, lum);
+        build_cells(sampling, lum, true);
     }
 
     /// The row weights, the cells' distribution and the density's scale of `sampling`, whose
     /// offset and weights are set, from the pixels' luminances `lum` (W x H).
-    void build_cells(Sampling &sampling, const std::vector<float> &lum) const {
+    void build_cells(Sampling &sampling, const std::vector<float> &lum, bool with_sides) const {
         const int W = m_width, H = m_height;
         // Row j's factor: sin θ (zero on the pole rows: sin of a float π is slightly negative)
         // times a power of two that puts the largest entry in [1, 2): the density is unchanged
@@ -542,20 +619,245 @@ private:
                 row[size_t(i)] =
                     table_from_luminance(lum[size_t(j) * W + size_t(i % W)], j, sampling);
         };
-        std::vector<float> cells(size_t(W) * size_t(H - 1));
+        // Stored block by block (each block's cells row by row): a block is one range.
+        std::vector<float> ordered(size_t(W) * size_t(H - 1));
         table_row(0, row1);
         for (int j = 0; j + 1 < H; ++j) {
             std::swap(row0, row1);
             table_row(j + 1, row1);
-            for (int i = 0; i < W; ++i)
-                cells[size_t(j) * W + size_t(i)] = 0.25f * (row0[size_t(i)] + row0[size_t(i) + 1] +
-                                                            row1[size_t(i)] + row1[size_t(i) + 1]);
+            const size_t by = m_row_block[size_t(j)];
+            const size_t y0 = size_t(m_block_y[by]);
+            for (int i = 0; i < W; ++i) {
+                const size_t bx = m_column_block[size_t(i)];
+                const size_t x0 = size_t(m_block_x[bx]), w = size_t(m_block_x[bx + 1]) - x0;
+                const size_t at = m_block_first[by * size_t(m_blocks_x) + bx] +
+                                  (size_t(j) - y0) * w + (size_t(i) - x0);
+                ordered[at] = 0.25f * (row0[size_t(i)] + row0[size_t(i) + 1] + row1[size_t(i)] +
+                                       row1[size_t(i) + 1]);
+            }
         }
-        sampling.cells.build(cells.data(), cells.size());
+        sampling.cells.build(ordered.data(), ordered.size());
         sampling.total = sampling.cells.sum();
         // Density over the unit square = table value / (mean cell value).
         sampling.density_scale =
-            sampling.total > 0.0 ? float(double(cells.size()) / sampling.total) : 0.f;
+            sampling.total > 0.0 ? float(double(ordered.size()) / sampling.total) : 0.f;
+        if (with_sides && sampling.total > 0.0) build_side_tables(sampling, ordered);
+    }
+
+    // -- Light samples with a side (sample_direction_mis()) -----------------------------------
+    // The cells are grouped in blocks of the grid, at most BlocksX x BlocksY (about 11° square),
+    // stored block by block in the table's distribution, so that a block's cells are one range
+    // of its CDF. Sides are binned on the faces of a cube (SideBinsPerEdge² bins per face). For
+    // each bin a CDF over the blocks picks a block in proportion to its share of the table,
+    // but none that lies wholly behind every side of the bin (the cone of the bin's sides
+    // against the cone of the block's directions, both bounded from above, with a margin);
+    // the table's own CDF then picks the cell within the block (u rescaled into its range).
+    // The density of a direction of block k is the table's times pmf_bin(k) / share(k): the
+    // light behind a side is never sampled, the rest as before, in proportion.
+    static constexpr int BlocksX = 32, BlocksY = 16, SideBinsPerEdge = 6;
+    static constexpr int SideBins = 6 * SideBinsPerEdge * SideBinsPerEdge;
+    static constexpr double MinSideCosine = 0.05;
+    /// The bins' CDFs count in these units (so that a bin's row of 512 blocks takes 1 KiB).
+    static constexpr uint32_t SideQuanta = 65535;
+    static_assert(uint32_t(BlocksX) * BlocksY < SideQuanta, "a quantum for every block");
+    static constexpr uint32_t SideGuides = 64; ///< guide entries per bin (Sampling::side_guide)
+    static constexpr int NoSide = -1;
+
+    size_t block_count() const { return size_t(m_blocks_x) * size_t(m_blocks_y); }
+
+    /// The block that holds cell `index` of the table's (blocks') order. A row of blocks holds
+    /// whole rows of cells; within it, block column a starts at index h · x_a (h its height).
+    size_t block_of_index(size_t index) const {
+        const size_t W = size_t(m_width);
+        const size_t by = size_t(m_row_block[std::min(index / W, m_row_block.size() - 1)]);
+        const size_t y0 = size_t(m_block_y[by]), h = size_t(m_block_y[by + 1]) - y0;
+        const size_t column = std::min((index - y0 * W) / h, W - 1);
+        return by * size_t(m_blocks_x) + size_t(m_column_block[column]);
+    }
+
+    /// The blocks' bounds on the grid of cells (W x (H - 1)) and each cell's block.
+    void build_blocks() {
+        const int W = m_width, rows = m_height - 1;
+        m_blocks_x = std::min(W, BlocksX);
+        m_blocks_y = std::min(rows, BlocksY);
+        m_block_x.resize(size_t(m_blocks_x) + 1);
+        m_block_y.resize(size_t(m_blocks_y) + 1);
+        for (int a = 0; a <= m_blocks_x; ++a)
+            m_block_x[size_t(a)] = int(int64_t(a) * W / m_blocks_x);
+        for (int b = 0; b <= m_blocks_y; ++b)
+            m_block_y[size_t(b)] = int(int64_t(b) * rows / m_blocks_y);
+        m_column_block.resize(size_t(W));
+        for (int a = 0; a < m_blocks_x; ++a)
+            for (int i = m_block_x[size_t(a)]; i < m_block_x[size_t(a) + 1]; ++i)
+                m_column_block[size_t(i)] = uint16_t(a);
+        m_row_block.resize(size_t(rows));
+        for (int b = 0; b < m_blocks_y; ++b)
+            for (int j = m_block_y[size_t(b)]; j < m_block_y[size_t(b) + 1]; ++j)
+                m_row_block[size_t(j)] = uint16_t(b);
+        m_block_first.assign(block_count() + 1, 0);
+        for (size_t k = 0; k < block_count(); ++k) {
+            const size_t bx = k % size_t(m_blocks_x), by = k / size_t(m_blocks_x);
+            m_block_first[k + 1] = m_block_first[k] + uint32_t((m_block_x[bx + 1] - m_block_x[bx]) *
+                                                               (m_block_y[by + 1] - m_block_y[by]));
+        }
+    }
+
+    /// A cone of directions: its axis and an upper bound of the angle from it.
+    struct Cone {
+        Vector3f axis;
+        float angle;
+    };
+
+    /// The cone around the directions of block k (its cells' part of the map's square).
+    Cone block_cone(size_t k) const {
+        const size_t bx = k % size_t(m_blocks_x), by = k / size_t(m_blocks_x);
+        // Cell i spans u in [(i + ½)/W, (i + 3/2)/W]; row j spans v in [j, j + 1]/(H - 1).
+        const double u0 = (m_block_x[bx] + 0.5) / m_width, u1 = (m_block_x[bx + 1] + 0.5) / m_width;
+        const double v0 = double(m_block_y[by]) / (m_height - 1),
+                     v1 = double(m_block_y[by + 1]) / (m_height - 1);
+        auto direction = [](double u, double v) {
+            const double phi = u * 2.0 * double(Pi), theta = v * double(Pi);
+            return Vector3f(float(std::sin(phi) * std::sin(theta)), float(std::cos(theta)),
+                            float(-std::cos(phi) * std::sin(theta)));
+        };
+        Cone cone{normalize(direction(0.5 * (u0 + u1), 0.5 * (v0 + v1))), float(Pi)};
+        // Half a turn or more around the axis (a map a few pixels wide): every direction.
+        if (u1 - u0 >= 0.5) return cone;
+        // The farthest point from the axis lies on the block's border (the antipode, the only
+        // other maximum, is far outside): the border at Steps points per edge, plus the arc
+        // between two of them (a bound of how much farther a point between them can be).
+        constexpr int Steps = 32;
+        double widest = 0.0;
+        for (int s = 0; s <= Steps; ++s) {
+            const double f = double(s) / Steps;
+            const Vector3f points[4] = {
+                direction(u0 + f * (u1 - u0), v0), direction(u0 + f * (u1 - u0), v1),
+                direction(u0, v0 + f * (v1 - v0)), direction(u1, v0 + f * (v1 - v0))};
+            for (const Vector3f &p : points)
+                widest =
+                    std::max(widest, std::acos(std::clamp(double(dot(cone.axis, p)), -1.0, 1.0)));
+        }
+        const double step = std::max((u1 - u0) * 2.0 * double(Pi), (v1 - v0) * double(Pi)) / Steps;
+        cone.angle = float(widest + step);
+        return cone;
+    }
+
+    /// The cube face and cell of a side: face f holds the sides whose largest component is
+    /// axis f / 2 (positive for even f); the cell comes from the other two components over it.
+    static void side_face_axes(int face, int &major, int &a, int &b) {
+        major = face / 2;
+        a = major == 0 ? 1 : 0;
+        b = major == 2 ? 1 : 2;
+    }
+
+    /// The cone of sides in bin `bin` (a geodesic quad of the cube's face: its corners bound it).
+    static Cone side_cone(int bin) {
+        const int face = bin / (SideBinsPerEdge * SideBinsPerEdge);
+        const int cell = bin % (SideBinsPerEdge * SideBinsPerEdge);
+        const int p = cell % SideBinsPerEdge, q = cell / SideBinsPerEdge;
+        int major, a, b;
+        side_face_axes(face, major, a, b);
+        auto point = [&](double x, double y) {
+            double c[3] = {0.0, 0.0, 0.0};
+            c[major] = face % 2 == 0 ? 1.0 : -1.0;
+            c[a] = x;
+            c[b] = y;
+            return normalize(Vector3f(float(c[0]), float(c[1]), float(c[2])));
+        };
+        auto edge = [](int k) { return -1.0 + 2.0 * k / SideBinsPerEdge; };
+        Cone cone{point(0.5 * (edge(p) + edge(p + 1)), 0.5 * (edge(q) + edge(q + 1))), 0.f};
+        double widest = 0.0;
+        for (int corner = 0; corner < 4; ++corner) {
+            const Vector3f c = point(edge(p + corner % 2), edge(q + corner / 2));
+            widest = std::max(widest, std::acos(std::clamp(double(dot(cone.axis, c)), -1.0, 1.0)));
+        }
+        cone.angle = float(widest + 1e-4);
+        return cone;
+    }
+
+    /// The bin of a world-space side (zero: none, NoSide).
+    int side_bin(const Vector3f &side) const {
+        if (!(dot(side, side) > 0.f)) return NoSide;
+        const Vector3f s = to_local(side);
+        const float c[3] = {s.x, s.y, s.z};
+        int major = 0;
+        for (int k = 1; k < 3; ++k)
+            if (std::abs(c[k]) > std::abs(c[major])) major = k;
+        const float m = std::abs(c[major]);
+        if (!(m > 0.f)) return NoSide; // not finite
+        int face = 2 * major + (c[major] > 0.f ? 0 : 1), f_major, a, b;
+        side_face_axes(face, f_major, a, b);
+        auto cell = [](float x) {
+            return std::clamp(int((x + 1.f) * 0.5f * float(SideBinsPerEdge)), 0,
+                              SideBinsPerEdge - 1);
+        };
+        return (face * SideBinsPerEdge + cell(c[b] / m)) * SideBinsPerEdge + cell(c[a] / m);
+    }
+
+    /// The blocks' starts and shares and each bin's CDF over them, for `sampling`, whose cells
+    /// (in the blocks' order: `ordered`) are built.
+    void build_side_tables(Sampling &sampling, const std::vector<float> &ordered) const {
+        const size_t blocks = block_count();
+        sampling.block_start.resize(blocks + 1);
+        sampling.block_share.resize(blocks);
+        sampling.block_inv_share.resize(blocks);
+        std::vector<Cone> cones(blocks);
+        for (size_t k = 0; k <= blocks; ++k) {
+            sampling.block_start[k] = m_block_first[k] < ordered.size()
+                                          ? sampling.cells.cdf_before(m_block_first[k])
+                                          : 1.0;
+            if (k == blocks) break;
+            double sum = 0.0;
+            for (uint32_t c = m_block_first[k]; c < m_block_first[k + 1]; ++c)
+                sum += double(std::max(ordered[c], 0.f));
+            sampling.block_share[k] = float(sum / sampling.total);
+            sampling.block_inv_share[k] = sum > 0.0 ? float(sampling.total / sum) : 0.f;
+            cones[k] = block_cone(k);
+        }
+        sampling.side_cdf.assign(size_t(SideBins) * blocks, 0);
+        sampling.side_guide.assign(size_t(SideBins) * size_t(SideGuides + 1), 0);
+        std::vector<double> weight(blocks);
+        for (int bin = 0; bin < SideBins; ++bin) {
+            const Cone side = side_cone(bin);
+            double sum = 0.0;
+            for (size_t k = 0; k < blocks; ++k) {
+                // The least angle between a side of the bin and a direction of the block.
+                const double apart =
+                    std::acos(std::clamp(double(dot(side.axis, cones[k].axis)), -1.0, 1.0)) -
+                    double(side.angle) - double(cones[k].angle);
+                const bool behind = apart > 0.5 * double(Pi) + 1e-3;
+                // In front: weighted by the largest cosine a side of the bin can have with a
+                // direction of the block (the cosine of the surfaces the light falls on), at
+                // least MinSideCosine.
+                const double cosine = std::max(std::cos(std::max(apart, 0.0)), MinSideCosine);
+                weight[k] = behind ? 0.0 : double(sampling.block_share[k]) * cosine;
+                sum += weight[k];
+            }
+            if (!(sum > 0.0)) continue;
+            // Every block in front gets one quantum, the others' in proportion to the weights:
+            // none with light is left out by rounding, and the CDF ends at SideQuanta.
+            size_t in_front = 0;
+            for (size_t k = 0; k < blocks; ++k) in_front += weight[k] > 0.0 ? 1 : 0;
+            const double rest = double(SideQuanta - in_front);
+            uint16_t *cdf = sampling.side_cdf.data() + size_t(bin) * blocks;
+            double running = 0.0;
+            size_t counted = 0;
+            for (size_t k = 0; k < blocks; ++k) {
+                running += weight[k];
+                counted += weight[k] > 0.0 ? 1 : 0;
+                cdf[k] =
+                    uint16_t(counted + size_t(std::llround(std::min(running / sum, 1.0) * rest)));
+            }
+            uint16_t *guide = sampling.side_guide.data() + size_t(bin) * size_t(SideGuides + 1);
+            size_t k = 0;
+            for (uint32_t g = 0; g <= SideGuides; ++g) {
+                // The block sample_uv() picks for u = g / SideGuides (x as it computes it).
+                const float u = float(g) / float(SideGuides);
+                const uint32_t below = uint32_t(u * float(SideQuanta));
+                while (k + 1 < blocks && cdf[k] <= below) ++k;
+                guide[g] = uint16_t(k);
+            }
+        }
     }
 
     /// What light samples that stand alone and emitted rays follow: m_sampling, or, when that
@@ -570,7 +872,7 @@ private:
                 for (int i = 0; i < m_width; ++i)
                     lum[size_t(j) * size_t(m_width) + size_t(i)] = luminance_at(i, j);
             auto plain = std::make_unique<Sampling>();
-            build_cells(*plain, lum);
+            build_cells(*plain, lum, false);
             m_plain = std::move(plain);
         });
         return *m_plain;
@@ -591,7 +893,13 @@ private:
     Sampling m_sampling; ///< what light samples for MIS follow (and, but for the mix, all)
     mutable std::once_flag m_plain_once;
     mutable std::unique_ptr<Sampling> m_plain; ///< see alone_sampling()
-    float m_mean_luminance = 0.f;              ///< over the sphere of directions, for power()
+    // The blocks of cells (see block_count()): their bounds in cells (m_blocks_x + 1 and
+    // m_blocks_y + 1 values), each cell column's and row's block, each block's first cell.
+    int m_blocks_x = 1, m_blocks_y = 1;
+    std::vector<int> m_block_x, m_block_y;
+    std::vector<uint16_t> m_column_block, m_row_block;
+    std::vector<uint32_t> m_block_first;
+    float m_mean_luminance = 0.f; ///< over the sphere of directions, for power()
     Point3f m_center;
     float m_radius = 1.f;
 };

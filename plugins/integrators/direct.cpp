@@ -92,14 +92,19 @@ public:
         const BSDF *bsdf = si.bsdf();
         if (!bsdf) return result;
 
+        // Light samples weighted by MIS are told the side the BSDF reflects to (if it does
+        // only to one), and so are the densities BSDF samples are weighted with.
+        const Vector3f side =
+            m_light_sampling == LightSampling::MIS ? light_side(*bsdf, si) : Vector3f(0.f);
+
         // ---- Emitter sampling ----
         if (has_flag(bsdf->flags(), BSDFFlags::Smooth)) {
             for (uint32_t i = 0; i < m_emitter_samples; ++i) {
                 // Up to 65535 samples: a stop (Ctrl-C, timeout) need not wait for them all.
                 if (render_should_stop(i)) return result;
                 // The shadow ray last: a sample the BSDF gives no weight costs none.
-                auto [ds, em_weight] =
-                    scene.sample_emitter_direction(si, sampler.next_2d(), false, m_light_sampling);
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, sampler.next_2d(), false,
+                                                                      m_light_sampling, side);
                 if (ds.pdf == 0.f || em_weight.is_black()) continue;
                 Vector3f wo = si.to_local(ds.d);
                 auto [f, bsdf_pdf] = bsdf->eval_pdf(ctx, si, wo);
@@ -125,7 +130,7 @@ public:
             if (!scene.ray_intersect(bsdf_ray, si_bsdf)) {
                 result += bsdf_weight *
                           environment_mis(scene, si_bsdf, si, bs.pdf * m_frac_bsdf, delta,
-                                          m_frac_emitter) *
+                                          m_frac_emitter, side) *
                           m_weight_bsdf;
                 continue;
             }
@@ -135,8 +140,8 @@ public:
             if (L.is_black()) continue;
             float w = 1.f;
             if (!delta) {
-                float em_pdf =
-                    scene.pdf_emitter_direction(si, direction_to(si_bsdf, si), LightSampling::MIS);
+                float em_pdf = scene.pdf_emitter_direction(si, direction_to(si_bsdf, si),
+                                                           LightSampling::MIS, side);
                 w = mis_weight(bs.pdf * m_frac_bsdf, em_pdf * m_frac_emitter);
             }
             result += bsdf_weight * L * (w * m_weight_bsdf);

@@ -195,7 +195,8 @@ private:
         float eta = 1.f;
         uint32_t depth = 0;
         SurfaceInteraction si;
-        Interaction prev_si; // the previous vertex: MIS only needs its position and normal
+        Interaction prev_si;     // the previous vertex: MIS only needs its position and normal
+        Vector3f prev_side(0.f); // and the side its light samples were given (light_side())
         // The camera ray behaves like a delta bounce: whatever it hits is counted in full.
         float prev_bsdf_pdf = 1.f;
         bool prev_bsdf_delta = true;
@@ -220,9 +221,9 @@ private:
             // ---- Emission found by the previous BSDF sample (or by the camera ray) ----
             if (!hit) {
                 if (count_emission)
-                    add_emission(
-                        result, throughput,
-                        environment_mis(scene, si, prev_si, prev_bsdf_pdf, prev_bsdf_delta));
+                    add_emission(result, throughput,
+                                 environment_mis(scene, si, prev_si, prev_bsdf_pdf, prev_bsdf_delta,
+                                                 1.f, prev_side));
                 break;
             }
             // The emitter and BSDF of the shape hit, read inline (si.emitter() and si.bsdf()
@@ -235,7 +236,7 @@ private:
                         float w = 1.f;
                         if (!prev_bsdf_delta) {
                             float em_pdf = scene.pdf_emitter_direction(
-                                prev_si, direction_to(si, prev_si), LightSampling::MIS);
+                                prev_si, direction_to(si, prev_si), LightSampling::MIS, prev_side);
                             w = mis_weight(prev_bsdf_pdf, em_pdf);
                         }
                         add_emission(result, throughput, L * w);
@@ -251,6 +252,7 @@ private:
             // BSDF is sampled first: its result is needed only for the next ray, so its chain of
             // dependent arithmetic runs while the emitter sample is built and traced.
             const bool sample_emitter = has_flag(bsdf->flags(), BSDFFlags::Smooth);
+            const Vector3f side = light_side(*bsdf, si);
             const Point2f emitter_sample = sample_emitter ? sampler.draw_2d() : Point2f();
             float sample1 = sampler.draw_1d();
             Point2f sample2 = sampler.draw_2d();
@@ -274,8 +276,8 @@ private:
             // The shadow ray comes last: a sample the BSDF gives no weight (an emitter behind
             // the surface) costs none.
             if (sample_emitter) {
-                auto [ds, em_weight] =
-                    scene.sample_emitter_direction(si, emitter_sample, false, LightSampling::MIS);
+                auto [ds, em_weight] = scene.sample_emitter_direction(si, emitter_sample, false,
+                                                                      LightSampling::MIS, side);
                 FACET_ASSERT(ds.pdf >= 0.f && em_weight.is_finite());
                 if (ds.pdf != 0.f && !em_weight.is_black()) {
                     Vector3f wo = si.to_local(ds.d);
@@ -335,6 +337,7 @@ private:
             }
             eta *= bs.eta;
             prev_si = si;
+            prev_side = side;
             prev_bsdf_pdf = bs.pdf;
             prev_bsdf_delta = has_flag(bs.sampled_type, BSDFFlags::Delta);
             ray = si.spawn_ray(si.to_world(bs.wo));

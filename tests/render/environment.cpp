@@ -37,6 +37,23 @@ std::string write_sky(const fs::path &dir) {
     return path;
 }
 
+/// A 64×32 sky without a sun, brighter below the horizon than above: the light samples of a
+/// plane facing up (which sees only the upper half) and of one that takes the whole map differ
+/// by a factor of about three, and the BSDF samples' MIS weights with them.
+std::string write_bright_ground(const fs::path &dir) {
+    Image img(64, 32, 3);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float t = float(y) / float(img.height - 1);
+            const Color3f c = t < 0.5f ? Color3f(1.f + float(x % 8) * 0.1f, 1.f, 1.2f - t)
+                                       : Color3f(4.f, 3.f, 2.f + t);
+            for (int ch = 0; ch < 3; ++ch) img.at(x, y, ch) = c[ch];
+        }
+    std::string path = (dir / "bright-ground.exr").string();
+    write_image(path, img);
+    return path;
+}
+
 /// A 4×3 map constant along each row: `zenith` on the first row (θ = 0), `horizon` on the
 /// second (θ = π/2), 0.1 on the last.
 std::string write_rows(const fs::path &dir, float zenith, float horizon) {
@@ -204,4 +221,35 @@ TEST(EnvironmentMap, MisCompensationSettingsAgreeWithQuadrature) {
                 EXPECT_NEAR(s.mean[ch], ref[ch], 4.f * s.stderr_[ch] + 1e-3f * ref[ch])
                     << "channel " << ch;
         }
+}
+
+TEST(EnvironmentMap, LightSamplesToldTheSideAgreeWithQuadratureInATurnedMap) {
+    // The diffuse plane reflects only to the side it is seen from: the path tracer's and the
+    // direct integrator's MIS light samples leave out the map's blocks wholly below it. With
+    // the map turned (its sun then lies at some height, and the plane's side falls in another
+    // bin of the map's own frame for each turn), the plane must show what the quadrature of
+    // the map over its upper hemisphere gives, for every compensation setting.
+    fs::path dir = fs::temp_directory_path() / "facet-envmap-render";
+    fs::create_directories(dir);
+    const std::string skies[] = {write_sky(dir), write_bright_ground(dir)};
+    const char *turns[] = {
+        "",
+        R"(<transform name="to_world"><rotate x="1" angle="70"/><rotate y="1" angle="30"/></transform>)",
+        R"(<transform name="to_world"><rotate z="1" angle="-100"/></transform>)"};
+    const char *integrators[] = {
+        R"(<integrator type="path"><integer name="max_depth" value="2"/></integrator>)",
+        R"(<integrator type="direct"/>)"};
+    const char *settings[] = {"", R"(<boolean name="mis_compensation" value="true"/>)"};
+    for (const std::string &sky : skies)
+        for (const char *turn : turns)
+            for (const char *integrator : integrators)
+                for (const char *setting : settings) {
+                    SCOPED_TRACE(sky + " " + turn + " " + integrator + " " + setting);
+                    const std::string extra = std::string(turn) + setting;
+                    Color3f ref = reference_radiance(scene_xml(sky, true, integrator, extra));
+                    Stats s = render_stats(scene_xml(sky, true, integrator, extra));
+                    for (int ch = 0; ch < 3; ++ch)
+                        EXPECT_NEAR(s.mean[ch], ref[ch], 4.f * s.stderr_[ch] + 1e-3f * ref[ch])
+                            << "channel " << ch;
+                }
 }

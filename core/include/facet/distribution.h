@@ -80,6 +80,15 @@ public:
         return float(block.width * share);
     }
 
+    /// The CDF before entry i (i < size()): sample_reuse() picks i or a later entry exactly
+    /// for u at or above it.
+    double cdf_before(size_t i) const {
+        FACET_ASSERT(i < size());
+        const Block &block = m_blocks[i / BlockSize];
+        const size_t j = i % BlockSize;
+        return block.start + (j > 0 ? block.width * double(block.cdf[j - 1]) : 0.0);
+    }
+
     /// Index for u in [0,1); `u` is rescaled to a fresh uniform variate within the entry.
     size_t sample_reuse(float &u) const {
         return sample_reuse(u, [](size_t, size_t) {});

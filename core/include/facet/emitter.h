@@ -74,13 +74,18 @@ public:
     /// (LightSampling::MIS), and its density. The same conventions as sample_direction() and
     /// pdf_direction(); the density may be zero only where BSDF sampling is expected to carry the
     /// light, never for a whole lobe of light (some samples must still reach every direction
-    /// with light: a BSDF without a density there would otherwise lose it). Default: the
-    /// samples of sample_direction().
-    virtual std::pair<DirectionSample, Color3f> sample_direction_mis(const Interaction &ref,
-                                                                     const Point2f &u) const {
+    /// with light: a BSDF without a density there would otherwise lose it). `side`: zero, or a
+    /// unit world-space vector such that no light counts from directions d with
+    /// dot(d, side) <= 0 (the BSDF at ref reflects only to that side: BSDFFlags::WiSideOnly);
+    /// the emitter may then send no samples there, and its density there may be zero. The same
+    /// `side` must reach both calls for a direction. Default: the samples of sample_direction(),
+    /// whatever the side.
+    virtual std::pair<DirectionSample, Color3f>
+    sample_direction_mis(const Interaction &ref, const Point2f &u, const Vector3f &side) const {
         return sample_direction(ref, u);
     }
-    virtual float pdf_direction_mis(const Interaction &ref, const DirectionSample &ds) const {
+    virtual float pdf_direction_mis(const Interaction &ref, const DirectionSample &ds,
+                                    const Vector3f &side) const {
         return pdf_direction(ref, ds);
     }
     /// Emitted radiance; zero for delta emitters.

@@ -39,11 +39,12 @@ inline DirectionSample direction_to(const SurfaceInteraction &si, const Interact
 /// sampling picks it and this direction (times `emitter_fraction`, the share of emitter samples
 /// when several strategies are mixed), since an emitter sample only ever carries its own
 /// emitter's radiance. The densities are those of light samples taken for MIS
-/// (LightSampling::MIS), the mode the caller's light samples must use. After a delta lobe or for a
-/// camera ray (`delta`) nothing is weighted and `ref` is not read.
+/// (LightSampling::MIS), the mode the caller's light samples must use, with their `side`
+/// (Scene::sample_emitter_direction()). After a delta lobe or for a camera ray (`delta`) nothing
+/// is weighted and `ref` is not read.
 inline Color3f environment_mis(const Scene &scene, const SurfaceInteraction &escaped,
                                const Interaction &ref, float bsdf_pdf, bool delta,
-                               float emitter_fraction = 1.f) {
+                               float emitter_fraction = 1.f, const Vector3f &side = Vector3f(0.f)) {
     FACET_ASSERT(!escaped.is_valid() && !escaped.shape);
     const auto &emitters = scene.environment_emitters();
     if (emitters.empty()) return Color3f(0.f);
@@ -59,8 +60,9 @@ inline Color3f environment_mis(const Scene &scene, const SurfaceInteraction &esc
         float w = 1.f;
         if (!delta) {
             ds.emitter = emitter.get();
-            w = mis_weight(bsdf_pdf, scene.pdf_emitter_direction(ref, ds, LightSampling::MIS) *
-                                         emitter_fraction);
+            w = mis_weight(bsdf_pdf,
+                           scene.pdf_emitter_direction(ref, ds, LightSampling::MIS, side) *
+                               emitter_fraction);
         }
         result += L * w;
     }

@@ -62,10 +62,13 @@ public:
     /// pdf_emitter_direction(), so estimates keep their expectation. `sampling` says how the
     /// caller uses the sample (LightSampling: alone, or weighted by MIS against BSDF samples with
     /// the densities of pdf_emitter_direction() in the same mode); emitters may sample
-    /// differently for each (Emitter::sample_direction_mis()).
-    std::pair<DirectionSample, Color3f> sample_emitter_direction(const Interaction &ref, Point2f u,
-                                                                 bool test_visibility,
-                                                                 LightSampling sampling) const;
+    /// differently for each (Emitter::sample_direction_mis()). `side` (the MIS mode only): zero,
+    /// or a unit vector such that no light counts from directions d with dot(d, side) <= 0 (a
+    /// BSDF with BSDFFlags::WiSideOnly), which emitters may then leave unsampled; the densities
+    /// of pdf_emitter_direction() must be asked with the same side.
+    std::pair<DirectionSample, Color3f>
+    sample_emitter_direction(const Interaction &ref, Point2f u, bool test_visibility,
+                             LightSampling sampling, const Vector3f &side = Vector3f(0.f)) const;
     /// The visibility test of sample_emitter_direction() on its own: true when nothing blocks
     /// the segment from ref to the emitter sample ds (or the ray towards it, for an emitter at
     /// infinity). For callers that test later, once the BSDF has given the sample a weight.
@@ -73,7 +76,7 @@ public:
     /// Density of sample_emitter_direction() in the mode `sampling` for ds (selection
     /// probability and q included).
     float pdf_emitter_direction(const Interaction &ref, const DirectionSample &ds,
-                                LightSampling sampling) const;
+                                LightSampling sampling, const Vector3f &side = Vector3f(0.f)) const;
     /// Surveys, once per scene (and again after rebuild()), where light samples are worth
     /// taking: a few thousand paths from the scene's sensors, a light sample at each vertex,
     /// counted per cell of a grid over the scene as useful (the emitter gives light, the BSDF
@@ -227,7 +230,7 @@ private:
     /// The solid-angle density of emitter `entry`'s own sample for ds seen from ref (without
     /// the selection): computed inline for triangle lights and shapes' constant lights.
     float light_pdf(const EmitterEntry &entry, const Interaction &ref, const DirectionSample &ds,
-                    LightSampling sampling) const;
+                    const Vector3f &side, LightSampling sampling) const;
     /// Per Embree geometry id: its shape, and the same shape as a Mesh when the scene computes
     /// the hits on it itself (without this the real-scene bench ran matpreview 2.2% to 8.1%
     /// slower in three of four paired measurements).
@@ -258,7 +261,7 @@ private:
     bool m_light_guide_enabled = true; ///< the scene option `light_guide`
     /// pdf_emitter_direction() before the guide's q.
     float unguided_emitter_pdf(const Interaction &ref, const DirectionSample &ds,
-                               LightSampling sampling) const;
+                               const Vector3f &side, LightSampling sampling) const;
     /// prepare_light_sampling()'s survey into `guide`.
     void survey_light_samples(detail::LightGuide &guide) const;
 };

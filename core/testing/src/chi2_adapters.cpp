@@ -289,7 +289,7 @@ Chi2Sample EmitterAdapter::sample(const float *u) const {
     Chi2Sample s;
     const Point2f u2(u[0], u[1]);
     auto [ds, weight] = m_sampling == LightSampling::MIS
-                            ? m_emitter->sample_direction_mis(m_ref, u2)
+                            ? m_emitter->sample_direction_mis(m_ref, u2, m_side)
                             : m_emitter->sample_direction(m_ref, u2);
     if (weight.is_black() || ds.pdf == 0.f) return s;
     s.has_weight = true;
@@ -307,7 +307,7 @@ Chi2Sample EmitterAdapter::sample(const float *u) const {
 }
 
 float EmitterAdapter::emitter_pdf(const DirectionSample &ds) const {
-    return m_sampling == LightSampling::MIS ? m_emitter->pdf_direction_mis(m_ref, ds)
+    return m_sampling == LightSampling::MIS ? m_emitter->pdf_direction_mis(m_ref, ds, m_side)
                                             : m_emitter->pdf_direction(m_ref, ds);
 }
 

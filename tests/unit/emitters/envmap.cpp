@@ -2,6 +2,8 @@
 // integrating to one. Chi-square tests of its importance sampling on the maps Mitsuba uses for
 // the same purpose: tests/chi2/configs.txt.
 
+#include "draws.h"
+
 #include <facet/emitter.h>
 #include <facet/image.h>
 #include <facet/scene.h>
@@ -212,18 +214,18 @@ TEST(EnvironmentMap, UnsetCompensationMixesMisSamplesOnly) {
             EXPECT_EQ(da.d, dp.d);
             EXPECT_EQ(da.pdf, dp.pdf);
             EXPECT_EQ(wa, wp);
-            EXPECT_EQ(ep.sample_direction_mis(ref, u).first.d, dp.d);
+            EXPECT_EQ(ep.sample_direction_mis(ref, u, Vector3f(0.f)).first.d, dp.d);
             auto [rp, pp] = ep.sample_ray(Point2f(0.3f, 0.6f), u, Wavelengths());
             auto [ra, pa] = em.sample_ray(Point2f(0.3f, 0.6f), u, Wavelengths());
             EXPECT_EQ(ra.d, rp.d);
             EXPECT_EQ(pa, pp);
             auto [dc, wc] = ec.sample_direction(ref, u);
-            EXPECT_EQ(ec.sample_direction_mis(ref, u).first.d, dc.d);
-            EXPECT_EQ(ec.pdf_direction_mis(ref, dc), dc.pdf);
+            EXPECT_EQ(ec.sample_direction_mis(ref, u, Vector3f(0.f)).first.d, dc.d);
+            EXPECT_EQ(ec.pdf_direction_mis(ref, dc, Vector3f(0.f)), dc.pdf);
 
-            auto [dm, wm] = em.sample_direction_mis(ref, u);
+            auto [dm, wm] = em.sample_direction_mis(ref, u, Vector3f(0.f));
             ASSERT_GT(dm.pdf, 0.f);
-            EXPECT_EQ(em.pdf_direction_mis(ref, dm), dm.pdf);
+            EXPECT_EQ(em.pdf_direction_mis(ref, dm, Vector3f(0.f)), dm.pdf);
             const float expected =
                 0.9f * ec.pdf_direction(ref, dm) + 0.1f * ep.pdf_direction(ref, dm);
             EXPECT_NEAR(dm.pdf, expected, 1e-4f * expected);
@@ -236,10 +238,109 @@ TEST(EnvironmentMap, UnsetCompensationMixesMisSamplesOnly) {
     for (int k = 0; k < n; ++k) {
         const Point2f u((float(k) + 0.5f) / float(n), 0.5f);
         if (ec.pdf_direction(ref, ep.sample_direction(ref, u).first) == 0.f) ++dark_plain;
-        if (ec.pdf_direction(ref, em.sample_direction_mis(ref, u).first) == 0.f) ++dark_mix;
+        if (ec.pdf_direction(ref, em.sample_direction_mis(ref, u, Vector3f(0.f)).first) == 0.f)
+            ++dark_mix;
     }
     EXPECT_GT(dark_plain, n / 10);
     EXPECT_NEAR(double(dark_mix) / n, 0.1 * dark_plain / n, 0.005);
+}
+
+namespace {
+/// Sides to test: the axes, the cube's edges and corners (where the bins of sides meet) and
+/// random ones.
+std::vector<Vector3f> test_sides() {
+    std::vector<Vector3f> sides;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z)
+                if (x || y || z) sides.push_back(normalize(Vector3f(float(x), float(y), float(z))));
+    PCG32 rng(5);
+    for (int k = 0; k < 40; ++k) {
+        Vector3f v = next_vector3f(rng) * 2.f - Vector3f(1.f);
+        if (dot(v, v) > 1e-2f) sides.push_back(normalize(v));
+    }
+    return sides;
+}
+} // namespace
+
+TEST(EnvironmentMap, MisSamplesWithASideCoverWhatItSees) {
+    // Told a side (no light counts from directions d with dot(d, side) <= 0), the MIS light
+    // samples leave out the map's parts wholly behind it. What they must keep: every direction
+    // in front of the side that has light has a density; a sample's density is
+    // pdf_direction_mis()'s with the same side and its weight the radiance over it; the density
+    // integrates to one over the sphere; and fewer samples fall behind the side than without it.
+    // A map with structure at several sizes (a 2-pixel-wide map: blocks of half a turn), and
+    // one turned by to_world.
+    auto sky = [](int x, int y) {
+        return Color3f(0.2f + 0.05f * float(y % 7) + (x % 13 == 3 ? 5.f : 0.f), 0.5f, 1.f);
+    };
+    const std::string rotated =
+        R"(<transform name="to_world"><rotate x="1" y="0.5" z="0.2" angle="50"/></transform>)";
+    struct Case {
+        std::string map, extra;
+        bool narrow_blocks; ///< blocks small enough that many lie wholly behind a side
+    };
+    const std::vector<Case> cases = {{write_map("side-2x3.exr", 2, 3, sky), "", false},
+                                     {write_map("side-5x4.exr", 5, 4, sky), "", false},
+                                     {write_map("side-64x32.exr", 64, 32, sky), "", true},
+                                     {write_map("side-64x32r.exr", 64, 32, sky), rotated, true},
+                                     {write_map("side-200x90.exr", 200, 90, sky), "", true}};
+    PCG32 rng(17);
+    for (const Case &c : cases) {
+        SCOPED_TRACE(c.map + " " + c.extra);
+        auto scene = load(scene_with(c.map, c.extra));
+        const Emitter &env = *scene->environment_emitters().at(0);
+        Interaction ref;
+        double behind_with = 0.0, behind_without = 0.0;
+        int samples = 0;
+        for (const Vector3f &side : test_sides()) {
+            SCOPED_TRACE(testing::Message() << "side " << side);
+            for (int k = 0; k < 64; ++k) {
+                const Point2f u = next_point2f(rng);
+                auto [ds, w] = env.sample_direction_mis(ref, u, side);
+                if (ds.pdf > 0.f) {
+                    EXPECT_EQ(env.pdf_direction_mis(ref, ds, side), ds.pdf);
+                    SurfaceInteraction seen; // the sample's own direction, not renormalised
+                    seen.wi = -ds.d;
+                    const float radiance = env.eval(seen).r;
+                    EXPECT_NEAR(w.r * ds.pdf, radiance, 1e-6f * radiance);
+                    behind_with += dot(ds.d, side) <= 0.f ? 1.0 : 0.0;
+                }
+                auto [d0, w0] = env.sample_direction_mis(ref, u, Vector3f(0.f));
+                behind_without += d0.pdf > 0.f && dot(d0.d, side) <= 0.f ? 1.0 : 0.0;
+                ++samples;
+                // A direction in front of the side with light has a density.
+                DirectionSample probe;
+                probe.d = normalize(next_vector3f(rng) * 2.f - Vector3f(1.f));
+                if (dot(probe.d, side) > 1e-4f &&
+                    env.pdf_direction_mis(ref, probe, Vector3f(0.f)) > 0.f) {
+                    EXPECT_GT(env.pdf_direction_mis(ref, probe, side), 0.f) << probe.d;
+                }
+            }
+        }
+        // Blocks of a map a few pixels wide span a large part of the sphere: few lie wholly
+        // behind a side.
+        if (c.narrow_blocks)
+            EXPECT_LT(behind_with, 0.6 * behind_without) << samples << " samples";
+        else
+            EXPECT_LE(behind_with, 1.05 * behind_without) << samples << " samples";
+        // The density over the sphere, on a grid of (cos θ, φ) cells (midpoints), for a few sides.
+        for (const Vector3f &side : {Vector3f(0.f, 1.f, 0.f), normalize(Vector3f(1.f, -2.f, 0.5f)),
+                                     normalize(Vector3f(-1.f, 1.f, 1.f))}) {
+            const int n = 400;
+            double integral = 0.0;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < 2 * n; ++j) {
+                    const double z = -1.0 + 2.0 * (i + 0.5) / n, phi = M_PI * (j + 0.5) / n;
+                    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+                    DirectionSample ds;
+                    ds.d = Vector3f(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z));
+                    integral += env.pdf_direction_mis(ref, ds, side);
+                }
+            integral *= 4.0 * M_PI / (2.0 * n * n);
+            EXPECT_NEAR(integral, 1.0, 0.01) << "side " << side;
+        }
+    }
 }
 
 TEST(EnvironmentMap, MisCompensationIsSkippedForNearConstantMaps) {
@@ -322,9 +423,9 @@ TEST(EnvironmentMap, SamplesOnTheEdgesOfTheSquareAreValid) {
                 auto [ds, w] = env.sample_direction(ref, Point2f(ux, uy));
                 expect_valid_direction_sample(ds, w, ux, uy);
                 EXPECT_EQ(env.pdf_direction(ref, ds), ds.pdf);
-                auto [dm, wm] = env.sample_direction_mis(ref, Point2f(ux, uy));
+                auto [dm, wm] = env.sample_direction_mis(ref, Point2f(ux, uy), Vector3f(0.f));
                 expect_valid_direction_sample(dm, wm, ux, uy);
-                EXPECT_EQ(env.pdf_direction_mis(ref, dm), dm.pdf);
+                EXPECT_EQ(env.pdf_direction_mis(ref, dm, Vector3f(0.f)), dm.pdf);
                 auto [ray, power] =
                     env.sample_ray(Point2f(0.5f, 0.5f), Point2f(ux, uy), Wavelengths());
                 EXPECT_TRUE(std::isfinite(ray.d.x) && std::isfinite(ray.o.x));
@@ -355,8 +456,8 @@ TEST(EnvironmentMap, VeryDarkAndVeryBrightMapsSampleLikeTheirUnitTwin) {
                 expect_valid_direction_sample(ds, ws, ux, uy);
                 EXPECT_EQ(ds.d, d1.d) << "u = (" << ux << ", " << uy << ")";
                 EXPECT_EQ(ds.pdf, d1.pdf) << "u = (" << ux << ", " << uy << ")";
-                auto [m1, v1] = e1.sample_direction_mis(ref, Point2f(ux, uy));
-                auto [ms, vs] = es.sample_direction_mis(ref, Point2f(ux, uy));
+                auto [m1, v1] = e1.sample_direction_mis(ref, Point2f(ux, uy), Vector3f(0.f));
+                auto [ms, vs] = es.sample_direction_mis(ref, Point2f(ux, uy), Vector3f(0.f));
                 expect_valid_direction_sample(ms, vs, ux, uy);
                 EXPECT_EQ(ms.d, m1.d) << "MIS, u = (" << ux << ", " << uy << ")";
                 EXPECT_EQ(ms.pdf, m1.pdf) << "MIS, u = (" << ux << ", " << uy << ")";

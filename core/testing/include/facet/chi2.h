@@ -234,6 +234,11 @@ public:
     /// Which of the emitter's samplings to test: sample_direction() and pdf_direction()
     /// (LightSampling::Alone, the default) or sample_direction_mis() and pdf_direction_mis().
     void set_light_sampling(LightSampling sampling) { m_sampling = sampling; }
+    /// The side given to sample_direction_mis() and pdf_direction_mis() (zero: none; normalised
+    /// here).
+    void set_side(const Vector3f &side) {
+        m_side = dot(side, side) > 0.f ? normalize(side) : Vector3f(0.f);
+    }
 
     int sample_dim() const override { return 2; }
     Chi2Sample sample(const float *u) const override;
@@ -247,6 +252,7 @@ private:
     std::shared_ptr<Emitter> m_emitter;
     Interaction m_ref;
     LightSampling m_sampling = LightSampling::Alone;
+    Vector3f m_side = Vector3f(0.f);
 };
 
 /// The directions of an emitter's emitted rays (sample_ray()) against pdf_ray_direction(), for
