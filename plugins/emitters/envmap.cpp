@@ -778,7 +778,9 @@ private:
     /// The bin of a world-space side (zero: none, NoSide).
     int side_bin(const Vector3f &side) const {
         if (!(dot(side, side) > 0.f)) return NoSide;
-        const Vector3f s = to_local(side);
+        // The map's frame without normalising: the bin depends on the direction alone.
+        const Vector3f s(dot(m_local_rows[0], side), dot(m_local_rows[1], side),
+                         dot(m_local_rows[2], side));
         const float c[3] = {s.x, s.y, s.z};
         int major = 0;
         for (int k = 1; k < 3; ++k)
