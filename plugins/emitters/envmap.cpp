@@ -240,10 +240,11 @@ private:
         DiscreteDistribution cells;    ///< in the blocks' order (see block_count())
         double total = 0.0;
         float density_scale = 0.f; ///< density over the unit square = value · density_scale
-        /// Per block: where its cells start in the CDF of `cells` (blocks + 1 values) and its
-        /// share of the table's total. Only for a table light samples with a side follow.
+        /// Per block: where its cells start in the CDF of `cells` (blocks + 1 values) and the
+        /// inverse of its share of the table's total (0 for an empty block). Only for a table
+        /// light samples with a side follow.
         std::vector<double> block_start;
-        std::vector<float> block_share, block_inv_share; ///< 1 / share (0 for an empty block)
+        std::vector<float> block_inv_share;
         /// Per bin of sides, the CDF over the blocks in units of 1 / SideQuanta (block_count()
         /// values each; all zero for a bin whose every block lies behind its sides).
         std::vector<uint16_t> side_cdf;
@@ -648,12 +649,13 @@ private:
     // The cells are grouped in blocks of the grid, at most BlocksX x BlocksY (about 11° square),
     // stored block by block in the table's distribution, so that a block's cells are one range
     // of its CDF. Sides are binned on the faces of a cube (SideBinsPerEdge² bins per face). For
-    // each bin a CDF over the blocks picks a block in proportion to its share of the table,
-    // but none that lies wholly behind every side of the bin (the cone of the bin's sides
-    // against the cone of the block's directions, both bounded from above, with a margin);
-    // the table's own CDF then picks the cell within the block (u rescaled into its range).
-    // The density of a direction of block k is the table's times pmf_bin(k) / share(k): the
-    // light behind a side is never sampled, the rest as before, in proportion.
+    // each bin a CDF over the blocks picks a block in proportion to its share of the table
+    // times the largest cosine a side of the bin can have with a direction of the block, but
+    // none that lies wholly behind every side of the bin (the cone of the bin's sides against
+    // the cone of the block's directions, both bounded from above, with a margin); the table's
+    // own CDF then picks the cell within the block (u rescaled into its range). The density of
+    // a direction of block k is the table's times pmf_bin(k) / share(k): the light behind a
+    // side is never sampled, the rest in proportion to the table within each block.
     static constexpr int BlocksX = 32, BlocksY = 16, SideBinsPerEdge = 6;
     static constexpr int SideBins = 6 * SideBinsPerEdge * SideBinsPerEdge;
     static constexpr double MinSideCosine = 0.05;
@@ -801,8 +803,8 @@ private:
     void build_side_tables(Sampling &sampling, const std::vector<float> &ordered) const {
         const size_t blocks = block_count();
         sampling.block_start.resize(blocks + 1);
-        sampling.block_share.resize(blocks);
         sampling.block_inv_share.resize(blocks);
+        std::vector<double> share(blocks);
         std::vector<Cone> cones(blocks);
         for (size_t k = 0; k <= blocks; ++k) {
             sampling.block_start[k] = m_block_first[k] < ordered.size()
@@ -812,7 +814,7 @@ private:
             double sum = 0.0;
             for (uint32_t c = m_block_first[k]; c < m_block_first[k + 1]; ++c)
                 sum += double(std::max(ordered[c], 0.f));
-            sampling.block_share[k] = float(sum / sampling.total);
+            share[k] = sum / sampling.total;
             sampling.block_inv_share[k] = sum > 0.0 ? float(sampling.total / sum) : 0.f;
             cones[k] = block_cone(k);
         }
@@ -832,7 +834,7 @@ private:
                 // direction of the block (the cosine of the surfaces the light falls on), at
                 // least MinSideCosine.
                 const double cosine = std::max(std::cos(std::max(apart, 0.0)), MinSideCosine);
-                weight[k] = behind ? 0.0 : double(sampling.block_share[k]) * cosine;
+                weight[k] = behind ? 0.0 : share[k] * cosine;
                 sum += weight[k];
             }
             if (!(sum > 0.0)) continue;
