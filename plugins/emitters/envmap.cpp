@@ -717,10 +717,9 @@ private:
         const double u0 = (m_block_x[bx] + 0.5) / m_width, u1 = (m_block_x[bx + 1] + 0.5) / m_width;
         const double v0 = double(m_block_y[by]) / (m_height - 1),
                      v1 = double(m_block_y[by + 1]) / (m_height - 1);
+        // (The map's own mapping, in float: its rounding is far below the margins below.)
         auto direction = [](double u, double v) {
-            const double phi = u * 2.0 * double(Pi), theta = v * double(Pi);
-            return Vector3f(float(std::sin(phi) * std::sin(theta)), float(std::cos(theta)),
-                            float(-std::cos(phi) * std::sin(theta)));
+            return uv_to_direction(Point2f(float(u), float(v)));
         };
         Cone cone{normalize(direction(0.5 * (u0 + u1), 0.5 * (v0 + v1))), float(Pi)};
         // Half a turn or more around the axis (a map a few pixels wide): every direction.
