@@ -2,6 +2,9 @@
 
 #include <facet/vector.h>
 
+#include <cstdint>
+#include <cstring>
+
 /// Warps from the unit square to other domains, each with the density of what it produces.
 namespace facet::warp {
 
@@ -14,24 +17,39 @@ namespace facet::warp {
 /// bounce).
 inline void sin_cos_quarter_pi(float a, float &s, float &c) {
     const float a2 = a * a;
-    s = a * (1.f + a2 * (-1.f / 6.f + a2 * (1.f / 120.f + a2 * (-1.f / 5040.f + a2 / 362880.f))));
-    c = 1.f + a2 * (-1.f / 2.f + a2 * (1.f / 24.f + a2 * (-1.f / 720.f +
-                                                          a2 * (1.f / 40320.f - a2 / 3628800.f))));
+    // (Coefficients as products: a division by a constant is not turned into a product when
+    // its reciprocal is inexact, and would sit on the polynomial's chain.)
+    s = a * (1.f +
+             a2 * (-1.f / 6.f + a2 * (1.f / 120.f + a2 * (-1.f / 5040.f + a2 * (1.f / 362880.f)))));
+    c = 1.f + a2 * (-1.f / 2.f +
+                    a2 * (1.f / 24.f +
+                          a2 * (-1.f / 720.f + a2 * (1.f / 40320.f - a2 * (1.f / 3628800.f)))));
+}
+
+/// `c ? a : b` by the bits, so that no branch is taken on a condition that random samples make
+/// unpredictable (a compiler may compile the ternary operator on floats to a branch).
+inline float select_bits(bool c, float a, float b) {
+    uint32_t ia, ib;
+    std::memcpy(&ia, &a, sizeof ia);
+    std::memcpy(&ib, &b, sizeof ib);
+    const uint32_t mask = 0u - uint32_t(c), bits = (ia & mask) | (ib & ~mask);
+    float r;
+    std::memcpy(&r, &bits, sizeof r);
+    return r;
 }
 
 inline Point2f square_to_uniform_disk_concentric(const Point2f &u) {
     // Shirley and Chiu's concentric map, in the branch-light form of Shirley's 2011 note: the
     // angle is θ = (π/4)(y/x) in the wedges around ±x and π/2 - (π/4)(x/y) in those around ±y,
     // whose cosine and sine are the sine and cosine of (π/4)(x/y).
-    float x = 2.f * u.x - 1.f, y = 2.f * u.y - 1.f;
-    if (x == 0.f && y == 0.f) return {0.f, 0.f};
+    // Which wedge is a coin toss for random samples: chosen without a branch.
+    const float x = 2.f * u.x - 1.f, y = 2.f * u.y - 1.f;
+    const bool wide = std::abs(x) > std::abs(y); // around ±x
+    const float r = select_bits(wide, x, y), t = select_bits(wide, y, x);
+    if (r == 0.f) return {0.f, 0.f};
     float s, c;
-    if (std::abs(x) > std::abs(y)) {
-        sin_cos_quarter_pi((Pi / 4.f) * (y / x), s, c);
-        return {x * c, x * s};
-    }
-    sin_cos_quarter_pi((Pi / 4.f) * (x / y), s, c);
-    return {y * s, y * c};
+    sin_cos_quarter_pi((Pi / 4.f) * (t / r), s, c);
+    return {r * select_bits(wide, c, s), r * select_bits(wide, s, c)};
 }
 float square_to_uniform_disk_concentric_pdf(const Point2f &p);
 /// Barycentric (b1, b2), uniform over the triangle.
