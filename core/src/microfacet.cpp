@@ -4,7 +4,91 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace facet {
+
+namespace {
+
+const float InvSqrtPi = 0.56418958354775628f;
+
+/// Where the Newton steps of Beckmann's visible-slope sampling start: X = erf(x̃) of the exact
+/// inverse of the CDF (sample_visible_11()) on a grid over w = sin θ / (sin θ + cos θ), which is
+/// about linear in θ at both ends, and u, read bilinearly. From there one Newton step reaches a
+/// float's precision for u in [1/32, 31/32] (unit.microfacet checks the result against the CDF
+/// in double); the tails keep the exact inverse for θ = π/2 as their start, and three steps.
+/// This halves the sampler's work (an erf, a log and two steps of an erfinv and an exp fewer).
+/// The grid: 34 KB, solved in double at first use (3 ms).
+class BeckmannStart {
+public:
+    static constexpr int NW = 65, NU = 129;
+    static constexpr float ULow = 1.f / 32.f, UHigh = 31.f / 32.f;
+
+    BeckmannStart() {
+        for (int i = 0; i < NW; ++i) {
+            const double w = double(i) / (NW - 1), len = std::hypot(w, 1.0 - w);
+            const double sin_theta = w / len, cos_theta = (1.0 - w) / len;
+            float *row = m_x + i * NU;
+            if (i == 0) { // normal incidence: x̃ is a plain Gaussian
+                for (int j = 0; j < NU; ++j) row[j] = float(2.0 * j / (NU - 1) - 1.0);
+                continue;
+            }
+            if (i == NW - 1) { // grazing: C ∝ exp(−x̃²) for x̃ < 0
+                row[0] = -1.f;
+                for (int j = 1; j < NU; ++j)
+                    row[j] = float(-std::erf(std::sqrt(-std::log(double(j) / (NU - 1)))));
+                continue;
+            }
+            // C(x̃) = 1 + erf(x̃) + k·exp(−x̃²) on (−∞, cot θ], C' = (2/√π)·exp(−x̃²)·(1 − x̃·tan θ):
+            // Newton's steps kept inside a bracket (halving it where a step leaves it), from the
+            // previous u's root.
+            const double tan_theta = sin_theta / cos_theta, cot_theta = cos_theta / sin_theta;
+            const double k = tan_theta / std::sqrt(Pi_d);
+            const double total = 1.0 + std::erf(cot_theta) + k * std::exp(-cot_theta * cot_theta);
+            row[0] = -1.f;
+            row[NU - 1] = float(std::erf(cot_theta));
+            double x = -6.0;
+            for (int j = 1; j < NU - 1; ++j) {
+                const double target = total * double(j) / (NU - 1);
+                double lo = x, hi = cot_theta;
+                for (int it = 0; it < 100; ++it) {
+                    const double e = std::exp(-x * x);
+                    const double value = 1.0 + std::erf(x) + k * e - target;
+                    if (value < 0.0)
+                        lo = x;
+                    else
+                        hi = x;
+                    const double slope = 2.0 / std::sqrt(Pi_d) * e * (1.0 - x * tan_theta);
+                    double next = slope > 0.0 ? x - value / slope : 0.5 * (lo + hi);
+                    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+                    if (std::abs(next - x) <= 1e-13 * (1.0 + std::abs(x)) || hi - lo < 1e-13) {
+                        x = next;
+                        break;
+                    }
+                    x = next;
+                }
+                row[j] = float(std::erf(x));
+            }
+        }
+    }
+
+    /// X at (w, u) for u in [ULow, UHigh].
+    float operator()(float w, float u) const {
+        float fw = w * float(NW - 1), fu = u * float(NU - 1);
+        const int iw = std::min(int(fw), NW - 2), iu = std::min(int(fu), NU - 2);
+        fw -= float(iw);
+        fu -= float(iu);
+        const float *x = m_x + iw * NU + iu;
+        return (x[0] + (x[1] - x[0]) * fu) * (1.f - fw) + (x[NU] + (x[NU + 1] - x[NU]) * fu) * fw;
+    }
+
+private:
+    static constexpr double Pi_d = 3.14159265358979323846;
+    float m_x[NW * NU];
+};
+
+} // namespace
 
 const char *microfacet_type_name(MicrofacetType type) {
     return type == MicrofacetType::Beckmann ? "beckmann" : "ggx";
@@ -102,7 +186,6 @@ Point2f MicrofacetDistribution::sample_visible_11(float cos_theta_i, const Point
     // seen at elevation θ have density ∝ exp(−x̃² − ỹ²)·(cos θ − x̃ sin θ) for x̃ < cot θ: ỹ is a
     // plain Gaussian, x̃ is found by inverting its CDF numerically. In the variable X = erf(x̃) the
     // CDF is, up to normalisation, C(X) = 1 + X + tanθ/√π·exp(−x̃²), with C'(X) = 1 − x̃·tanθ.
-    const float InvSqrtPi = 0.56418958354775628f;
     Point2f u(clamp(u_in.x, 1e-6f, 1.f - 1e-6f), clamp(u_in.y, 1e-6f, 1.f - 1e-6f));
     float sin_theta_i = safe_sqrt(1.f - cos_theta_i * cos_theta_i);
     float tan_theta_i = sin_theta_i / cos_theta_i;
@@ -113,9 +196,18 @@ Point2f MicrofacetDistribution::sample_visible_11(float cos_theta_i, const Point
     float x_max = std::min(std::erf(cot_theta_i), 1.f - 1e-6f); // C is defined on [−1, x_max]
     float target = u.x * (1.f + x_max + InvSqrtPi * tan_theta_i * std::exp(-sqr(cot_theta_i)));
 
-    // Initial guess: the exact inverse for θ = π/2 (C ∝ exp(−x̃²)), mapped onto [−1, x_max].
-    float X = x_max - (1.f + x_max) * std::erf(std::sqrt(-std::log(u.x)));
-    for (int i = 0; i < 3; ++i) { // Newton steps
+    float X;
+    int steps;
+    if (u.x >= BeckmannStart::ULow && u.x <= BeckmannStart::UHigh) {
+        static const BeckmannStart start;
+        X = clamp(start(sin_theta_i / (sin_theta_i + cos_theta_i), u.x), -1.f + 1e-6f, x_max);
+        steps = 1;
+    } else {
+        // The tails: the exact inverse for θ = π/2 (C ∝ exp(−x̃²)), mapped onto [−1, x_max].
+        X = x_max - (1.f + x_max) * std::erf(std::sqrt(-std::log(u.x)));
+        steps = 3;
+    }
+    for (int i = 0; i < steps; ++i) { // Newton steps
         float slope = erfinv(X);
         float value = 1.f + X + InvSqrtPi * tan_theta_i * std::exp(-slope * slope) - target;
         float derivative = 1.f - slope * tan_theta_i;
