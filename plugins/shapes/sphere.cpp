@@ -154,10 +154,12 @@ public:
         // uniform one, the common case, ignores it), or a caller without a light.
         if (!m_emitter || has_flag(m_emitter->flags(), EmitterFlags::SpatiallyVarying))
             ds.uv = spherical_uv(object_direction(dir));
-        ds.d = ds.p - ref.p;
-        ds.dist = norm(ds.d);
+        // The direction and distance of the double computation (d is a unit vector to its
+        // rounding): the point is within its rounding of ref + d·τ, and the float point's
+        // difference and its norm would put a square root and a division on the chain.
+        ds.d = Vector3f(d);
+        ds.dist = float(tau);
         if (!(ds.dist > 0.f)) return ds;
-        ds.d /= ds.dist;
         ds.pdf = cone_pdf(one_minus_cos_max);
         return ds;
     }
