@@ -16,14 +16,15 @@ namespace facet::warp {
 /// the range reduction and the call of std::sin and std::cos (this runs at every diffuse
 /// bounce).
 inline void sin_cos_quarter_pi(float a, float &s, float &c) {
-    const float a2 = a * a;
-    // (Coefficients as products: a division by a constant is not turned into a product when
-    // its reciprocal is inexact, and would sit on the polynomial's chain.)
-    s = a * (1.f +
-             a2 * (-1.f / 6.f + a2 * (1.f / 120.f + a2 * (-1.f / 5040.f + a2 * (1.f / 362880.f)))));
-    c = 1.f + a2 * (-1.f / 2.f +
-                    a2 * (1.f / 24.f +
-                          a2 * (-1.f / 720.f + a2 * (1.f / 40320.f - a2 * (1.f / 3628800.f)))));
+    // In pairs of terms (Estrin's scheme) rather than one Horner chain: the products of the pairs
+    // run side by side, so the result waits for 7 dependent operations instead of 11 (within 8e-8
+    // of the sine and cosine, as Horner's 7e-8). The coefficients are products, not divisions: a
+    // division by a constant is not turned into a product when its reciprocal is inexact.
+    const float a2 = a * a, a4 = a2 * a2;
+    s = a * ((1.f + a2 * (-1.f / 6.f)) +
+             a4 * ((1.f / 120.f + a2 * (-1.f / 5040.f)) + a4 * (1.f / 362880.f)));
+    c = (1.f + a2 * (-1.f / 2.f)) +
+        a4 * ((1.f / 24.f + a2 * (-1.f / 720.f)) + a4 * (1.f / 40320.f + a2 * (-1.f / 3628800.f)));
 }
 
 /// `c ? a : b` by the bits, so that no branch is taken on a condition that random samples make
