@@ -133,6 +133,12 @@ public:
         m_nested[1]->parameters_changed();
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_weight, si);
+        m_nested[0]->prefetch(si);
+        m_nested[1]->prefetch(si);
+    }
+
     std::string to_string() const override {
         return fmt::format("BlendBSDF[weight = {}, first = {}, second = {}]", m_weight->to_string(),
                            m_nested[0]->to_string(), m_nested[1]->to_string());

@@ -75,6 +75,11 @@ public:
         set_nested_components(m_height->is_spatially_varying());
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_height, si);
+        m_nested->prefetch(si);
+    }
+
     std::string to_string() const override {
         return fmt::format("BumpMap[height = {}, scale = {}, flip_invalid_normals = {}, "
                            "use_shadowing_function = {}, nested = {}]",

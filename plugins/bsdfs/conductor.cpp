@@ -98,6 +98,12 @@ public:
         return {Color3f(0.f), 0.f};
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_eta, si);
+        facet::prefetch(m_k, si);
+        facet::prefetch(m_specular_reflectance, si);
+    }
+
     std::string to_string() const override {
         return fmt::format("Conductor[material = {}, eta = {}, k = {}, specular_reflectance = {}]",
                            m_material, m_eta->to_string(), m_k->to_string(),

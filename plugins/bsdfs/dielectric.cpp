@@ -142,6 +142,11 @@ public:
     /// Relative index of refraction η = int_ior / ext_ior.
     float eta() const { return m_eta; }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_specular_reflectance, si);
+        facet::prefetch(m_specular_transmittance, si);
+    }
+
     std::string to_string() const override {
         return fmt::format("Dielectric[eta = {}, specular_reflectance = {}, "
                            "specular_transmittance = {}]",

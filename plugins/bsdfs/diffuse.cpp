@@ -82,6 +82,8 @@ public:
         return m_reflectance.eval(si);
     }
 
+    void prefetch(const SurfaceInteraction &si) const override { m_reflectance.prefetch(si); }
+
     std::string to_string() const override {
         return fmt::format("Diffuse[reflectance = {}]", m_reflectance->to_string());
     }

@@ -98,6 +98,11 @@ public:
 
     void parameters_changed() override { m_nested->parameters_changed(); }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_opacity, si);
+        m_nested->prefetch(si);
+    }
+
     std::string to_string() const override {
         return fmt::format("Mask[opacity = {}, nested = {}]", m_opacity->to_string(),
                            m_nested->to_string());

@@ -46,6 +46,11 @@ public:
         set_nested_components(m_normalmap->is_spatially_varying());
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_normalmap, si);
+        m_nested->prefetch(si);
+    }
+
     std::string to_string() const override {
         return fmt::format("NormalMap[normalmap = {}, flip_invalid_normals = {}, "
                            "use_shadowing_function = {}, nested = {}]",

@@ -146,6 +146,11 @@ public:
         return m_diffuse_reflectance->eval(si);
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_diffuse_reflectance, si);
+        facet::prefetch(m_specular_reflectance, si);
+    }
+
     std::string to_string() const override {
         return fmt::format(
             "Plastic[eta = {}, diffuse_reflectance = {}, specular_reflectance = {}, "

@@ -182,6 +182,13 @@ public:
         return m_diffuse_reflectance->eval(si);
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_diffuse_reflectance, si);
+        facet::prefetch(m_specular_reflectance, si);
+        facet::prefetch(m_microfacet.alpha_u(), si);
+        facet::prefetch(m_microfacet.alpha_v(), si);
+    }
+
     std::string to_string() const override {
         return fmt::format("PolarizedPlastic[{}, eta = {}, diffuse_reflectance = {}, "
                            "specular_reflectance = {}]",

@@ -125,6 +125,14 @@ public:
         return {F * (m_specular_reflectance->eval(si) * value), pdf};
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_eta, si);
+        facet::prefetch(m_k, si);
+        facet::prefetch(m_specular_reflectance, si);
+        facet::prefetch(m_microfacet.alpha_u(), si);
+        facet::prefetch(m_microfacet.alpha_v(), si);
+    }
+
     std::string to_string() const override {
         return fmt::format("RoughConductor[{}, material = {}, eta = {}, k = {}, "
                            "specular_reflectance = {}]",

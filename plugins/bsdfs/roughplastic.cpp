@@ -325,6 +325,13 @@ public:
                t * m_external_transmittance[size_t(i) + 1];
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_diffuse_reflectance, si);
+        facet::prefetch(m_specular_reflectance, si);
+        facet::prefetch(m_microfacet.alpha_u(), si);
+        facet::prefetch(m_microfacet.alpha_v(), si);
+    }
+
     std::string to_string() const override {
         return fmt::format("RoughPlastic[{}, eta = {}, diffuse_reflectance = {}, "
                            "specular_reflectance = {}, nonlinear = {}, internal_reflectance = {}, "

@@ -103,6 +103,11 @@ public:
         return result;
     }
 
+    void prefetch(const SurfaceInteraction &si) const override {
+        facet::prefetch(m_specular_reflectance, si);
+        facet::prefetch(m_specular_transmittance, si);
+    }
+
     std::string to_string() const override {
         return fmt::format("ThinDielectric[eta = {}, specular_reflectance = {}, "
                            "specular_transmittance = {}]",

@@ -171,6 +171,19 @@ public:
                 m_uv_matrix[1] * g.x + m_uv_matrix[4] * g.y};
     }
 
+    /// Starts loading the pixels eval() will read at si.
+    void prefetch(const SurfaceInteraction &si) const override {
+        const Point2f uv = to_uv(si.uv);
+        if (m_filter == FilterType::Nearest) {
+            auto [x, y] = nearest_pixel(uv);
+            prefetch_pixels(x, x, y);
+            return;
+        }
+        const Footprint f = bilinear_footprint(uv);
+        prefetch_pixels(f.xa, f.xb, f.ya);
+        prefetch_pixels(f.xa, f.xb, f.yb);
+    }
+
     Color3f mean() const override { return m_mean; }
     float max() const override { return m_max; }
 
@@ -302,36 +315,78 @@ private:
         });
     }
 
-    /// The filter's blend of the values value(x, y) of the pixels around uv (transformed).
-    template <typename Value> Color3f filtered(const Point2f &uv, Value value) const {
-        float x = uv.x * float(m_width), y = uv.y * float(m_height);
-        if (m_filter == FilterType::Nearest)
-            return value(wrap(floor_to_int(x), m_width), wrap(floor_to_int(y), m_height));
-
-        // Bilinear between the four pixel centres around (x, y); centres sit at half-integers.
-        x -= 0.5f;
-        y -= 0.5f;
+    /// The bilinear filter's four pixels around uv (transformed): columns xa and xb, rows ya
+    /// and yb (wrapped), and the weights fx and fy of xb and yb.
+    struct Footprint {
+        int xa, xb, ya, yb;
+        float fx, fy;
+    };
+    Footprint bilinear_footprint(const Point2f &uv) const {
+        // Pixel centres sit at half-integers.
+        float x = uv.x * float(m_width) - 0.5f, y = uv.y * float(m_height) - 0.5f;
         int x0 = floor_to_int(x), y0 = floor_to_int(y);
         float fx = clamp(x - float(x0), 0.f, 1.f), fy = clamp(y - float(y0), 0.f, 1.f);
         if (!std::isfinite(fx)) fx = 0.f;
         if (!std::isfinite(fy)) fy = 0.f;
-        int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
-        int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
+        return {wrap(x0, m_width),
+                wrap(x0 + 1, m_width),
+                wrap(y0, m_height),
+                wrap(y0 + 1, m_height),
+                fx,
+                fy};
+    }
+    /// The nearest filter's pixel at uv (transformed).
+    std::pair<int, int> nearest_pixel(const Point2f &uv) const {
+        return {wrap(floor_to_int(uv.x * float(m_width)), m_width),
+                wrap(floor_to_int(uv.y * float(m_height)), m_height)};
+    }
+
+    /// The filter's blend of the values value(x, y) of the pixels around uv (transformed).
+    template <typename Value> Color3f filtered(const Point2f &uv, Value value) const {
+        if (m_filter == FilterType::Nearest) {
+            auto [x, y] = nearest_pixel(uv);
+            return value(x, y);
+        }
+        const auto [xa, xb, ya, yb, fx, fy] = bilinear_footprint(uv);
         return (value(xa, ya) * (1.f - fx) + value(xb, ya) * fx) * (1.f - fy) +
                (value(xa, yb) * (1.f - fx) + value(xb, yb) * fx) * fy;
+    }
+
+    /// Starts loading pixels xa and xb of row y as eval() reads them: the spectral mode's curves,
+    /// else the bytes or floats.
+    void prefetch_pixels(int xa, int xb, int y) const {
+        const char *base;
+        size_t size;
+        if (!m_curves.empty()) {
+            base = reinterpret_cast<const char *>(m_curves.data());
+            size = sizeof(SigmoidPolynomial);
+        } else if (m_bytes) {
+            base = reinterpret_cast<const char *>(m_bytes);
+            size = size_t(m_channels);
+        } else {
+            base = reinterpret_cast<const char *>(m_floats);
+            size = size_t(m_channels) * sizeof(float);
+        }
+        const size_t row = size_t(y) * size_t(m_width);
+        // The lines from the first byte to the last of a pixel, or of two neighbours.
+        auto span = [&](size_t first_pixel, size_t last_pixel) {
+            const size_t last = (row + last_pixel + 1) * size - 1;
+            for (size_t at = ((row + first_pixel) * size) & ~size_t(63); at <= last; at += 64)
+                prefetch_line(base + at);
+        };
+        if (xb == xa + 1 || xb == xa) {
+            span(size_t(xa), size_t(xb));
+        } else { // xb wrapped to the row's other end
+            span(size_t(xa), size_t(xa));
+            span(size_t(xb), size_t(xb));
+        }
     }
 
     /// Gradient of the scalar (grey or luminance) bilinear lookup with respect to the transformed
     /// uv: the four pixels of lookup(), differentiated in x and y, times the resolution.
     template <int C, bool Bytes> Vector2f lookup_grad(const Point2f &uv) const {
         if (m_filter == FilterType::Nearest) return Vector2f(0.f);
-        float x = uv.x * float(m_width) - 0.5f, y = uv.y * float(m_height) - 0.5f;
-        int x0 = floor_to_int(x), y0 = floor_to_int(y);
-        float fx = clamp(x - float(x0), 0.f, 1.f), fy = clamp(y - float(y0), 0.f, 1.f);
-        if (!std::isfinite(fx)) fx = 0.f;
-        if (!std::isfinite(fy)) fy = 0.f;
-        int xa = wrap(x0, m_width), xb = wrap(x0 + 1, m_width);
-        int ya = wrap(y0, m_height), yb = wrap(y0 + 1, m_height);
+        const auto [xa, xb, ya, yb, fx, fy] = bilinear_footprint(uv);
         auto value = [&](int px, int py) {
             Color3f c = pixel<C, Bytes>(px, py);
             return C == 1 ? c.r : c.luminance();

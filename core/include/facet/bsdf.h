@@ -166,6 +166,12 @@ public:
     virtual Color3f eval_diffuse_reflectance(const SurfaceInteraction &si) const {
         return Color3f(0.f);
     }
+    /// A hint that the BSDF is about to be queried at `si`: one that reads memory the cache may
+    /// not hold (an image texture's texels) may start loading it here, so that the caller's
+    /// other work (a light sample) overlaps the wait; an integrator calls it when the BSDF is
+    /// BSDFFlags::SpatiallyVarying. It must not change any result; the default does nothing, and
+    /// adapters pass it on to their nested BSDFs.
+    virtual void prefetch(const SurfaceInteraction &) const {}
 
     BSDFFlags flags() const { return m_flags; }
     BSDFFlags flags(size_t component) const { return m_components.at(component); }
