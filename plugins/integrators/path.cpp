@@ -250,8 +250,12 @@ private:
 
             // The samples are drawn in the dimension order emitter (2D), BSDF (1D, 2D), but the
             // BSDF is sampled first: its result is needed only for the next ray, so its chain of
-            // dependent arithmetic runs while the emitter sample is built and traced.
+            // dependent arithmetic runs while the emitter sample is built and traced. A BSDF
+            // that varies over the surface (image textures) is told to start loading what it
+            // will read, and sampled last, so that the light sample overlaps the wait.
             const bool sample_emitter = has_flag(bsdf->flags(), BSDFFlags::Smooth);
+            const bool varying = has_flag(bsdf->flags(), BSDFFlags::SpatiallyVarying);
+            if (varying) bsdf->prefetch(si);
             const Vector3f side = light_side(*bsdf, si);
             const Point2f emitter_sample = sample_emitter ? sampler.draw_2d() : Point2f();
             float sample1 = sampler.draw_1d();
@@ -263,14 +267,17 @@ private:
             BSDFSample bs;
             Color3f bsdf_weight;
             Mueller bsdf_mueller;
-            if (polarizing) {
-                std::tie(bs, bsdf_mueller) = bsdf->sample_polarized(ctx, si, sample1, sample2);
-                FACET_ASSERT(bsdf_mueller.is_finite());
-                bsdf_weight = bsdf_mueller.unpolarized();
-            } else {
-                std::tie(bs, bsdf_weight) = bsdf->sample(ctx, si, sample1, sample2);
-            }
-            FACET_ASSERT(bsdf_weight.is_finite());
+            auto sample_bsdf = [&] {
+                if (polarizing) {
+                    std::tie(bs, bsdf_mueller) = bsdf->sample_polarized(ctx, si, sample1, sample2);
+                    FACET_ASSERT(bsdf_mueller.is_finite());
+                    bsdf_weight = bsdf_mueller.unpolarized();
+                } else {
+                    std::tie(bs, bsdf_weight) = bsdf->sample(ctx, si, sample1, sample2);
+                }
+                FACET_ASSERT(bsdf_weight.is_finite());
+            };
+            if (!varying) sample_bsdf();
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
             // The shadow ray comes last: a sample the BSDF gives no weight (an emitter behind
@@ -310,6 +317,8 @@ private:
                     }
                 }
             }
+
+            if (varying) sample_bsdf();
 
             // ---- Light seen through a delta lobe beside smooth ones (count_delta_lobes()) ----
             if (sample_emitter && has_flag(bsdf->flags(), DeltaLobes) && separable(*bsdf)) {

@@ -1,28 +1,54 @@
-// The out-of-tree `plainarea` light and `plainsampler` against facet's `area` and `independent`:
-// a scene lit by mesh lights and by a sphere's and a disk's renders the same image whether the
-// scene samples a light from its constant_radiance() or through the emitter's own methods, and
-// whether the render draws from the sampler's generator or through next_1d()/next_2d(). Usage:
-// plain_check <scene.xml> <folder of the plugins>; exits with 1 when an image differs.
+// The out-of-tree `plainarea` light, `plainsampler` and `plaindiffuse` BSDF against facet's
+// `area`, `independent` and `diffuse`: a scene lit by mesh lights and by a sphere's and a disk's
+// renders the same image whether the scene samples a light from its constant_radiance() or
+// through the emitter's own methods, whether the render draws from the sampler's generator or
+// through next_1d()/next_2d(), and whether the path tracer prefetches the BSDF's texels and
+// samples it after the light sample or does neither (the two textures, one read as bytes and one
+// as floats, are written next to the plugins). Usage: plain_check <scene.xml> <folder of the
+// plugins>; exits with 1 when an image differs.
 
+#include <facet/image.h>
 #include <facet/plugin.h>
 #include <facet/render.h>
 #include <facet/scene.h>
 #include <facet/xml.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 namespace {
 
-facet::Image render_with(const char *scene_path, const char *emitter, const char *sampler) {
+std::string g_sphere_texture, g_floor_texture;
+
+facet::Image render_with(const char *scene_path, const char *emitter, const char *sampler,
+                         const char *bsdf = "diffuse") {
     facet::LoadOptions load;
     load.params["emitter"] = emitter;
     load.params["sampler"] = sampler;
+    load.params["bsdf"] = bsdf;
+    load.params["sphere_texture"] = g_sphere_texture;
+    load.params["floor_texture"] = g_floor_texture;
     std::shared_ptr<facet::Scene> scene = facet::load_scene(scene_path, load);
     facet::RenderOptions opts;
     opts.seed = 7;
     return facet::render(*scene, *scene->sensors().at(0), opts).image;
+}
+
+/// A texture of w x h pixels whose neighbours differ (so that a lookup's four pixels matter).
+facet::Image pattern(int w, int h) {
+    facet::Image image(w, h, 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                uint32_t v =
+                    uint32_t(x) * 73856093u ^ uint32_t(y) * 19349663u ^ uint32_t(c) * 83492791u;
+                v = (v ^ (v >> 13)) * 0x5bd1e995u;
+                image.at(x, y, c) = 0.1f + 0.8f * float((v >> 8) & 0xffff) / 65535.f;
+            }
+    return image;
 }
 
 /// Counts the values of `ours` that differ from `theirs`; prints the comparison.
@@ -52,12 +78,21 @@ int main(int argc, char **argv) {
     }
     try {
         facet::PluginRegistry::instance().add_search_dir(argv[2]);
+        g_sphere_texture = std::string(argv[2]) + "/plain_sphere.exr";
+        g_floor_texture = std::string(argv[2]) + "/plain_floor.png";
+        facet::write_image(g_sphere_texture, pattern(61, 37));
+        facet::write_image(g_floor_texture, pattern(173, 149));
         const facet::Image facets = render_with(argv[1], "area", "independent");
         const bool light = same("plainarea against area",
                                 render_with(argv[1], "plainarea", "independent"), facets);
         const bool sampler = same("plainsampler against independent",
                                   render_with(argv[1], "area", "plainsampler"), facets);
-        return light && sampler ? 0 : 1;
+        const bool bsdf = same("plaindiffuse against diffuse",
+                               render_with(argv[1], "area", "independent", "plaindiffuse"), facets);
+        const bool unflagged =
+            same("plaindiffuse_unflagged against diffuse",
+                 render_with(argv[1], "area", "independent", "plaindiffuse_unflagged"), facets);
+        return light && sampler && bsdf && unflagged ? 0 : 1;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "plain_check: %s\n", e.what());
         return 1;
