@@ -133,10 +133,10 @@ public:
         m_nested[1]->parameters_changed();
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_weight, si);
-        m_nested[0]->prefetch(si);
-        m_nested[1]->prefetch(si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_weight, si) | m_nested[0]->prefetch(si) |
+               m_nested[1]->prefetch(si);
     }
 
     std::string to_string() const override {

@@ -75,9 +75,9 @@ public:
         set_nested_components(m_height->is_spatially_varying());
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_height, si);
-        m_nested->prefetch(si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_height, si) | m_nested->prefetch(si);
     }
 
     std::string to_string() const override {

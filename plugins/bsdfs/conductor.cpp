@@ -98,10 +98,10 @@ public:
         return {Color3f(0.f), 0.f};
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_eta, si);
-        facet::prefetch(m_k, si);
-        facet::prefetch(m_specular_reflectance, si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_eta, si) | facet::prefetch(m_k, si) |
+               facet::prefetch(m_specular_reflectance, si);
     }
 
     std::string to_string() const override {

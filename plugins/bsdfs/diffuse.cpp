@@ -82,7 +82,9 @@ public:
         return m_reflectance.eval(si);
     }
 
-    void prefetch(const SurfaceInteraction &si) const override { m_reflectance.prefetch(si); }
+    bool prefetch(const SurfaceInteraction &si) const override {
+        return m_reflectance.prefetch(si);
+    }
 
     std::string to_string() const override {
         return fmt::format("Diffuse[reflectance = {}]", m_reflectance->to_string());

@@ -98,9 +98,9 @@ public:
 
     void parameters_changed() override { m_nested->parameters_changed(); }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_opacity, si);
-        m_nested->prefetch(si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_opacity, si) | m_nested->prefetch(si);
     }
 
     std::string to_string() const override {

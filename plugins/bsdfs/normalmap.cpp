@@ -46,9 +46,9 @@ public:
         set_nested_components(m_normalmap->is_spatially_varying());
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_normalmap, si);
-        m_nested->prefetch(si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_normalmap, si) | m_nested->prefetch(si);
     }
 
     std::string to_string() const override {

@@ -146,9 +146,10 @@ public:
         return m_diffuse_reflectance->eval(si);
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_diffuse_reflectance, si);
-        facet::prefetch(m_specular_reflectance, si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_diffuse_reflectance, si) |
+               facet::prefetch(m_specular_reflectance, si);
     }
 
     std::string to_string() const override {

@@ -235,11 +235,13 @@ public:
         return m_base_color->eval(si);
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
+    bool prefetch(const SurfaceInteraction &si) const override {
+        bool started = false;
         for (const auto *t :
              {&m_base_color, &m_roughness, &m_anisotropic, &m_metallic, &m_spec_trans, &m_spec_tint,
               &m_sheen, &m_sheen_tint, &m_flatness, &m_clearcoat, &m_clearcoat_gloss})
-            facet::prefetch(*t, si);
+            started |= facet::prefetch(*t, si);
+        return started;
     }
 
     std::string to_string() const override {

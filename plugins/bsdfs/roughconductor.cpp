@@ -125,12 +125,12 @@ public:
         return {F * (m_specular_reflectance->eval(si) * value), pdf};
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_eta, si);
-        facet::prefetch(m_k, si);
-        facet::prefetch(m_specular_reflectance, si);
-        facet::prefetch(m_microfacet.alpha_u(), si);
-        facet::prefetch(m_microfacet.alpha_v(), si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_eta, si) | facet::prefetch(m_k, si) |
+               facet::prefetch(m_specular_reflectance, si) |
+               facet::prefetch(m_microfacet.alpha_u(), si) |
+               facet::prefetch(m_microfacet.alpha_v(), si);
     }
 
     std::string to_string() const override {

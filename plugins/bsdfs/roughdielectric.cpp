@@ -127,11 +127,12 @@ public:
 
     float eta() const { return m_eta; }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_specular_reflectance, si);
-        facet::prefetch(m_specular_transmittance, si);
-        facet::prefetch(m_microfacet.alpha_u(), si);
-        facet::prefetch(m_microfacet.alpha_v(), si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_specular_reflectance, si) |
+               facet::prefetch(m_specular_transmittance, si) |
+               facet::prefetch(m_microfacet.alpha_u(), si) |
+               facet::prefetch(m_microfacet.alpha_v(), si);
     }
 
     std::string to_string() const override {

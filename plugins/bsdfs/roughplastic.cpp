@@ -325,11 +325,12 @@ public:
                t * m_external_transmittance[size_t(i) + 1];
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_diffuse_reflectance, si);
-        facet::prefetch(m_specular_reflectance, si);
-        facet::prefetch(m_microfacet.alpha_u(), si);
-        facet::prefetch(m_microfacet.alpha_v(), si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_diffuse_reflectance, si) |
+               facet::prefetch(m_specular_reflectance, si) |
+               facet::prefetch(m_microfacet.alpha_u(), si) |
+               facet::prefetch(m_microfacet.alpha_v(), si);
     }
 
     std::string to_string() const override {

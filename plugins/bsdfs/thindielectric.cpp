@@ -103,9 +103,10 @@ public:
         return result;
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
-        facet::prefetch(m_specular_reflectance, si);
-        facet::prefetch(m_specular_transmittance, si);
+    bool prefetch(const SurfaceInteraction &si) const override {
+        // | rather than ||: every one is told.
+        return facet::prefetch(m_specular_reflectance, si) |
+               facet::prefetch(m_specular_transmittance, si);
     }
 
     std::string to_string() const override {

@@ -116,9 +116,9 @@ public:
         if (m_back != m_front) m_back->parameters_changed();
     }
 
-    void prefetch(const SurfaceInteraction &si) const override {
+    bool prefetch(const SurfaceInteraction &si) const override {
         // The side eval() and sample() will query (the back one at the mirrored si, same uv).
-        (Frame::cos_theta(si.wi) > 0.f ? m_front : m_back)->prefetch(si);
+        return (Frame::cos_theta(si.wi) > 0.f ? m_front : m_back)->prefetch(si);
     }
 
     std::string to_string() const override {

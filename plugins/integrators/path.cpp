@@ -251,11 +251,12 @@ private:
             // The samples are drawn in the dimension order emitter (2D), BSDF (1D, 2D), but the
             // BSDF is sampled first: its result is needed only for the next ray, so its chain of
             // dependent arithmetic runs while the emitter sample is built and traced. A BSDF
-            // that varies over the surface (image textures) is told to start loading what it
-            // will read, and sampled last, so that the light sample overlaps the wait.
+            // that varies over the surface is told to start loading what it will read (an image
+            // texture's texels); when it did, it is sampled last, so that the light sample
+            // overlaps the wait.
             const bool sample_emitter = has_flag(bsdf->flags(), BSDFFlags::Smooth);
-            const bool varying = has_flag(bsdf->flags(), BSDFFlags::SpatiallyVarying);
-            if (varying) bsdf->prefetch(si);
+            const bool loading =
+                has_flag(bsdf->flags(), BSDFFlags::SpatiallyVarying) && bsdf->prefetch(si);
             const Vector3f side = light_side(*bsdf, si);
             const Point2f emitter_sample = sample_emitter ? sampler.draw_2d() : Point2f();
             float sample1 = sampler.draw_1d();
@@ -277,7 +278,7 @@ private:
                 }
                 FACET_ASSERT(bsdf_weight.is_finite());
             };
-            if (!varying) sample_bsdf();
+            if (!loading) sample_bsdf();
 
             // ---- Emitter sampling (pointless for purely specular BSDFs) ----
             // The shadow ray comes last: a sample the BSDF gives no weight (an emitter behind
@@ -318,7 +319,7 @@ private:
                 }
             }
 
-            if (varying) sample_bsdf();
+            if (loading) sample_bsdf();
 
             // ---- Light seen through a delta lobe beside smooth ones (count_delta_lobes()) ----
             if (sample_emitter && has_flag(bsdf->flags(), DeltaLobes) && separable(*bsdf)) {

@@ -172,16 +172,17 @@ public:
     }
 
     /// Starts loading the pixels eval() will read at si.
-    void prefetch(const SurfaceInteraction &si) const override {
+    bool prefetch(const SurfaceInteraction &si) const override {
         const Point2f uv = to_uv(si.uv);
         if (m_filter == FilterType::Nearest) {
             auto [x, y] = nearest_pixel(uv);
             prefetch_pixels(x, x, y);
-            return;
+            return true;
         }
         const Footprint f = bilinear_footprint(uv);
         prefetch_pixels(f.xa, f.xb, f.ya);
         prefetch_pixels(f.xa, f.xb, f.yb);
+        return true;
     }
 
     Color3f mean() const override { return m_mean; }

@@ -167,11 +167,12 @@ public:
         return Color3f(0.f);
     }
     /// A hint that the BSDF is about to be queried at `si`: one that reads memory the cache may
-    /// not hold (an image texture's texels) may start loading it here, so that the caller's
-    /// other work (a light sample) overlaps the wait; an integrator calls it when the BSDF is
-    /// BSDFFlags::SpatiallyVarying. It must not change any result; the default does nothing, and
-    /// adapters pass it on to their nested BSDFs.
-    virtual void prefetch(const SurfaceInteraction &) const {}
+    /// not hold (an image texture's texels) may start loading it here and return true, so that
+    /// the caller gives the load time (the path tracer takes its light sample before the BSDF's
+    /// when the BSDF is BSDFFlags::SpatiallyVarying and this returns true). It must not change
+    /// any result; the default loads nothing and returns false. Adapters pass it on to their
+    /// nested BSDFs and textures (Texture::prefetch()), true when any of them started a load.
+    virtual bool prefetch(const SurfaceInteraction &) const { return false; }
 
     BSDFFlags flags() const { return m_flags; }
     BSDFFlags flags(size_t component) const { return m_components.at(component); }

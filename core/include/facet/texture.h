@@ -37,9 +37,9 @@ public:
     /// its aspect ratio from it, as in Mitsuba 3.
     virtual Point2i resolution() const { return {1, 1}; }
     /// A hint that eval() is coming at `si` (BSDF::prefetch()): a texture that reads memory the
-    /// cache may not hold may start loading it. It must not change any result; the default does
-    /// nothing.
-    virtual void prefetch(const SurfaceInteraction &) const {}
+    /// cache may not hold may start loading it, and returns true when it did. It must not change
+    /// any result; the default loads nothing and returns false.
+    virtual bool prefetch(const SurfaceInteraction &) const { return false; }
 
     /// Importance sampling of the texture's domain, uv in [0, 1]², for an area light whose shape
     /// maps [0, 1]² onto its surface (Shape::eval_parameterization). A texture that can sample
@@ -60,9 +60,9 @@ public:
 /// BSDFFlags::SpatiallyVarying).
 inline bool varies(const std::shared_ptr<Texture> &t) { return t && t->is_spatially_varying(); }
 
-/// Texture::prefetch() of `t`, where it is present.
-inline void prefetch(const std::shared_ptr<Texture> &t, const SurfaceInteraction &si) {
-    if (t) t->prefetch(si);
+/// Texture::prefetch() of `t`, where it is present (false where not).
+inline bool prefetch(const std::shared_ptr<Texture> &t, const SurfaceInteraction &si) {
+    return t && t->prefetch(si);
 }
 
 /// The texture behind a plain number, rgb or spectrum parameter.
@@ -97,8 +97,8 @@ public:
     Color3f eval(const SurfaceInteraction &si) const {
         return m_constant ? m_value : m_texture->eval(si);
     }
-    void prefetch(const SurfaceInteraction &si) const {
-        if (!m_constant && m_texture) m_texture->prefetch(si);
+    bool prefetch(const SurfaceInteraction &si) const {
+        return !m_constant && m_texture && m_texture->prefetch(si);
     }
     const std::shared_ptr<Texture> &texture() const { return m_texture; }
     const Texture *operator->() const { return m_texture.get(); }

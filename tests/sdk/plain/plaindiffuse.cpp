@@ -2,10 +2,11 @@ static const char *DOC = R"DOC(
 # plaindiffuse: a Lambertian BSDF through the BSDF interface alone
 
 The same reflection as facet's `diffuse`, f = ρ/π on the front side, written only against the
-BSDF interface: it does not implement prefetch(), so a render never asks it to start loading its
-texture's texels. Built twice out of tree by facet's SDK test: `plaindiffuse` flags itself
-SpatiallyVarying when its reflectance varies (the path tracer then samples it after the light
-sample), `plaindiffuse_unflagged` never does (it is sampled first).
+BSDF interface: it does not implement prefetch(), so a render never has it load its texture's
+texels ahead, and the path tracer samples it before the light sample (facet's `diffuse`, whose
+bitmap starts loading, after). Built twice out of tree by facet's SDK test: `plaindiffuse` flags
+itself SpatiallyVarying when its reflectance varies (the path tracer then asks it to prefetch),
+`plaindiffuse_unflagged` never does.
 
 | Parameter | Type | Default | Description |
 |-----------|------|---------|-------------|
