@@ -440,6 +440,54 @@ TEST_F(Bitmap, WorksAsABSDFParameter) {
                 1e-6f);
 }
 
+TEST_F(Bitmap, PrefetchSaysWhereALoadStartedAndChangesNoValue) {
+    Image img = pattern();
+    write_png_codes("p.png", img);
+    const std::string texture = R"(<texture type="bitmap" name="NAME">
+            <string name="filename" value=")" +
+                                path("p.png") + R"("/>
+        </texture>)";
+    auto with = [&](const std::string &name) {
+        std::string t = texture;
+        t.replace(t.find("NAME"), 4, name);
+        return t;
+    };
+    auto bsdf = [&](std::string xml) { // a top-level element states the scene version
+        xml.insert(6, R"(version="3.0.0" )");
+        auto b = std::dynamic_pointer_cast<BSDF>(load_string(xml));
+        EXPECT_TRUE(b);
+        return b;
+    };
+    SurfaceInteraction si = at_uv(0.3f, 0.6f);
+    si.wi = normalize(Vector3f(0.2f, 0.1f, 0.9f));
+    const Vector3f wo = normalize(Vector3f(-0.3f, 0.2f, 0.8f));
+    // Every bitmap starts a load, at any uv (wrapped, or not finite).
+    auto tex = make_bitmap("p.png");
+    auto near = make_bitmap("p.png", "nearest", "clamp");
+    for (Point2f uv : {Point2f(0.3f, 0.6f), Point2f(-7.2f, 1e6f), Point2f(std::nanf(""), 2.f)}) {
+        SurfaceInteraction at = at_uv(uv.x, uv.y);
+        const Color3f before = tex->eval(at);
+        EXPECT_TRUE(tex->prefetch(at));
+        EXPECT_TRUE(near->prefetch(at));
+        EXPECT_EQ(tex->eval(at), before);
+    }
+    // BSDFs pass it on: true where a bitmap is reached, false for constants and procedures.
+    const std::string d = R"(<bsdf type="diffuse">)" + with("reflectance") + "</bsdf>";
+    auto diffuse = bsdf(d);
+    const Color3f value = diffuse->eval(BSDFContext(), si, wo);
+    EXPECT_TRUE(diffuse->prefetch(si));
+    EXPECT_EQ(diffuse->eval(BSDFContext(), si, wo), value);
+    EXPECT_TRUE(bsdf(R"(<bsdf type="twosided">)" + d + "</bsdf>")->prefetch(si));
+    EXPECT_TRUE(bsdf(R"(<bsdf type="mask">)" + with("opacity") + R"(<bsdf type="diffuse"/></bsdf>)")
+                    ->prefetch(si));
+    EXPECT_TRUE(bsdf(R"(<bsdf type="roughplastic">)" + with("diffuse_reflectance") + "</bsdf>")
+                    ->prefetch(si));
+    EXPECT_FALSE(bsdf(R"(<bsdf type="diffuse"/>)")->prefetch(si));
+    EXPECT_FALSE(bsdf(R"(<bsdf type="diffuse">
+            <texture type="checkerboard" name="reflectance"/></bsdf>)")
+                     ->prefetch(si));
+}
+
 TEST_F(Bitmap, AlphaIsDroppedAndTheStoredColourKept) {
     // As Mitsuba: a texel of RGB (200, 120, 40) under alpha 128 is the colour as stored (sRGB
     // decoded), not the colour times alpha (0.128 for the red channel). The files are written
