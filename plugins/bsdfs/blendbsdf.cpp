@@ -134,9 +134,11 @@ public:
     }
 
     bool prefetch(const SurfaceInteraction &si) const override {
-        // | rather than ||: every one is told.
-        return facet::prefetch(m_weight, si) | m_nested[0]->prefetch(si) |
-               m_nested[1]->prefetch(si);
+        // Every one is told, whatever the others said.
+        bool started = facet::prefetch(m_weight, si);
+        started |= m_nested[0]->prefetch(si);
+        started |= m_nested[1]->prefetch(si);
+        return started;
     }
 
     std::string to_string() const override {

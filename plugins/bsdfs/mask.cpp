@@ -99,8 +99,10 @@ public:
     void parameters_changed() override { m_nested->parameters_changed(); }
 
     bool prefetch(const SurfaceInteraction &si) const override {
-        // | rather than ||: every one is told.
-        return facet::prefetch(m_opacity, si) | m_nested->prefetch(si);
+        // Every one is told, whatever the others said.
+        bool started = facet::prefetch(m_opacity, si);
+        started |= m_nested->prefetch(si);
+        return started;
     }
 
     std::string to_string() const override {

@@ -47,8 +47,10 @@ public:
     }
 
     bool prefetch(const SurfaceInteraction &si) const override {
-        // | rather than ||: every one is told.
-        return facet::prefetch(m_normalmap, si) | m_nested->prefetch(si);
+        // Every one is told, whatever the others said.
+        bool started = facet::prefetch(m_normalmap, si);
+        started |= m_nested->prefetch(si);
+        return started;
     }
 
     std::string to_string() const override {

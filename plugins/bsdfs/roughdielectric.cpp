@@ -128,11 +128,12 @@ public:
     float eta() const { return m_eta; }
 
     bool prefetch(const SurfaceInteraction &si) const override {
-        // | rather than ||: every one is told.
-        return facet::prefetch(m_specular_reflectance, si) |
-               facet::prefetch(m_specular_transmittance, si) |
-               facet::prefetch(m_microfacet.alpha_u(), si) |
-               facet::prefetch(m_microfacet.alpha_v(), si);
+        // Every one is told, whatever the others said.
+        bool started = facet::prefetch(m_specular_reflectance, si);
+        started |= facet::prefetch(m_specular_transmittance, si);
+        started |= facet::prefetch(m_microfacet.alpha_u(), si);
+        started |= facet::prefetch(m_microfacet.alpha_v(), si);
+        return started;
     }
 
     std::string to_string() const override {

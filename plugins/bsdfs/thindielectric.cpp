@@ -104,9 +104,10 @@ public:
     }
 
     bool prefetch(const SurfaceInteraction &si) const override {
-        // | rather than ||: every one is told.
-        return facet::prefetch(m_specular_reflectance, si) |
-               facet::prefetch(m_specular_transmittance, si);
+        // Every one is told, whatever the others said.
+        bool started = facet::prefetch(m_specular_reflectance, si);
+        started |= facet::prefetch(m_specular_transmittance, si);
+        return started;
     }
 
     std::string to_string() const override {
