@@ -204,6 +204,7 @@ uint32_t LightBVH::build_range(std::vector<std::pair<uint32_t, LightBounds>> &it
         node.sin_normals[k] = 0.f;
         node.cos_emission[k] = 0.f;
         node.power[k] = 0.f;
+        node.inside[k] = 0.f;
         node.two_sided[k] = 0.f;
         node.child[k] = 0;
     }
@@ -227,6 +228,8 @@ uint32_t LightBVH::build_range(std::vector<std::pair<uint32_t, LightBounds>> &it
         node.sin_normals[k] = std::sqrt(std::max(0.f, 1.f - cos_n * cos_n));
         node.cos_emission[k] = std::cos(group.theta_emission);
         node.power[k] = float(group.power);
+        // (The division importance() made at every call, the same float operation.)
+        node.inside[k] = node.radius2[k] > 0.f ? node.power[k] / node.radius2[k] : 0.f;
         node.two_sided[k] = group.two_sided ? 1.f : 0.f;
         const uint64_t child_path = path | (uint64_t(k) << (2 * depth));
         if (e - b == 1 || depth + 1 == MaxDepth) {
@@ -252,7 +255,7 @@ void LightBVH::importance(const Node &node, const Point3f &p, const Normal3f &n,
     // Inside a child's sphere every direction may lead to it, and the distance is bounded
     // below by the sphere's radius.
     const M4 outside = dist2 > radius2;
-    const F4 inside_value = select(radius2 > zero, power / radius2, zero);
+    const F4 inside_value = F4::load(node.inside);
     const F4 inv_dist = one / sqrt(dist2), inv_dist2 = inv_dist * inv_dist;
     // The sphere around the child seen from p: the half-angle of its cone of directions.
     const F4 sin_bound = radius * inv_dist;
@@ -290,12 +293,18 @@ void LightBVH::importance(const Node &node, const Point3f &p, const Normal3f &n,
 
 namespace {
 
-/// The children's probabilities at a node: importance over their sum, in slot order.
-bool shares(const float (&w)[LightBVH::Arity], float (&p)[LightBVH::Arity]) {
+/// The sum of the children's importances at a node, or 0 where they give no probabilities.
+float total_of(const float (&w)[LightBVH::Arity]) {
     const float total = (w[0] + w[1]) + (w[2] + w[3]);
     // (An infinite total, a point at a point light's position, would make every share 0 or
     // NaN: nothing is picked there.)
-    if (!(total > 0.f) || !std::isfinite(total)) return false;
+    return total > 0.f && std::isfinite(total) ? total : 0.f;
+}
+
+/// The children's probabilities at a node: importance over their sum, in slot order.
+bool shares(const float (&w)[LightBVH::Arity], float (&p)[LightBVH::Arity]) {
+    const float total = total_of(w);
+    if (total == 0.f) return false;
     for (int k = 0; k < LightBVH::Arity; ++k) p[k] = w[k] / total;
     return true;
 }
@@ -340,11 +349,13 @@ float LightBVH::pmf(const Point3f &p, const Normal3f &n, uint32_t index) const {
     float pmf = 1.f;
     for (int level = 0; level < depth; ++level) {
         const Node &node = m_nodes[at];
-        float w[Arity], share[Arity];
+        float w[Arity];
         importance(node, p, n, w);
-        if (!shares(w, share)) return 0.f;
+        const float total = total_of(w);
+        if (total == 0.f) return 0.f;
+        // The share sample() takes for this child, and only that one.
         const int k = int((path >> (2 * level)) & 3);
-        pmf *= share[k];
+        pmf *= w[k] / total;
         at = node.child[k];
     }
     return pmf;

@@ -45,6 +45,7 @@ private:
         float sin_normals[Arity];              ///< of the same
         float cos_emission[Arity];             ///< of the emission's spread beyond the normals
         float power[Arity];
+        float inside[Arity];    ///< power / radius2 (0 for radius 0): the value inside the sphere
         float two_sided[Arity]; ///< 1 for a two-sided child, else 0
         /// Inner child: its node; leaf child: the emitter's scene index.
         uint32_t child[Arity];
