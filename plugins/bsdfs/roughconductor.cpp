@@ -130,8 +130,7 @@ public:
         bool started = facet::prefetch(m_eta, si);
         started |= facet::prefetch(m_k, si);
         started |= facet::prefetch(m_specular_reflectance, si);
-        started |= facet::prefetch(m_microfacet.alpha_u(), si);
-        started |= facet::prefetch(m_microfacet.alpha_v(), si);
+        started |= m_microfacet.prefetch(si);
         return started;
     }
 

@@ -329,8 +329,7 @@ public:
         // Every one is told, whatever the others said.
         bool started = facet::prefetch(m_diffuse_reflectance, si);
         started |= facet::prefetch(m_specular_reflectance, si);
-        started |= facet::prefetch(m_microfacet.alpha_u(), si);
-        started |= facet::prefetch(m_microfacet.alpha_v(), si);
+        started |= m_microfacet.prefetch(si);
         return started;
     }
 

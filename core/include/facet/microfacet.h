@@ -168,6 +168,14 @@ public:
     /// True unless αu and αv are the same texture or equal constants.
     bool is_anisotropic() const { return m_anisotropic; }
     bool is_spatially_varying() const { return !m_constant; }
+    /// Texture::prefetch() of the roughness textures, for a BSDF's prefetch(): false at once for
+    /// constants; a texture given for both αu and αv is told once.
+    bool prefetch(const SurfaceInteraction &si) const {
+        if (m_constant) return false;
+        bool started = facet::prefetch(m_alpha_u, si);
+        if (m_alpha_v != m_alpha_u) started |= facet::prefetch(m_alpha_v, si);
+        return started;
+    }
     std::string to_string() const;
 
 private:

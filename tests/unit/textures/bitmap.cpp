@@ -486,6 +486,12 @@ TEST_F(Bitmap, PrefetchSaysWhereALoadStartedAndChangesNoValue) {
     EXPECT_FALSE(bsdf(R"(<bsdf type="diffuse">
             <texture type="checkerboard" name="reflectance"/></bsdf>)")
                      ->prefetch(si));
+    // A roughness texture too (MicrofacetParameters::prefetch()), for both axes or one.
+    EXPECT_TRUE(bsdf(R"(<bsdf type="roughconductor">)" + with("alpha") + "</bsdf>")->prefetch(si));
+    EXPECT_TRUE(bsdf(R"(<bsdf type="roughdielectric"><float name="alpha_u" value="0.2"/>)" +
+                     with("alpha_v") + "</bsdf>")
+                    ->prefetch(si));
+    EXPECT_FALSE(bsdf(R"(<bsdf type="roughconductor"/>)")->prefetch(si));
 }
 
 TEST_F(Bitmap, AlphaIsDroppedAndTheStoredColourKept) {
