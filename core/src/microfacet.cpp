@@ -193,8 +193,14 @@ Point2f MicrofacetDistribution::sample_visible_11(float cos_theta_i, const Point
         return Point2f(erfinv(2.f * u.x - 1.f), erfinv(2.f * u.y - 1.f));
 
     float cot_theta_i = cos_theta_i / sin_theta_i;
-    float x_max = std::min(std::erf(cot_theta_i), 1.f - 1e-6f); // C is defined on [−1, x_max]
-    float target = u.x * (1.f + x_max + InvSqrtPi * tan_theta_i * std::exp(-sqr(cot_theta_i)));
+    // C is defined on [−1, x_max]. From cot θ = 4 on (3.84 would do) erf(cot θ) exceeds the
+    // bound and the exp term is below half a float's step of 1 + x_max: the same values to the
+    // last bit without erf and exp, as a test checks.
+    float x_max = 1.f - 1e-6f, target = u.x * (1.f + x_max);
+    if (cot_theta_i < 4.f) {
+        x_max = std::min(std::erf(cot_theta_i), x_max);
+        target = u.x * (1.f + x_max + InvSqrtPi * tan_theta_i * std::exp(-sqr(cot_theta_i)));
+    }
 
     float X;
     int steps;

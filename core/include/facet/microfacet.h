@@ -26,6 +26,9 @@ class MicrofacetDistribution {
 public:
     /// Smallest roughness kept; smaller values are clamped (the smooth plugins cover α = 0).
     static constexpr float MinAlpha = 1e-4f;
+    /// α² tan²θ at and below which Beckmann's visible_normalization() is exactly 1 in float
+    /// (a = 1/(α tan θ) ≥ 4).
+    static constexpr float BeckmannUnmaskedTan2 = 1.f / 16.f;
 
     MicrofacetDistribution(MicrofacetType type, float alpha, bool sample_visible = true)
         : MicrofacetDistribution(type, alpha, alpha, sample_visible) {}
@@ -95,6 +98,9 @@ public:
         if (xy_alpha_2 == 0.f) return 1.f;
         float tan_theta_alpha_2 = xy_alpha_2 / sqr(v.z);
         if (m_type == MicrofacetType::GGX) return 2.f / (1.f + std::sqrt(1.f + tan_theta_alpha_2));
+        // From a = 4 on (3.715 would do) the expression below is 1 to the last bit, as a test
+        // checks: smooth surfaces and steep views need neither erf nor exp.
+        if (tan_theta_alpha_2 <= BeckmannUnmaskedTan2) return 1.f;
         float a = 1.f / std::sqrt(tan_theta_alpha_2);
         const float InvSqrtPi = 0.56418958354775628f;
         return 2.f / (1.f + std::erf(a) + std::exp(-a * a) * InvSqrtPi / a);

@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <string>
 
 using namespace facet;
@@ -392,4 +394,38 @@ TEST(MicrofacetSampling, BeckmannVisibleSlopeInvertsItsCdf) {
     }
     EXPECT_EQ(count, 11 * 4001);
     RecordProperty("worst_cdf_error", fmt::format("{:.3g}", worst));
+}
+
+TEST(MicrofacetSampling, BeckmannShortcutsAreExact) {
+    // visible_normalization() returns 1 without erf and exp for α² tan²θ up to
+    // BeckmannUnmaskedTan2, and sample_visible_11() takes its bounds without them from cot θ = 4
+    // on: the full float expressions must give those values to the last bit there (every
+    // float of cos θ; of α² tan²θ every 64th).
+    const float InvSqrtPi = 0.56418958354775628f;
+    int checked = 0;
+    for (float t = std::numeric_limits<float>::min();
+         t <= MicrofacetDistribution::BeckmannUnmaskedTan2;) {
+        const float a = 1.f / std::sqrt(t);
+        const float full = 2.f / (1.f + std::erf(a) + std::exp(-a * a) * InvSqrtPi / a);
+        ASSERT_EQ(full, 1.f) << "α² tan²θ " << t;
+        uint32_t bits;
+        std::memcpy(&bits, &t, sizeof bits);
+        bits += 64;
+        std::memcpy(&t, &bits, sizeof bits);
+        ++checked;
+    }
+    EXPECT_GT(checked, 15000000);
+    checked = 0;
+    for (float c = 4.f / std::sqrt(17.f); c < 1.f; c = std::nextafter(c, 2.f)) {
+        const float sin_theta = std::sqrt(std::max(1.f - c * c, 0.f));
+        const float tan_theta = sin_theta / c, cot_theta = c / sin_theta;
+        if (!(cot_theta >= 4.f) || !(tan_theta > 1e-4f)) continue;
+        const float x_max = std::min(std::erf(cot_theta), 1.f - 1e-6f);
+        ASSERT_EQ(x_max, 1.f - 1e-6f) << "cos θ " << c;
+        ASSERT_EQ(1.f + x_max + InvSqrtPi * tan_theta * std::exp(-sqr(cot_theta)),
+                  1.f + (1.f - 1e-6f))
+            << "cos θ " << c;
+        ++checked;
+    }
+    EXPECT_GT(checked, 400000);
 }
