@@ -680,6 +680,40 @@ TEST(ShapeIntersection, SphereHitDistanceIsExact) {
     EXPECT_GT(hits, 500);
 }
 
+TEST(ShapeIntersection, SphereShadowRaysStopShortOrReachIt) {
+    // A shadow ray towards a light's sphere ends just before its surface (the occlusion test
+    // answers those without solving the quadratic); one ending just past it must be blocked.
+    const Point3f center(-2.f, 0.5f, 1.f);
+    const float radius = 0.25f;
+    Properties props;
+    props.set_vector("center", center);
+    props.set_float("radius", radius);
+    SingleShape scene(make_shape("sphere", props));
+    PCG32 rng(17);
+    int checked = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const float dist = radius * std::pow(1000.f, rng.next_float()) * 1.5f;
+        const Point3f o = center + warp::square_to_uniform_sphere(next_point2f(rng)) * dist;
+        const Point3f target =
+            center + warp::square_to_uniform_sphere(next_point2f(rng)) * (radius * 0.9f);
+        const Vector3f d = normalize(target - o);
+        const Vector3d od = Vector3d(o) - Vector3d(center), dd = Vector3d(d);
+        // |d| is 1 only to float rounding, which matters near the rim of a distant sphere.
+        const double a = dot(dd, dd), b = dot(od, dd);
+        const double disc = b * b - a * (dot(od, od) - double(radius) * radius);
+        if (disc < 1e-2 * double(radius) * radius) continue; // the rim
+        const double t = (-b - std::sqrt(disc)) / a;
+        for (double gap : {1e-3, 1e-4, 1e-5}) {
+            EXPECT_FALSE(scene.occluded(Ray(o, d, 0.f, float(t * (1.0 - gap)))))
+                << "ends " << gap << " short, at " << dist / radius << " radii";
+            EXPECT_TRUE(scene.occluded(Ray(o, d, 0.f, float(t * (1.0 + gap)))))
+                << "ends " << gap << " beyond, at " << dist / radius << " radii";
+        }
+        ++checked;
+    }
+    EXPECT_GT(checked, 1500);
+}
+
 TEST(ShapeIntersection, SphereFromInsideAndFlippedNormals) {
     Properties props;
     props.set_bool("flip_normals", true);
