@@ -87,13 +87,15 @@ public:
                                        const Point2f &aperture_sample) const override {
         // Film x grows to the right, which is local -X (local +X is the camera's left).
         const float u = film_pos.x + m_principal_offset.x, v = film_pos.y + m_principal_offset.y;
-        const Vector3f local =
-            normalize(Vector3f((1.f - 2.f * u) * m_tan_x, (1.f - 2.f * v) * m_tan_y, 1.f));
-        const float inv_z = 1.f / local.z;
-        // m_to_world.apply_vector(local), inline (the same products summed in the same order).
+        // The point on the plane z = 1, rotated (m_to_world.apply_vector(), inline) and then
+        // normalised once: the rotation keeps lengths, so its length alone gives the clipping
+        // distances (near and far depths over cos θ = 1 / |local|). One square root and one
+        // division on the chain where normalising before the rotation put two of each.
+        const Vector3f local((1.f - 2.f * u) * m_tan_x, (1.f - 2.f * v) * m_tan_y, 1.f);
+        const float length = norm(local);
         const Vector3f d(dot(m_rotation[0], local), dot(m_rotation[1], local),
                          dot(m_rotation[2], local));
-        Ray ray(m_origin, normalize(d), m_near_clip * inv_z, m_far_clip * inv_z);
+        Ray ray(m_origin, normalize(d), m_near_clip * length, m_far_clip * length);
         ray.time = time;
         return {ray, Color3f(1.f)};
     }
