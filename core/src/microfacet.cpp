@@ -207,7 +207,18 @@ Point2f MicrofacetDistribution::sample_visible_11(float cos_theta_i, const Point
     if (u.x >= BeckmannStart::ULow && u.x <= BeckmannStart::UHigh) {
         static const BeckmannStart start;
         X = clamp(start(sin_theta_i / (sin_theta_i + cos_theta_i), u.x), -1.f + 1e-6f, x_max);
-        steps = 1;
+        // One Newton step, taken in the slope: the step ΔX = C/C' of X = erf(x̃) moves x̃ by
+        // ΔX / erf'(x̃) = ΔX·√π/2·exp(x̃²) to first order, an error of the order of the step's
+        // own, and one erfinv fewer than inverting the new X. A step that leaves X's range is
+        // clamped in X as below.
+        const float slope = erfinv(X), e = std::exp(-slope * slope);
+        const float value = 1.f + X + InvSqrtPi * tan_theta_i * e - target;
+        const float step = value / (1.f - slope * tan_theta_i);
+        const float next = X - step;
+        if (next >= -1.f + 1e-6f && next <= x_max && e > 0.f)
+            return Point2f(slope - step * (0.5f / InvSqrtPi) / e, erfinv(2.f * u.y - 1.f));
+        X = clamp(next, -1.f + 1e-6f, x_max);
+        steps = 0;
     } else {
         // The tails: the exact inverse for θ = π/2 (C ∝ exp(−x̃²)), mapped onto [−1, x_max].
         X = x_max - (1.f + x_max) * std::erf(std::sqrt(-std::log(u.x)));
