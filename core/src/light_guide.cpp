@@ -43,20 +43,6 @@ LightGuide::LightGuide(const BoundingBox3f &bounds, size_t emitters) {
     m_probability.assign(m_levels[0].records.size(), 1.f);
 }
 
-void LightGuide::coordinates(const Point3f &p, int (&c)[3]) const {
-    for (int a = 0; a < 3; ++a) {
-        const float x = (p[a] - m_origin[a]) * m_inv_cell[a];
-        const float last = float(m_levels[0].dims[a] - 1);
-        c[a] = x >= 0.f ? int(std::min(x, last)) : 0; // NaN compares false: cell 0
-    }
-}
-
-size_t LightGuide::index(const Level &level, const int (&c)[3], int shift) const {
-    return (size_t(c[2] >> shift) * size_t(level.dims[1]) + size_t(c[1] >> shift)) *
-               size_t(level.dims[0]) +
-           size_t(c[0] >> shift);
-}
-
 void LightGuide::record(const Point3f &p, bool useful, size_t emitter, float contribution) {
     int c[3];
     coordinates(p, c);

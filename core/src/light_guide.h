@@ -20,6 +20,7 @@
 #include <facet/bbox.h>
 #include <facet/vector.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -85,8 +86,20 @@ private:
         std::vector<double> contribution; ///< per cell, per emitter (choice levels only)
     };
     /// The finest cell's coordinates of p (points outside the box, or not finite, clamp).
-    void coordinates(const Point3f &p, int (&c)[3]) const;
-    size_t index(const Level &level, const int (&c)[3], int shift) const;
+    /// Inline, with index(): every light sample and every density of a light hit looks a cell
+    /// up, from the scene's file.
+    void coordinates(const Point3f &p, int (&c)[3]) const {
+        for (int a = 0; a < 3; ++a) {
+            const float x = (p[a] - m_origin[a]) * m_inv_cell[a];
+            const float last = float(m_levels[0].dims[a] - 1);
+            c[a] = x >= 0.f ? int(std::min(x, last)) : 0; // NaN compares false: cell 0
+        }
+    }
+    size_t index(const Level &level, const int (&c)[3], int shift) const {
+        return (size_t(c[2] >> shift) * size_t(level.dims[1]) + size_t(c[1] >> shift)) *
+                   size_t(level.dims[0]) +
+               size_t(c[0] >> shift);
+    }
     /// finish()'s part for the choice of emitters; returns the cells that have one.
     size_t finish_choice(const std::vector<float> &fixed);
     size_t cell(const Point3f &p) const {
