@@ -240,21 +240,31 @@ private:
         return std::isfinite(pdf) ? pdf : 0.f;
     }
 
-    /// Both roots of |o + t·d - c|² = r², nearest first. Returns false when the ray misses.
-    bool solve(double ox, double oy, double oz, double dx, double dy, double dz, double &t0,
-               double &t1) const {
+    /// Both roots of |o + t·d - c|² = r², nearest first. Returns false when the ray misses, or
+    /// when it ends (at tfar) before it reaches the sphere from outside: f(t) = a t² + 2 b t + c
+    /// then still falls at tfar (its least lies beyond) and is positive there, so no root lies
+    /// on it. A light sample's shadow ray, which stops short of the light's sphere, is told so
+    /// without the divisions and the square root. f(tfar) must exceed a margin far above the
+    /// rounding of either computation (1e-10 of its terms' size, against doubles' 1e-16), so
+    /// that it only says what the roots would say too; a ray ending closer finds them.
+    bool solve(double ox, double oy, double oz, double dx, double dy, double dz, double tfar,
+               double &t0, double &t1) const {
         ox -= m_center.x;
         oy -= m_center.y;
         oz -= m_center.z;
         double a = dx * dx + dy * dy + dz * dz;
         if (!(a > 0.0)) return false;
         double b = ox * dx + oy * dy + oz * dz; // half of the usual linear coefficient
-        double c = ox * ox + oy * oy + oz * oz - double(m_radius) * double(m_radius);
+        const double r2 = double(m_radius) * double(m_radius);
+        double c = ox * ox + oy * oy + oz * oz - r2;
+        if (c > 0.0 && -b > a * tfar &&
+            (a * tfar + 2.0 * b) * tfar + c > 1e-10 * (c + 2.0 * r2 + a * tfar * tfar))
+            return false;
         // Discriminant from the distance between the centre and the line (Haines et al.,
         // "Precision improvements for ray/sphere intersection", Ray Tracing Gems 2019).
         double k = b / a;
         double lx = ox - dx * k, ly = oy - dy * k, lz = oz - dz * k;
-        double disc = a * (double(m_radius) * double(m_radius) - (lx * lx + ly * ly + lz * lz));
+        double disc = a * (r2 - (lx * lx + ly * ly + lz * lz));
         if (disc < 0.0) return false;
         double q = -b - std::copysign(std::sqrt(disc), b);
         if (q == 0.0) {
@@ -267,33 +277,11 @@ private:
         return true;
     }
 
-    /// True when the ray, from outside the sphere, ends before reaching it: the distance
-    /// squared to the centre less r², f(t) = a t² + 2 b t + c, still falls at tfar (its least
-    /// lies beyond) and is positive there, so no root lies in [0, tfar]. A light sample's shadow
-    /// ray, which stops short of the light's sphere, is told so without solve()'s divisions and
-    /// square root. f(tfar) must exceed a margin far above the rounding of either computation
-    /// (1e-10 of its terms' size, against doubles' 1e-16), so that it only says what solve()
-    /// would find too; a ray ending closer is left to solve().
-    bool falls_short(double ox, double oy, double oz, double dx, double dy, double dz,
-                     double tfar) const {
-        ox -= m_center.x;
-        oy -= m_center.y;
-        oz -= m_center.z;
-        const double a = dx * dx + dy * dy + dz * dz;
-        const double b = ox * dx + oy * dy + oz * dz;
-        const double r2 = double(m_radius) * double(m_radius);
-        const double o2 = ox * ox + oy * oy + oz * oz;
-        if (!(o2 > r2) || !(-b > a * tfar)) return false;
-        const double f = (a * tfar + 2.0 * b) * tfar + (o2 - r2);
-        return f > 1e-10 * (o2 + r2 + a * tfar * tfar);
-    }
-
     /// Nearest root inside [tnear, tfar], or a negative value.
     bool nearest_hit(float ox, float oy, float oz, float dx, float dy, float dz, float tnear,
                      float tfar, float &t_hit) const {
-        if (falls_short(ox, oy, oz, dx, dy, dz, tfar)) return false;
         double t0, t1;
-        if (!solve(ox, oy, oz, dx, dy, dz, t0, t1)) return false;
+        if (!solve(ox, oy, oz, dx, dy, dz, tfar, t0, t1)) return false;
         if (t0 >= tnear && t0 <= tfar) {
             t_hit = float(t0);
             return true;
