@@ -7,6 +7,7 @@
 // last bit.
 #pragma once
 
+#include <facet/bbox.h>
 #include <facet/emitter.h>
 
 #include <cstdint>
@@ -28,6 +29,11 @@ public:
     /// The probability that sample() picks the emitter of scene index `index` for (p, n); 0 for
     /// one that is not in the tree.
     float pmf(const Point3f &p, const Normal3f &n, uint32_t index) const;
+    /// The probability of the emitter of scene index `index` by the same tree for a whole box
+    /// of points: each node's children in proportion to a bound of their importance over the
+    /// box (at least their importance at any point of it, for any normal). An emitter with a
+    /// probability at some point of the box has one for the box (the light guide's floor).
+    float pmf(const BoundingBox3f &box, uint32_t index) const;
 
     /// Children per node: the importances of a node's children are computed together, one
     /// child per lane of a 4-wide vector.
@@ -55,6 +61,8 @@ private:
     /// The importances of a node's children for (p, n).
     static void importance(const Node &node, const Point3f &p, const Normal3f &n,
                            float (&out)[Arity]);
+    /// The bound of the importances of a node's children over the points of a box.
+    static void importance(const Node &node, const BoundingBox3f &box, float (&out)[Arity]);
     uint32_t build_range(std::vector<std::pair<uint32_t, LightBounds>> &items, size_t begin,
                          size_t end, uint64_t path, int depth);
 

@@ -58,7 +58,7 @@ void LightGuide::record(const Point3f &p, bool useful, size_t emitter, float con
     }
 }
 
-size_t LightGuide::finish(const std::vector<float> &fixed) {
+size_t LightGuide::finish(const std::vector<float> &fixed, const OwnChoice &own) {
     const Level &finest = m_levels[0];
     size_t changed = 0;
     int c[3];
@@ -78,7 +78,7 @@ size_t LightGuide::finish(const std::vector<float> &fixed) {
                 m_probability[index(finest, c, 0)] = q;
                 if (q < 1.f) ++changed;
             }
-    if (m_emitters > 0) changed += finish_choice(fixed);
+    if (m_emitters > 0) changed += finish_choice(fixed, own);
     // The counts are not needed any more.
     for (Level &level : m_levels) {
         level.records = {};
@@ -88,7 +88,17 @@ size_t LightGuide::finish(const std::vector<float> &fixed) {
     return changed;
 }
 
-size_t LightGuide::finish_choice(const std::vector<float> &fixed) {
+BoundingBox3f LightGuide::cell_box(size_t l, const int (&c)[3]) const {
+    BoundingBox3f box;
+    for (int a = 0; a < 3; ++a) {
+        const float size = 1.f / m_inv_cell[a], margin = 1e-3f * size;
+        box.min[a] = m_origin[a] + float(c[a] << l) * size - margin;
+        box.max[a] = m_origin[a] + float((c[a] + 1) << l) * size + margin;
+    }
+    return box;
+}
+
+size_t LightGuide::finish_choice(const std::vector<float> &fixed, const OwnChoice &own) {
     const Level &base = m_levels[m_choice_level];
     const size_t E = m_emitters;
     // The probability the learned emitters share, and how many there are: fewer than two
@@ -104,11 +114,7 @@ size_t LightGuide::finish_choice(const std::vector<float> &fixed) {
     }
     if (learned < 2 || !(free_share > 0.0)) return 0;
     m_choice_offset.assign(base.records.size(), -1);
-    // Per level and cell: where its choice starts once made (cells that fall back to the same
-    // coarser cell share it).
-    std::vector<std::vector<int32_t>> made(m_levels.size());
-    for (size_t l = m_choice_level; l < m_levels.size(); ++l)
-        made[l].assign(m_levels[l].records.size(), -1);
+    std::vector<float> learnt(E), own_choice(E);
     size_t chosen = 0;
     int c[3];
     for (c[2] = 0; c[2] < base.dims[2]; ++c[2])
@@ -128,20 +134,33 @@ size_t LightGuide::finish_choice(const std::vector<float> &fixed) {
                         if (!is_fixed(e)) total += std::sqrt(level.contribution[i * E + e]);
                     if (!(total > 0.0) || !std::isfinite(total)) continue;
                     ++chosen;
-                    if (made[l][i] >= 0) {
-                        m_choice_offset[index(base, c, 0)] = made[l][i];
-                        break;
+                    for (size_t e = 0; e < E; ++e)
+                        learnt[e] = is_fixed(e)
+                                        ? fixed[e]
+                                        : float(free_share *
+                                                std::sqrt(level.contribution[i * E + e]) / total);
+                    // The own rule for the base cell's points, normalised (where the hierarchy
+                    // finds no emitter that reaches the cell, the others take its share).
+                    double own_total = 0.0;
+                    if (own) {
+                        own(cell_box(m_choice_level, c), own_choice.data());
+                        for (size_t e = 0; e < E; ++e)
+                            own_total += std::max(double(own_choice[e]), 0.0);
+                    } else {
+                        std::fill(own_choice.begin(), own_choice.end(), 1.f);
+                        own_total = double(E);
                     }
-                    made[l][i] = int32_t(m_choice.size());
-                    m_choice_offset[index(base, c, 0)] = int32_t(m_choice.size());
                     const size_t start = m_choice.size();
+                    m_choice_offset[index(base, c, 0)] = int32_t(start);
                     m_choice.resize(start + 2 * E);
                     float sum = 0.f;
                     for (size_t e = 0; e < E; ++e) {
+                        const float o =
+                            own_total > 0.0 && std::isfinite(own_total)
+                                ? float(std::max(double(own_choice[e]), 0.0) / own_total)
+                                : learnt[e];
                         m_choice[start + e] =
-                            is_fixed(e) ? fixed[e]
-                                        : float(free_share *
-                                                std::sqrt(level.contribution[i * E + e]) / total);
+                            OwnChoiceShare * o + (1.f - OwnChoiceShare) * learnt[e];
                         sum += m_choice[start + e];
                         m_choice[start + E + e] = sum;
                     }

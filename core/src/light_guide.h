@@ -10,11 +10,13 @@
 // The same survey also learns which emitters are worth a light sample, per cell of a coarser
 // grid: each emitter's second moment there (the square of BSDF times radiance over density of its
 // useful samples, times their MIS weight, over the probability its choice had), whose square root
-// is the share that minimises the variance of a one-emitter sample. The scene then picks an
-// emitter a tenth of the time by its own rule and otherwise by those shares, and gives every
-// sample the density of that mixture: no emitter gets less than a tenth of the share it had (a
-// defence against what the survey missed), and the ones the cell's points actually see get more.
-// Emitters at infinity keep their share (finish()'s `fixed`).
+// is the share that minimises the variance of a one-emitter sample. A cell's choice is the
+// mixture of a tenth of the scene's own rule for the cell (finish()'s `own`: the light
+// hierarchy's choice for the cell's box as a whole) and nine tenths of those shares, stored as
+// one table per cell: no emitter that can reach a point of the cell gets less than a tenth of
+// the share the cell gives it (a defence against what the survey missed), the ones the cell's
+// points actually see get more, and a pick or a density is one lookup. Emitters at infinity
+// keep their share (finish()'s `fixed`).
 #pragma once
 
 #include <facet/bbox.h>
@@ -22,6 +24,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace facet::detail {
@@ -43,7 +46,8 @@ public:
     static constexpr uint32_t MinChoiceRecords = 64;
     /// The choice is learned for scenes with this many emitters, or fewer (and at least two).
     static constexpr size_t MaxChoiceEmitters = 32;
-    /// The share of light samples that keep the scene's own choice of emitter. 0.1 against 0.5:
+    /// The share of a cell's choice that follows the scene's own rule for the cell. 0.1 against
+    /// 0.5 (when the rule was taken at each point):
     /// 0.90x the squared error of Veach's four lights (each pixel's error clipped to 1, 7 seeds),
     /// 0.98x the staircase's 13 (5 seeds), at the same spp and cost.
     static constexpr float OwnChoiceShare = 0.1f;
@@ -59,13 +63,18 @@ public:
     /// probability below 1 or a choice (0: the guide changes nothing). `fixed` (empty, or one
     /// value per emitter): an emitter's probability in every choice where it is >= 0 (the
     /// emitters at infinity, whose light reaches points at scales finer than a cell); the others
-    /// share the rest by what the survey learned.
-    size_t finish(const std::vector<float> &fixed = {});
+    /// share the rest by what the survey learned. `own(box, out)` writes the scene's own
+    /// probability of each emitter for the points of a box (a cell of the choice); the choice
+    /// mixes OwnChoiceShare of it (normalised to sum 1; where it is all zero, none) with what
+    /// was learned. Without it the own rule is uniform.
+    using OwnChoice = std::function<void(const BoundingBox3f &box, float *out)>;
+    size_t finish(const std::vector<float> &fixed = {}, const OwnChoice &own = {});
 
     /// The probability of taking a light sample at p, in (0, 1].
     float probability(const Point3f &p) const { return m_probability[cell(p)]; }
-    /// The learned choice of emitters for p: per scene index its probability (they sum to 1),
-    /// then their running sums; null where none was learned.
+    /// The choice of emitters for p (the mixture of the own rule and what was learned): per
+    /// scene index its probability (they sum to 1), then their running sums; null where none
+    /// was learned.
     const float *choice(const Point3f &p) const {
         if (m_choice_offset.empty()) return nullptr;
         int c[3];
@@ -101,7 +110,10 @@ private:
                size_t(c[0] >> shift);
     }
     /// finish()'s part for the choice of emitters; returns the cells that have one.
-    size_t finish_choice(const std::vector<float> &fixed);
+    size_t finish_choice(const std::vector<float> &fixed, const OwnChoice &own);
+    /// The box of cell c of level l, widened by a thousandth of a finest cell on every side
+    /// (points whose float coordinates round into the cell lie in it).
+    BoundingBox3f cell_box(size_t l, const int (&c)[3]) const;
     size_t cell(const Point3f &p) const {
         int c[3];
         coordinates(p, c);
@@ -116,7 +128,7 @@ private:
     size_t m_choice_level = 0;        ///< the finest level the choice is learned on
     /// Per cell of the choice level: where its choice starts in m_choice, or -1.
     std::vector<int32_t> m_choice_offset;
-    std::vector<float> m_choice; ///< per choice: the emitters' probabilities, then their sums
+    std::vector<float> m_choice; ///< per cell: the emitters' probabilities, then their sums
 };
 
 } // namespace facet::detail

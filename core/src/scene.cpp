@@ -713,7 +713,16 @@ void Scene::prepare_light_sampling() const {
         for (size_t i = 0; i < m_emitter_table.size(); ++i)
             if (m_emitter_table[i].emitter->is_infinite())
                 fixed[i] = m_light_bvh ? m_outside_pmf : m_emitter_table[i].pmf;
-        const size_t guided = guide->finish(fixed);
+        // The scene's own rule for a cell of the choice: the hierarchy's choice for its box (the
+        // emitters outside the hierarchy their constant share), else the constant choice.
+        auto own = [this](const BoundingBox3f &box, float *out) {
+            for (size_t i = 0; i < m_emitter_table.size(); ++i)
+                out[i] = !m_light_bvh ? m_emitter_table[i].pmf
+                         : m_emitter_table[i].in_hierarchy
+                             ? m_hierarchy_share * m_light_bvh->pmf(box, uint32_t(i))
+                             : m_outside_pmf;
+        };
+        const size_t guided = guide->finish(fixed, own);
         const bool chooses = guide->chooses();
         if (guided > 0) m_light_guide = std::move(guide);
         FACET_LOG(
@@ -804,43 +813,26 @@ bool Scene::uniform_selection() const {
 std::pair<size_t, float> Scene::pick_emitter(const Interaction *ref, float &u) const {
     const float *choice = ref && m_light_guide ? m_light_guide->choice(ref->p) : nullptr;
     if (!choice) return own_pick(ref, u);
-    // The mixture: OwnChoiceShare of the picks by the scene's own rule, the rest by the
-    // guide's learned probabilities (then running sums) for this cell; each pick's probability
-    // is the mixture's, as pick_pmf() computes it.
-    constexpr float Own = detail::LightGuide::OwnChoiceShare;
+    // The guide's choice for this cell (its own rule's floor included): probabilities, then
+    // running sums.
     const size_t count = m_light_guide->emitters();
-    size_t index;
-    float own = 0.f;
-    if (u < Own) {
-        u = std::min(u / Own, OneMinusEpsilon);
-        std::tie(index, own) = own_pick(ref, u);
-        // The own rule found no emitter that can reach ref: no sample (index is no pick).
-        if (!(own > 0.f)) return {index, 0.f};
-    } else {
-        const float v = std::min((u - Own) / (1.f - Own), OneMinusEpsilon);
-        const float *sums = choice + count;
-        index = count;
-        for (size_t e = 0; e < count; ++e)
-            if (v < sums[e]) {
-                index = e;
-                break;
-            }
-        if (index == count) // past the last sum by rounding: the last emitter with a share
-            for (index = count - 1; index > 0 && !(choice[index] > 0.f); --index) {}
-        const float below = index > 0 ? sums[index - 1] : 0.f;
-        u = choice[index] > 0.f ? std::clamp((v - below) / choice[index], 0.f, OneMinusEpsilon)
-                                : 0.f;
-        own = own_pmf(ref, index);
-    }
-    // pick_pmf()'s arithmetic (own_pick() gives own_pmf()'s value to the last bit).
-    return {index, Own * own + (1.f - Own) * choice[index]};
+    const float *sums = choice + count;
+    size_t index = count;
+    for (size_t e = 0; e < count; ++e)
+        if (u < sums[e]) {
+            index = e;
+            break;
+        }
+    if (index == count) // past the last sum by rounding: the last emitter with a share
+        for (index = count - 1; index > 0 && !(choice[index] > 0.f); --index) {}
+    const float below = index > 0 ? sums[index - 1] : 0.f;
+    u = choice[index] > 0.f ? std::clamp((u - below) / choice[index], 0.f, OneMinusEpsilon) : 0.f;
+    return {index, choice[index]};
 }
 
 float Scene::pick_pmf(const Interaction *ref, size_t index) const {
     const float *choice = ref && m_light_guide ? m_light_guide->choice(ref->p) : nullptr;
-    if (!choice) return own_pmf(ref, index);
-    constexpr float Own = detail::LightGuide::OwnChoiceShare;
-    return Own * own_pmf(ref, index) + (1.f - Own) * choice[index];
+    return choice ? choice[index] : own_pmf(ref, index);
 }
 
 std::pair<size_t, float> Scene::own_pick(const Interaction *ref, float &u) const {

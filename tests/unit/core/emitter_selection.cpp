@@ -3,6 +3,7 @@
 // expected image either way, for the path tracer's MIS and for the light tracer.
 #include "direction_cone.h" // (core/src: the hierarchy's cone arithmetic)
 #include "draws.h"
+#include "light_bvh.h" // (core/src: the hierarchy itself, for its choice over a box)
 
 #include <facet/emitter.h>
 #include <facet/plugin.h>
@@ -450,6 +451,61 @@ TEST(EmitterSelection, TheLightHierarchyKeepsTheImageAndLowersItsNoise) {
                                                  "uniform choice's";
         }
     }
+}
+
+TEST(EmitterSelection, TheHierarchysChoiceForABoxKeepsEveryLightItsPointsCanReach) {
+    // The light guide's floor: the hierarchy's probabilities for a box as a whole. Boxes from a
+    // twentieth of a lamp's spacing to twice it, in and around the corridor of 40 lamps: an
+    // emitter the hierarchy picks with some probability for a point of the box (any normal,
+    // or none) has a probability for the box, they sum to at most 1, and some emitters are still
+    // ruled out (the boxes above the panels, which face down).
+    auto scene = load(corridor_xml(40, "", "path", 1, 0));
+    std::vector<std::pair<uint32_t, LightBounds>> items;
+    for (const auto &emitter : scene->emitters())
+        if (auto bounds = emitter->light_bounds())
+            items.emplace_back(emitter->scene_index(), *bounds);
+    ASSERT_EQ(items.size(), scene->emitters().size());
+    detail::LightBVH bvh;
+    bvh.build(items);
+    PCG32 rng(23);
+    size_t reached = 0, ruled_out = 0;
+    for (int i = 0; i < 400; ++i) {
+        const float side = 0.1f * std::pow(40.f, rng.next_float());
+        const Point3f lo(26.f * rng.next_float() - 13.f, 6.f * rng.next_float() - 3.f,
+                         3.f * rng.next_float() - 0.5f);
+        const Vector3f size(side * (0.5f + rng.next_float()), side * (0.5f + rng.next_float()),
+                            side * (0.5f + rng.next_float()));
+        const BoundingBox3f box(lo, lo + size);
+        std::vector<float> box_pmf(scene->emitters().size(), 0.f);
+        double sum = 0.0;
+        for (const auto &item : items) {
+            box_pmf[item.first] = bvh.pmf(box, item.first);
+            EXPECT_GE(box_pmf[item.first], 0.f);
+            sum += box_pmf[item.first];
+            if (!(box_pmf[item.first] > 0.f)) ++ruled_out;
+        }
+        // At most 1 (as for a point: a group's bound may reach the box where none of its
+        // emitters' does).
+        EXPECT_LE(sum, 1.0 + 1e-5) << "box " << i;
+        for (int k = 0; k < 64; ++k) {
+            const Point3f p(lo.x + size.x * rng.next_float(), lo.y + size.y * rng.next_float(),
+                            lo.z + size.z * rng.next_float());
+            Normal3f n(0.f);
+            if (k % 4 != 0) {
+                const Vector3f v = next_vector3f(rng) - Vector3f(0.5f);
+                if (norm(v) > 0.05f) n = Normal3f(normalize(v));
+            }
+            for (const auto &item : items) {
+                if (!(bvh.pmf(p, n, item.first) > 0.f)) continue;
+                ++reached;
+                EXPECT_GT(box_pmf[item.first], 0.f)
+                    << "emitter " << item.first << " reaches (" << p.x << ", " << p.y << ", " << p.z
+                    << ") of box " << i << " but has no probability for the box";
+            }
+        }
+    }
+    EXPECT_GT(reached, 100000u);
+    EXPECT_GT(ruled_out, 400u) << "the box bound rules no emitter out";
 }
 
 TEST(EmitterSelection, AFlatLightsNormalsMakeANarrowCone) {

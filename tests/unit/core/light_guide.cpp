@@ -179,17 +179,87 @@ TEST(LightGuide, GuidedSamplesAreTakenAtRateQWithTheirDensities) {
             const float own = ds.emitter->pdf_direction(si, ds);
             EXPECT_NEAR(ds.pdf, q * pmf * own, 1e-5f * ds.pdf);
             EXPECT_NEAR(weight.g * ds.pdf, 1.f, 1e-5f);
-            // The choice keeps at least OwnChoiceShare of the scene's own rule's probability,
-            // whatever it learned.
-            const Emitter &twin = *plain->emitters().at(ds.emitter->scene_index());
-            EXPECT_GE(pmf, detail::LightGuide::OwnChoiceShare * plain->emitter_pmf(si, twin) *
-                               (1.f - 1e-6f));
+        }
+        // Whatever the survey learned, the choice leaves out no emitter the scene's own rule
+        // gives a probability at the point (its floor: EveryCellKeepsATenthOfItsOwnRule).
+        for (const auto &emitter : guided->emitters()) {
+            const Emitter &twin = *plain->emitters().at(emitter->scene_index());
+            if (plain->emitter_pmf(si, twin) > 0.f) {
+                EXPECT_GT(guided->emitter_pmf(si, *emitter), 0.f);
+            }
         }
     }
     // The maze makes most light samples useless somewhere the camera looks.
     EXPECT_GT(below_one, points.size() / 4) << "the guide changed nothing";
     // Samples are taken at the rate q (a binomial count).
     EXPECT_NEAR(taken, expected_taken, 4.0 * std::sqrt(taken_variance) + 1.0);
+}
+
+TEST(LightGuide, EveryCellKeepsATenthOfItsOwnRule) {
+    // The guide alone, over a box 10 x 4 x 6 with five emitters, from a survey that found light
+    // from emitters 0 to 3 only (by position), never from 4. The scene's own rule (`own`) is
+    // asked for each cell of the choice's box: at every point the choice is a probability
+    // distribution (running sums included), the point lies in a box the rule was asked for,
+    // and each emitter keeps at least OwnChoiceShare of that rule's share there (normalised:
+    // emitter 3 gets nothing from the rule where x > 5): emitter 4 too.
+    const BoundingBox3f bounds(Point3f(0.f), Point3f(10.f, 4.f, 6.f));
+    constexpr size_t E = 5;
+    detail::LightGuide guide(bounds, E);
+    PCG32 rng(5);
+    auto point = [&] {
+        const float x = 10.f * rng.next_float(), y = 4.f * rng.next_float();
+        return Point3f(x, y, 6.f * rng.next_float());
+    };
+    for (int i = 0; i < 400000; ++i) {
+        const Point3f p = point();
+        const size_t e = size_t(p.x / 2.5f + p.z / 6.f) % 4;
+        guide.record(p, true, e, 0.1f + rng.next_float());
+    }
+    std::vector<BoundingBox3f> boxes;
+    std::vector<std::vector<float>> rules;
+    auto own = [&](const BoundingBox3f &box, float *out) {
+        const Point3f c = box.center();
+        for (size_t e = 0; e < E; ++e) out[e] = 1.f / (1.f + float(e) * c.y);
+        if (c.x > 5.f) out[3] = 0.f;
+        boxes.push_back(box);
+        rules.emplace_back(out, out + E);
+    };
+    EXPECT_GT(guide.finish({}, own), 0u);
+    ASSERT_TRUE(guide.chooses());
+    ASSERT_FALSE(boxes.empty());
+    constexpr float Own = detail::LightGuide::OwnChoiceShare;
+    for (int i = 0; i < 2000; ++i) {
+        const Point3f p = point();
+        const float *choice = guide.choice(p);
+        ASSERT_NE(choice, nullptr);
+        double sum = 0.0;
+        for (size_t e = 0; e < E; ++e) {
+            sum += choice[e];
+            EXPECT_NEAR(choice[E + e], sum, 1e-6);
+        }
+        EXPECT_NEAR(sum, 1.0, 1e-5);
+        // The cells' boxes overlap by their margins: the point's cell is one of those holding it.
+        bool floor_kept = false, inside = false;
+        for (size_t b = 0; b < boxes.size(); ++b) {
+            const BoundingBox3f &box = boxes[b];
+            if (!(p.x >= box.min.x && p.x <= box.max.x && p.y >= box.min.y && p.y <= box.max.y &&
+                  p.z >= box.min.z && p.z <= box.max.z))
+                continue;
+            inside = true;
+            double total = 0.0;
+            for (float v : rules[b]) total += v;
+            bool kept = true;
+            for (size_t e = 0; e < E; ++e)
+                kept = kept && choice[e] >= Own * float(rules[b][e] / total) * (1.f - 1e-5f);
+            floor_kept = floor_kept || kept;
+        }
+        EXPECT_TRUE(inside) << "(" << p.x << ", " << p.y << ", " << p.z << ") in no cell's box";
+        EXPECT_TRUE(floor_kept) << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+        EXPECT_GT(choice[4], 0.f);
+        if (p.x > 5.5f) { // no share from the rule there: the learned share alone
+            EXPECT_LE(choice[3], (1.f - Own) * (1.f + 1e-6f));
+        }
+    }
 }
 
 TEST(LightGuide, TheLearnedChoiceOfEmittersIsTheOneSampled) {
