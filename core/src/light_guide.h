@@ -74,9 +74,10 @@ public:
     float probability(const Point3f &p) const { return m_probability[cell(p)]; }
     /// The choice of emitters for p (the mixture of the own rule and what was learned): per
     /// scene index its probability (they sum to 1), then their running sums; null where none
-    /// was learned.
+    /// was learned, and for a point outside the grid (not in any cell's box: the point's own
+    /// rule decides there).
     const float *choice(const Point3f &p) const {
-        if (m_choice_offset.empty()) return nullptr;
+        if (m_choice_offset.empty() || !in_grid(p)) return nullptr;
         int c[3];
         coordinates(p, c);
         const int32_t offset =
@@ -103,6 +104,16 @@ private:
             const float last = float(m_levels[0].dims[a] - 1);
             c[a] = x >= 0.f ? int(std::min(x, last)) : 0; // NaN compares false: cell 0
         }
+    }
+    /// Whether p lies within the finest level's cells (the grid's far faces included), where
+    /// coordinates() needs no clamp; false for a point that is not finite.
+    bool in_grid(const Point3f &p) const {
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) {
+            const float x = (p[a] - m_origin[a]) * m_inv_cell[a];
+            inside = inside && x >= 0.f && x <= float(m_levels[0].dims[a]);
+        }
+        return inside;
     }
     size_t index(const Level &level, const int (&c)[3], int shift) const {
         return (size_t(c[2] >> shift) * size_t(level.dims[1]) + size_t(c[1] >> shift)) *

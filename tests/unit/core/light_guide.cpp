@@ -1,8 +1,9 @@
 // The light-sample guide (Scene::prepare_light_sampling()): where the scene's survey found few
 // light samples useful, a point takes one with probability q < 1, its weight divided by q and
-// its density multiplied by it; and the emitter it samples is chosen a tenth of the time by the
-// scene's own rule, otherwise by what the survey learned there. The densities are those of that
-// sampling, the expected image is the same, and the guide depends on the scene alone.
+// its density multiplied by it; and the emitter it samples is chosen by a mixture of a tenth of
+// the scene's own rule for the point's cell and nine tenths of what the survey learned there.
+// The densities are those of that sampling, the expected image is the same, and the guide
+// depends on the scene alone.
 #include "light_guide.h"
 
 #include "draws.h"
@@ -227,6 +228,12 @@ TEST(LightGuide, EveryCellKeepsATenthOfItsOwnRule) {
     EXPECT_GT(guide.finish({}, own), 0u);
     ASSERT_TRUE(guide.chooses());
     ASSERT_FALSE(boxes.empty());
+    // A point outside the grid lies in no cell's box: no choice there (the scene's own rule
+    // at the point decides); the box's far corner is inside.
+    EXPECT_EQ(guide.choice(Point3f(-0.5f, 2.f, 3.f)), nullptr);
+    EXPECT_EQ(guide.choice(Point3f(5.f, 2.f, 8.f)), nullptr);
+    EXPECT_EQ(guide.choice(Point3f(std::nanf(""), 2.f, 3.f)), nullptr);
+    EXPECT_NE(guide.choice(Point3f(10.f, 4.f, 6.f)), nullptr);
     constexpr float Own = detail::LightGuide::OwnChoiceShare;
     for (int i = 0; i < 2000; ++i) {
         const Point3f p = point();
