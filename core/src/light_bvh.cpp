@@ -402,22 +402,28 @@ float LightBVH::pmf(const Point3f &p, const Normal3f &n, uint32_t index) const {
     return pmf;
 }
 
-float LightBVH::pmf(const BoundingBox3f &box, uint32_t index) const {
-    if (index >= m_paths.size() || m_paths[index].second < 0 || !box.valid()) return 0.f;
-    const auto [path, depth] = m_paths[index];
-    uint32_t at = 0;
-    double pmf = 1.0;
-    for (int level = 0; level < depth; ++level) {
+void LightBVH::pmf(const BoundingBox3f &box, std::vector<float> &out) const {
+    out.assign(m_paths.size(), 0.f);
+    if (m_nodes.empty() || !box.valid()) return;
+    // Depth first from the root: each node with the probability of reaching it.
+    std::vector<std::pair<uint32_t, double>> pending{{0u, 1.0}};
+    while (!pending.empty()) {
+        const auto [at, reach] = pending.back();
+        pending.pop_back();
         const Node &node = m_nodes[at];
         float w[Arity];
         importance(node, box, w);
         const double total = (double(w[0]) + double(w[1])) + (double(w[2]) + double(w[3]));
-        if (!(total > 0.0)) return 0.f;
-        const int k = int((path >> (2 * level)) & 3);
-        pmf *= double(w[k]) / total;
-        at = node.child[k];
+        if (!(total > 0.0)) continue;
+        for (int k = 0; k < node.count; ++k) {
+            const double share = reach * (double(w[k]) / total);
+            if (!(share > 0.0)) continue;
+            if ((node.leaf >> k) & 1)
+                out[node.child[k]] = float(share);
+            else
+                pending.emplace_back(node.child[k], share);
+        }
     }
-    return float(pmf);
 }
 
 } // namespace facet::detail

@@ -29,11 +29,12 @@ public:
     /// The probability that sample() picks the emitter of scene index `index` for (p, n); 0 for
     /// one that is not in the tree.
     float pmf(const Point3f &p, const Normal3f &n, uint32_t index) const;
-    /// The probability of the emitter of scene index `index` by the same tree for a whole box
-    /// of points: each node's children in proportion to a bound of their importance over the
-    /// box (at least their importance at any point of it, for any normal). An emitter with a
-    /// probability at some point of the box has one for the box (the light guide's floor).
-    float pmf(const BoundingBox3f &box, uint32_t index) const;
+    /// The probability of every emitter by the same tree for a whole box of points, in `out`
+    /// by scene index (0 for one not in the tree): each node's children in proportion to a
+    /// bound of their importance over the box (at least their importance at any point of it,
+    /// for any normal), each node evaluated once. An emitter with a probability at some point
+    /// of the box has one for the box (the light guide's floor).
+    void pmf(const BoundingBox3f &box, std::vector<float> &out) const;
 
     /// Children per node: the importances of a node's children are computed together, one
     /// child per lane of a 4-wide vector.

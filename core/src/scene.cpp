@@ -714,13 +714,15 @@ void Scene::prepare_light_sampling() const {
             if (m_emitter_table[i].emitter->is_infinite())
                 fixed[i] = m_light_bvh ? m_outside_pmf : m_emitter_table[i].pmf;
         // The scene's own rule for a cell of the choice: the hierarchy's choice for its box (the
-        // emitters outside the hierarchy their constant share), else the constant choice.
-        auto own = [this](const BoundingBox3f &box, float *out) {
+        // emitters outside the hierarchy their constant share), else the constant choice. (The
+        // hierarchy's probabilities hold every emitter in it, by scene index.)
+        std::vector<float> hierarchy;
+        auto own = [this, &hierarchy](const BoundingBox3f &box, float *out) {
+            if (m_light_bvh) m_light_bvh->pmf(box, hierarchy);
             for (size_t i = 0; i < m_emitter_table.size(); ++i)
-                out[i] = !m_light_bvh ? m_emitter_table[i].pmf
-                         : m_emitter_table[i].in_hierarchy
-                             ? m_hierarchy_share * m_light_bvh->pmf(box, uint32_t(i))
-                             : m_outside_pmf;
+                out[i] = !m_light_bvh                      ? m_emitter_table[i].pmf
+                         : m_emitter_table[i].in_hierarchy ? m_hierarchy_share * hierarchy[i]
+                                                           : m_outside_pmf;
         };
         const size_t guided = guide->finish(fixed, own);
         const bool chooses = guide->chooses();
