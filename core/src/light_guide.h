@@ -65,8 +65,8 @@ public:
     /// emitters at infinity, whose light reaches points at scales finer than a cell); the others
     /// share the rest by what the survey learned. `own(box, out)` writes the scene's own
     /// probability of each emitter for the points of a box (a cell of the choice); the choice
-    /// mixes OwnChoiceShare of it (normalised to sum 1; where it is all zero, none) with what
-    /// was learned. Without it the own rule is uniform.
+    /// mixes OwnChoiceShare of it (normalised to sum 1; where it is all zero, the learned
+    /// shares take its place) with what was learned. Without it the own rule is uniform.
     using OwnChoice = std::function<void(const BoundingBox3f &box, float *out)>;
     size_t finish(const std::vector<float> &fixed = {}, const OwnChoice &own = {});
 
