@@ -74,12 +74,11 @@ public:
     float probability(const Point3f &p) const { return m_probability[cell(p)]; }
     /// The choice of emitters for p (the mixture of the own rule and what was learned): per
     /// scene index its probability (they sum to 1), then their running sums; null where none
-    /// was learned, and for a point outside the grid (not in any cell's box: the point's own
-    /// rule decides there).
+    /// was learned, and for a point outside the grid (in no cell's box: the scene's own rule
+    /// at the point decides there).
     const float *choice(const Point3f &p) const {
-        if (m_choice_offset.empty() || !in_grid(p)) return nullptr;
         int c[3];
-        coordinates(p, c);
+        if (m_choice_offset.empty() || !coordinates(p, c)) return nullptr;
         const int32_t offset =
             m_choice_offset[index(m_levels[m_choice_level], c, int(m_choice_level))];
         return offset >= 0 ? m_choice.data() + offset : nullptr;
@@ -96,22 +95,16 @@ private:
         std::vector<double> contribution; ///< per cell, per emitter (choice levels only)
     };
     /// The finest cell's coordinates of p (points outside the box, or not finite, clamp).
-    /// Inline, with index(): every light sample and every density of a light hit looks a cell
-    /// up, from the scene's file.
-    void coordinates(const Point3f &p, int (&c)[3]) const {
+    /// Returns whether p lies within the grid (its far faces included), unclamped; false for a
+    /// point that is not finite. Inline, with index(): every light sample and every density of
+    /// a light hit looks a cell up, from the scene's file.
+    bool coordinates(const Point3f &p, int (&c)[3]) const {
+        bool inside = true;
         for (int a = 0; a < 3; ++a) {
             const float x = (p[a] - m_origin[a]) * m_inv_cell[a];
             const float last = float(m_levels[0].dims[a] - 1);
             c[a] = x >= 0.f ? int(std::min(x, last)) : 0; // NaN compares false: cell 0
-        }
-    }
-    /// Whether p lies within the finest level's cells (the grid's far faces included), where
-    /// coordinates() needs no clamp; false for a point that is not finite.
-    bool in_grid(const Point3f &p) const {
-        bool inside = true;
-        for (int a = 0; a < 3; ++a) {
-            const float x = (p[a] - m_origin[a]) * m_inv_cell[a];
-            inside = inside && x >= 0.f && x <= float(m_levels[0].dims[a]);
+            inside = inside && x >= 0.f && x <= last + 1.f;
         }
         return inside;
     }
