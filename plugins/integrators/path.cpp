@@ -49,6 +49,7 @@ are all delta, keeps its one random lobe.
 #include <fmt/format.h>
 
 #include <limits>
+#include <new>
 #include <tuple>
 #include <type_traits>
 
@@ -173,6 +174,28 @@ private:
         return next_known;
     }
 
+    /// A record made when it is first asked for: trace()'s next_si, which only delta lobes
+    /// beside smooth ones need (a SurfaceInteraction's member initialisers zero it, for every
+    /// sample).
+    class LazyRecord {
+    public:
+        LazyRecord() {}
+        SurfaceInteraction &get() {
+            if (!m_made) {
+                new (&m_storage.si) SurfaceInteraction();
+                m_made = true;
+            }
+            return m_storage.si;
+        }
+
+    private:
+        union Storage {
+            Storage() {}
+            SurfaceInteraction si;
+        } m_storage;
+        bool m_made = false;
+    };
+
     /// The path's radiance: a colour, or in the polarized mode (Polarized) the Stokes vector of
     /// the light arriving along the camera ray. The polarized path's throughput is a Mueller
     /// matrix in the world's implicit frames (mueller.h): the product of the BSDF matrices along
@@ -205,7 +228,7 @@ private:
         // vertex, found by the lobe's ray, is then known (next_si), and its emission is not
         // counted again.
         bool next_known = false, next_hit = false, emission_counted = false;
-        SurfaceInteraction next_si;
+        LazyRecord next_si;
 
         for (;;) {
             bool hit;
@@ -327,7 +350,7 @@ private:
                 emission_counted = !bsdf_weight.is_black() && has_flag(bs.sampled_type, DeltaLobes);
                 next_known = count_delta_lobes<Polarized>(scene, *bsdf, si, bs, emission_counted,
                                                           sample1, sample2, polarizing, throughput,
-                                                          result, next_si, next_hit);
+                                                          result, next_si.get(), next_hit);
             }
 
             // ---- BSDF sampling: the next segment of the path ----
@@ -351,7 +374,7 @@ private:
             prev_bsdf_pdf = bs.pdf;
             prev_bsdf_delta = has_flag(bs.sampled_type, BSDFFlags::Delta);
             ray = si.spawn_ray(si.to_world(bs.wo));
-            if (next_known) si = next_si; // what `ray` hits, found above
+            if (next_known) si = next_si.get(); // what `ray` hits, found above
             ++depth;
             // A stop (Ctrl-C, timeout) ends even a path that would bounce for hours (a closed
             // mirror without Russian roulette); the render drops the unit of this sample.
