@@ -204,10 +204,11 @@ private:
     RenderResult run_sampling(const SamplingIntegrator &integrator);
     RenderResult run_light_tracing(const LightTracer &tracer);
     /// Samples [first, last) of every pixel of block `index` of the grid into `block`; false
-    /// when a stop cut it short.
+    /// when a stop cut it short. `lanes`: Scene::PacketSize samplers when the integrator takes
+    /// the camera rays' hits (their rays are then traced in packets), else null.
     bool render_block(const SamplingIntegrator &integrator, const BlockGrid &grid, size_t index,
-                      uint32_t first, uint32_t last, Sampler &sampler, std::vector<float> &aovs,
-                      ImageBlock &block, InvalidSamples &invalid) const;
+                      uint32_t first, uint32_t last, Sampler &sampler, Sampler *const *lanes,
+                      std::vector<float> &aovs, ImageBlock &block, InvalidSamples &invalid) const;
     /// Light paths [begin, end) of the render into `block`; false when a stop cut it short.
     bool trace_paths(const LightTracer &tracer, uint64_t begin, uint64_t end, Sampler &sampler,
                      ImageBlock &block) const;
@@ -311,17 +312,26 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
     m_merger = std::make_unique<BlockMerger>(*m_buffer, /*splat=*/false, blocks);
     std::atomic<uint64_t> samples_done{0};
     InvalidSamples invalid;
+    const bool packets = integrator.takes_first_hit();
     // Unit `index` is block index % blocks of pass index / blocks.
     auto make_worker = [&]() -> std::function<void(size_t)> {
         auto sampler = std::shared_ptr<Sampler>(m_sampler->clone());
         auto aovs = std::make_shared<std::vector<float>>(bands + aov_names.size() + 1, 0.f);
-        return [&, sampler, aovs](size_t index) {
+        // With an integrator that takes the camera rays' hits, one sampler per packet lane.
+        auto lanes = std::make_shared<std::vector<std::unique_ptr<Sampler>>>();
+        auto lane_ptrs = std::make_shared<std::vector<Sampler *>>();
+        if (packets)
+            for (int k = 0; k < Scene::PacketSize; ++k) {
+                lanes->push_back(m_sampler->clone());
+                lane_ptrs->push_back(lanes->back().get());
+            }
+        return [&, sampler, aovs, lanes, lane_ptrs](size_t index) {
             const size_t pass = index / blocks;
             const uint32_t first = m_range.first + m_pass_start[pass],
                            last = m_range.first + m_pass_start[pass + 1];
             std::unique_ptr<ImageBlock> block = m_merger->acquire();
-            if (!render_block(integrator, grid, index % blocks, first, last, *sampler, *aovs,
-                              *block, invalid)) {
+            if (!render_block(integrator, grid, index % blocks, first, last, *sampler,
+                              packets ? lane_ptrs->data() : nullptr, *aovs, *block, invalid)) {
                 m_merger->release(std::move(block));
                 return;
             }
@@ -349,7 +359,7 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
 
 bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGrid &grid,
                              size_t index, uint32_t first, uint32_t last, Sampler &sampler,
-                             std::vector<float> &aovs, ImageBlock &block,
+                             Sampler *const *lanes, std::vector<float> &aovs, ImageBlock &block,
                              InvalidSamples &invalid) const {
     const Point2i film_size = m_film.size(), offset = grid.block_offset(index);
     const Point2i size(std::min(grid.bs, film_size.x - offset.x),
@@ -369,63 +379,119 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     const bool spectral = is_spectral(m_scene.mode());
     const Point2f inv_film_size(1.f / float(film_size.x), 1.f / float(film_size.y));
 
+    // A sample's camera ray: the sampler, set to the sample, draws the position in pixel (x, y),
+    // the aperture if the sensor has one and, in the spectral mode, the wavelengths (drawn from
+    // the film's bands or the sensor's response if there is one; the radiance at them becomes
+    // the film's RGB through XYZ, times the sensor's response, or the bands).
+    struct CameraSample {
+        Point2f pos;
+        Ray ray;
+        Color3f weight, wavelength_weight;
+    };
+    auto camera = [&](Sampler &s, int x, int y, CameraSample &c) {
+        const Point2f u = s.draw_2d();
+        c.pos = Point2f(float(x) + u.x, float(y) + u.y);
+        const Point2f aperture = needs_aperture ? s.draw_2d() : Point2f(0.5f, 0.5f);
+        std::tie(c.ray, c.weight) = m_sensor.sample_ray(0.f, c.pos * inv_film_size, aperture);
+        if (spectral) {
+            const float uw = s.draw_1d();
+            if (bands) {
+                std::tie(c.ray.wavelengths, c.wavelength_weight) = bands->sample_wavelengths(uw);
+            } else if (srf) {
+                std::tie(c.ray.wavelengths, c.wavelength_weight) = srf->sample_wavelengths(uw);
+                c.wavelength_weight = c.wavelength_weight * srf->eval(0, c.ray.wavelengths);
+            } else {
+                std::tie(c.ray.wavelengths, c.wavelength_weight) = sample_wavelengths(uw);
+            }
+        }
+    };
     uint64_t bad = 0, first_bad_pixel = UINT64_MAX;
+    // The radiance L of camera sample c (of pixel `pixel_index`) into the block, with the AOVs
+    // the integrator wrote; a sample that is not finite is dropped.
+    auto record = [&](const CameraSample &c, Color3f L, uint64_t pixel_index) {
+        bool valid = true;
+        if (bands) {
+            bands->develop(L, c.ray.wavelengths, c.wavelength_weight, aovs.data());
+            for (int k = 0; k < band_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
+        } else {
+            if (spectral) L = spectral_to_srgb(L, c.ray.wavelengths, c.wavelength_weight);
+            valid = L.is_finite();
+        }
+        for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aov_values[k]);
+        if (!valid) {
+            // One bad sample must not turn the whole pixel into NaN: drop it.
+            if (bad++ == 0) first_bad_pixel = pixel_index;
+            return;
+        }
+        if (bands)
+            block.put_values(c.pos, aovs.data(), filter);
+        else
+            block.put(c.pos, L, aov_values, filter);
+    };
+
     uint32_t until_check = 1;
-    uint64_t pixel_seeds[4]; // of the row's pixels x0 + 4i .. x0 + 4i + 3
-    for (int y = y0; y < y1; ++y) {
-        for (int x = x0; x < x1; ++x) {
-            const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
-            if ((x - x0) % 4 == 0) sample_stream_seeds4(m_seed, pixel_index, pixel_seeds);
-            sampler.seed(pixel_seeds[(x - x0) % 4]);
-            for (uint32_t s = first; s < last; ++s) {
-                // A stop abandons the block (its pass is incomplete and is dropped).
-                if (--until_check == 0) {
-                    until_check = 16;
-                    if (m_stop()) return false;
+    if (lanes) {
+        // The camera rays of eight neighbouring pixels in a row, one sample each, are traced
+        // together (Scene::ray_intersect_packet()). The eight are fixed by the film: pixels
+        // 8k .. 8k + 7 of a row (the last group padded with copies of its first ray), whatever
+        // the block, crop, part or thread count, so that each ray meets the same packet in every
+        // render of the scene. A pixel of the group outside the block has its ray traced, not
+        // its path. Lane k's sampler follows pixel 8k + k's stream.
+        constexpr int N = Scene::PacketSize;
+        CameraSample cams[N];
+        Ray rays[N];
+        SurfaceInteraction sis[N];
+        bool hits[N];
+        for (int y = y0; y < y1; ++y) {
+            for (int gx = x0 - x0 % N; gx < x1; gx += N) {
+                const int count = std::min(N, film_size.x - gx);
+                const uint64_t row_index = uint64_t(y) * uint64_t(film_size.x);
+                for (int k = 0; k < count; k += 4) {
+                    uint64_t seeds[4];
+                    sample_stream_seeds4(m_seed, row_index + uint64_t(gx + k), seeds);
+                    for (int j = 0; j < 4 && k + j < count; ++j) lanes[k + j]->seed(seeds[j]);
                 }
-                sampler.set_sample_index(s);
-                const Point2f u = sampler.draw_2d();
-                const Point2f pos(float(x) + u.x, float(y) + u.y);
-                const Point2f aperture = needs_aperture ? sampler.draw_2d() : Point2f(0.5f, 0.5f);
-                auto [ray, weight] = m_sensor.sample_ray(0.f, pos * inv_film_size, aperture);
-                // The spectral mode's wavelengths come with the camera ray (the sample's next
-                // dimension), drawn from the film's bands or the sensor's response if there is
-                // one; its radiance at them becomes the film's RGB through XYZ (times the
-                // sensor's response), or the bands.
-                Color3f wavelength_weight;
-                if (spectral) {
-                    const float u = sampler.draw_1d();
-                    if (bands) {
-                        std::tie(ray.wavelengths, wavelength_weight) = bands->sample_wavelengths(u);
-                    } else if (srf) {
-                        std::tie(ray.wavelengths, wavelength_weight) = srf->sample_wavelengths(u);
-                        wavelength_weight = wavelength_weight * srf->eval(0, ray.wavelengths);
-                    } else {
-                        std::tie(ray.wavelengths, wavelength_weight) = sample_wavelengths(u);
+                for (uint32_t s = first; s < last; ++s) {
+                    // A stop abandons the block (its pass is incomplete and is dropped).
+                    if (m_stop()) return false;
+                    for (int k = 0; k < count; ++k) {
+                        lanes[k]->set_sample_index(s);
+                        camera(*lanes[k], gx + k, y, cams[k]);
+                        rays[k] = cams[k].ray;
+                    }
+                    for (int k = count; k < N; ++k) rays[k] = rays[0];
+                    m_scene.ray_intersect_packet(rays, N, sis, hits);
+                    for (int k = std::max(0, x0 - gx); k < std::min(count, x1 - gx); ++k) {
+                        // Integrators need not write every AOV for every sample (e.g. on a miss).
+                        if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
+                        const Color3f L = integrator.sample_from_hit(m_scene, *lanes[k], rays[k],
+                                                                     sis[k], hits[k], aov_values);
+                        record(cams[k], L * cams[k].weight, row_index + uint64_t(gx + k));
                     }
                 }
-                // Integrators need not write every AOV for every sample (e.g. on a miss).
-                if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
-                Color3f L = integrator.sample(m_scene, sampler, ray, aov_values) * weight;
-                bool valid = true;
-                if (bands) {
-                    bands->develop(L, ray.wavelengths, wavelength_weight, aovs.data());
-                    for (int k = 0; k < band_count; ++k)
-                        valid = valid && std::isfinite(aovs[size_t(k)]);
-                } else {
-                    if (spectral) L = spectral_to_srgb(L, ray.wavelengths, wavelength_weight);
-                    valid = L.is_finite();
+            }
+        }
+    } else {
+        uint64_t pixel_seeds[4]; // of the row's pixels x0 + 4i .. x0 + 4i + 3
+        CameraSample cam;
+        for (int y = y0; y < y1; ++y) {
+            for (int x = x0; x < x1; ++x) {
+                const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
+                if ((x - x0) % 4 == 0) sample_stream_seeds4(m_seed, pixel_index, pixel_seeds);
+                sampler.seed(pixel_seeds[(x - x0) % 4]);
+                for (uint32_t s = first; s < last; ++s) {
+                    // A stop abandons the block (its pass is incomplete and is dropped).
+                    if (--until_check == 0) {
+                        until_check = 16;
+                        if (m_stop()) return false;
+                    }
+                    sampler.set_sample_index(s);
+                    camera(sampler, x, y, cam);
+                    // Integrators need not write every AOV for every sample (e.g. on a miss).
+                    if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
+                    const Color3f L = integrator.sample(m_scene, sampler, cam.ray, aov_values);
+                    record(cam, L * cam.weight, pixel_index);
                 }
-                for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aov_values[k]);
-                if (!valid) {
-                    // One bad sample must not turn the whole pixel into NaN: drop it.
-                    if (bad++ == 0) first_bad_pixel = pixel_index;
-                    continue;
-                }
-                if (bands)
-                    block.put_values(pos, aovs.data(), filter);
-                else
-                    block.put(pos, L, aov_values, filter);
             }
         }
     }

@@ -527,6 +527,31 @@ uint64_t detail::SceneQueries::resend(const Scene &scene, const RayQuery *querie
     return differing;
 }
 
+inline void Scene::complete_hit(const Ray &ray, float t, unsigned geom, unsigned prim,
+                                unsigned inst, const Point2f &uv, SurfaceInteraction &si) const {
+    if (inst != RTC_INVALID_GEOMETRY_ID) {
+        // A hit inside an instanced group: geom is the member of the group.
+        FACET_ASSERT(inst < m_geometries.size());
+        m_geometries[inst].shape->compute_instance_interaction(ray, t, geom, prim, uv, si);
+        si.instance_index = inst;
+        return;
+    }
+    FACET_ASSERT(geom < m_geometries.size());
+    const GeometryEntry &geometry = m_geometries[geom];
+    const Shape *shape = geometry.shape;
+    // The shape fills in its geometry (a flat mesh inline); the hit is finished here, once for
+    // every shape.
+    if (geometry.flat_mesh)
+        geometry.flat_mesh->flat_hit(prim, uv, si);
+    else
+        shape->compute_surface_interaction(ray, t, prim, uv, si);
+    si.t = t;
+    si.shape = shape;
+    si.prim_index = prim;
+    si.instance_index = uint32_t(-1);
+    si.wi = si.to_local(-ray.d);
+}
+
 bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
     g_intersect_calls.add();
     si.wavelengths = ray.wavelengths;
@@ -544,30 +569,63 @@ bool Scene::ray_intersect(const Ray &ray, SurfaceInteraction &si) const {
         escaped(ray, si);
         return false;
     }
-    const Point2f uv(rh.hit.u, rh.hit.v);
-    if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) {
-        // A hit inside an instanced group: geomID is the member of the group.
-        FACET_ASSERT(rh.hit.instID[0] < m_geometries.size());
-        m_geometries[rh.hit.instID[0]].shape->compute_instance_interaction(
-            ray, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, uv, si);
-        si.instance_index = rh.hit.instID[0];
-    } else {
-        FACET_ASSERT(rh.hit.geomID < m_geometries.size());
-        const GeometryEntry &geometry = m_geometries[rh.hit.geomID];
-        const Shape *shape = geometry.shape;
-        // The shape fills in its geometry (a flat mesh inline); the hit is finished here, once
-        // for every shape.
-        if (geometry.flat_mesh)
-            geometry.flat_mesh->flat_hit(rh.hit.primID, uv, si);
-        else
-            shape->compute_surface_interaction(ray, rh.ray.tfar, rh.hit.primID, uv, si);
-        si.t = rh.ray.tfar;
-        si.shape = shape;
-        si.prim_index = rh.hit.primID;
-        si.instance_index = uint32_t(-1);
-        si.wi = si.to_local(-ray.d);
-    }
+    complete_hit(ray, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0],
+                 Point2f(rh.hit.u, rh.hit.v), si);
     return true;
+}
+
+void Scene::ray_intersect_packet(const Ray *rays, int count, SurfaceInteraction *sis,
+                                 bool *hits) const {
+    static_assert(PacketSize == 8, "the packet is Embree's RTCRayHit8");
+    FACET_ASSERT(count >= 1 && count <= PacketSize);
+    alignas(32) int valid[PacketSize];
+    alignas(32) RTCRayHit8 rh;
+    for (int k = 0; k < PacketSize; ++k) {
+        // A lane without a ray (past `count`, or one Embree cannot trace: a NaN direction, say,
+        // escapes) is left out (valid 0) and holds an empty range.
+        const Ray *ray = k < count ? &rays[k] : nullptr;
+        if (ray) {
+            __m128 a, b;
+            ray_words(*ray, a, b);
+            if (!embree_can_trace(a, b)) ray = nullptr;
+        }
+        valid[k] = ray ? -1 : 0;
+        rh.ray.org_x[k] = ray ? ray->o.x : 0.f;
+        rh.ray.org_y[k] = ray ? ray->o.y : 0.f;
+        rh.ray.org_z[k] = ray ? ray->o.z : 0.f;
+        rh.ray.tnear[k] = ray ? ray->mint : 0.f;
+        rh.ray.dir_x[k] = ray ? ray->d.x : 0.f;
+        rh.ray.dir_y[k] = ray ? ray->d.y : 0.f;
+        rh.ray.dir_z[k] = ray ? ray->d.z : 1.f;
+        rh.ray.time[k] = 0.f;
+        rh.ray.tfar[k] = ray ? ray->maxt : -Infinity;
+        rh.ray.mask[k] = ~0u; // the Debian build has ray masks on: any other value can miss
+        rh.ray.id[k] = 0;
+        rh.ray.flags[k] = 0;
+        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect8(valid, m_rtc_scene, &context, &rh);
+    detail::RayQueryObserver *observer = g_query_observer.load(std::memory_order_relaxed);
+    for (int k = 0; k < count; ++k) {
+        g_intersect_calls.add();
+        const Ray &ray = rays[k];
+        SurfaceInteraction &si = sis[k];
+        si.wavelengths = ray.wavelengths;
+        const bool hit = valid[k] != 0 && rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+        if (observer && valid[k] != 0) observe_query(*observer, ray, false, hit);
+        hits[k] = hit;
+        if (!hit) {
+            escaped(ray, si);
+            continue;
+        }
+        complete_hit(ray, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.instID[0][k],
+                     Point2f(rh.hit.u[k], rh.hit.v[k]), si);
+    }
 }
 
 bool Scene::ray_test(const Ray &ray) const { return occluded(ray); }

@@ -70,6 +70,15 @@ public:
         return trace<false>(scene, sampler, camera_ray);
     }
 
+    Color3f sample_from_hit(const Scene &scene, Sampler &sampler, const Ray &camera_ray,
+                            const SurfaceInteraction &si, bool hit,
+                            float * /*aovs*/) const override {
+        const FirstHit first{&si, hit};
+        if (m_polarized) return trace<true>(scene, sampler, camera_ray, first).s[0];
+        return trace<false>(scene, sampler, camera_ray, first);
+    }
+    bool takes_first_hit() const override { return true; }
+
     Stokes sample_stokes(const Scene &scene, Sampler &sampler, const Ray &camera_ray,
                          float * /*aovs*/) const override {
         if (m_polarized) return trace<true>(scene, sampler, camera_ray);
@@ -196,13 +205,21 @@ private:
         bool m_made = false;
     };
 
+    /// The camera ray's closest hit when the caller has found it (sample_from_hit()).
+    struct FirstHit {
+        const SurfaceInteraction *si = nullptr;
+        bool hit = false;
+    };
+
     /// The path's radiance: a colour, or in the polarized mode (Polarized) the Stokes vector of
     /// the light arriving along the camera ray. The polarized path's throughput is a Mueller
     /// matrix in the world's implicit frames (mueller.h): the product of the BSDF matrices along
     /// the path, each turned from its local frame (mueller::to_world()); unpolarised emitted
     /// light adds its first column times the radiance.
-    template <bool Polarized> std::conditional_t<Polarized, Stokes, Color3f>
-    trace(const Scene &scene, Sampler &sampler, const Ray &camera_ray) const {
+    template <bool Polarized>
+    std::conditional_t<Polarized, Stokes, Color3f> trace(const Scene &scene, Sampler &sampler,
+                                                         const Ray &camera_ray,
+                                                         const FirstHit &first = {}) const {
         using Value = std::conditional_t<Polarized, Stokes, Color3f>;
         using Throughput = std::conditional_t<Polarized, Mueller, Color3f>;
         if (m_max_depth == 0) return Value{};
@@ -217,7 +234,8 @@ private:
             throughput = Color3f(1.f);
         float eta = 1.f;
         uint32_t depth = 0;
-        SurfaceInteraction si;
+        // The camera ray's hit when the caller found it (else filled by the first query).
+        SurfaceInteraction si = first.si ? *first.si : SurfaceInteraction();
         Interaction prev_si;     // the previous vertex: MIS only needs its position and normal
         Vector3f prev_side(0.f); // and the side its light samples were given (light_side())
         // The camera ray behaves like a delta bounce: whatever it hits is counted in full.
@@ -227,7 +245,8 @@ private:
         // The light a delta lobe sees may be counted already (count_delta_lobes()): the next
         // vertex, found by the lobe's ray, is then known (next_si), and its emission is not
         // counted again.
-        bool next_known = false, next_hit = false, emission_counted = false;
+        // The camera ray's hit, when given, is known the same way.
+        bool next_known = first.si != nullptr, next_hit = first.hit, emission_counted = false;
         LazyRecord next_si;
 
         for (;;) {

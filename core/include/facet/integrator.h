@@ -68,6 +68,21 @@ public:
     }
     /// True when sample_stokes() follows the polarisation of light in the polarized mode.
     virtual bool has_stokes() const { return false; }
+    /**
+     * sample() for a ray whose closest hit the caller has found already: `si` and `hit` are
+     * what scene.ray_intersect(ray, si) gave. When takes_first_hit() is true the render loop
+     * traces the camera rays of neighbouring pixels together (Scene::ray_intersect_packet())
+     * and calls this instead of sample(), with the sampler where sample() would find it (past
+     * the camera's dimensions). The default ignores the hit.
+     */
+    virtual Color3f sample_from_hit(const Scene &scene, Sampler &sampler, const Ray &ray,
+                                    const SurfaceInteraction & /*si*/, bool /*hit*/,
+                                    float *aovs) const {
+        return sample(scene, sampler, ray, aovs);
+    }
+    /// Whether sample_from_hit() uses the hit it is given (false by default: the render loop
+    /// then calls sample(), which traces the camera ray itself).
+    virtual bool takes_first_hit() const { return false; }
     /// Called by the render loop before the first sample of a render from `sensor`, on one
     /// thread: an integrator that needs the sensor (the `stokes` integrator's reference frame)
     /// records it. One integrator renders from one sensor at a time.

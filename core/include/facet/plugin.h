@@ -13,7 +13,7 @@ namespace facet {
 
 /// Version of the binary interface between libfacet and plugins. Bump it whenever a public class
 /// layout, a virtual table or PluginDescriptor changes; the registry refuses other versions.
-constexpr uint32_t FACET_ABI_VERSION = 14;
+constexpr uint32_t FACET_ABI_VERSION = 15;
 
 /// What every plugin library exports through `facet_plugin_descriptor()`.
 /// `abi_version` stays the first member in every future version, so it can always be checked.

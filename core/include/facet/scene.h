@@ -47,6 +47,15 @@ public:
     /// Closest hit: fills si and returns true. On a miss returns false and makes si the record
     /// of a ray that left the scene (escaped()), which environment emitters' eval() reads.
     bool ray_intersect(const Ray &ray, SurfaceInteraction &si) const;
+    /// ray_intersect() for `count` rays (1 to PacketSize) at once, as one Embree packet: rays
+    /// that travel together (the camera rays of neighbouring pixels) cost a fraction of their
+    /// separate queries. hits[k] and sis[k] are what ray_intersect(rays[k], sis[k]) gives,
+    /// except that Embree's packet arithmetic may settle a ray that grazes the edge between two
+    /// triangles the other way (about one camera ray in 10^4 on a mesh). The answers can depend
+    /// on the packet's other rays: the same rays in the same lanes give the same answers.
+    static constexpr int PacketSize = 8;
+    void ray_intersect_packet(const Ray *rays, int count, SurfaceInteraction *sis,
+                              bool *hits) const;
     /// The record of a ray that left the scene, the one route to the environment emitters: t =
     /// Infinity, no shape, p = the ray's origin, the identity shading frame and wi = -ray.d in it
     /// (local, like every wi; the world direction towards the origin is si.to_world(si.wi)), and
@@ -177,6 +186,10 @@ private:
     bool replace_geometries(Scene &previous);
     /// ray_test()'s body, inlined into the shadow ray of sample_emitter_direction().
     bool occluded(const Ray &ray) const;
+    /// The record of Embree's hit of `ray` (at distance t, geometry `geom`, primitive `prim`,
+    /// instance `inst`, barycentrics uv) in si: ray_intersect()'s, and its packet's, last step.
+    void complete_hit(const Ray &ray, float t, unsigned geom, unsigned prim, unsigned inst,
+                      const Point2f &uv, SurfaceInteraction &si) const;
 
     std::vector<std::shared_ptr<Shape>> m_shapes;
     std::vector<std::shared_ptr<Emitter>> m_emitters;

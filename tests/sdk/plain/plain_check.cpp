@@ -1,11 +1,13 @@
-// The out-of-tree `plainarea` light, `plainsampler` and `plaindiffuse` BSDF against facet's
-// `area`, `independent` and `diffuse`: a scene lit by mesh lights and by a sphere's and a disk's
-// renders the same image whether the scene samples a light from its constant_radiance() or
-// through the emitter's own methods, whether the render draws from the sampler's generator or
-// through next_1d()/next_2d(), and whether the path tracer prefetches the BSDF's texels and
-// samples it after the light sample or does neither (the two textures, one read as bytes and one
-// as floats, are written next to the plugins). Usage: plain_check <scene.xml> <folder of the
-// plugins>; exits with 1 when an image differs.
+// The out-of-tree `plainarea` light, `plainsampler`, `plaindiffuse` BSDF and `plainforward`
+// integrator against facet's `area`, `independent`, `diffuse` and `path`: a scene lit by mesh
+// lights and by a sphere's and a disk's renders the same image whether the scene samples a light
+// from its constant_radiance() or through the emitter's own methods, whether the render draws
+// from the sampler's generator or through next_1d()/next_2d(), whether the path tracer
+// prefetches the BSDF's texels and samples it after the light sample or does neither, and
+// whether the render loop traces the camera rays of eight pixels as one packet or each path
+// traces its own (the two textures, one read as bytes and one as floats, are written next to the
+// plugins). Usage: plain_check <scene.xml> <folder of the plugins>; exits with 1 when an image
+// differs.
 
 #include <facet/image.h>
 #include <facet/plugin.h>
@@ -24,8 +26,9 @@ namespace {
 std::string g_sphere_texture, g_floor_texture;
 
 facet::Image render_with(const char *scene_path, const char *emitter, const char *sampler,
-                         const char *bsdf = "diffuse") {
+                         const char *bsdf = "diffuse", const char *integrator = "path") {
     facet::LoadOptions load;
+    load.params["integrator"] = integrator;
     load.params["emitter"] = emitter;
     load.params["sampler"] = sampler;
     load.params["bsdf"] = bsdf;
@@ -92,7 +95,10 @@ int main(int argc, char **argv) {
         const bool unflagged =
             same("plaindiffuse_unflagged against diffuse",
                  render_with(argv[1], "area", "independent", "plaindiffuse_unflagged"), facets);
-        return light && sampler && bsdf && unflagged ? 0 : 1;
+        const bool forward =
+            same("plainforward against path",
+                 render_with(argv[1], "area", "independent", "diffuse", "plainforward"), facets);
+        return light && sampler && bsdf && unflagged && forward ? 0 : 1;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "plain_check: %s\n", e.what());
         return 1;

@@ -641,3 +641,97 @@ TEST(SceneQuery, InstancesDispatchToTheGroupMembers) {
     expect_near_vec(scene.bbox().min, Vector3f(-2.5f, -0.5f, -0.5f), 1e-5f);
     expect_near_vec(scene.bbox().max, Vector3f(2.5f, 0.5f, 0.5f), 1e-5f);
 }
+
+namespace {
+/// Every field of si that a hit fills in, compared exactly.
+void expect_same_record(const SurfaceInteraction &a, const SurfaceInteraction &b) {
+    EXPECT_EQ(a.t, b.t);
+    EXPECT_EQ(a.shape, b.shape);
+    EXPECT_EQ(a.prim_index, b.prim_index);
+    EXPECT_EQ(a.instance_index, b.instance_index);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(a.p[k], b.p[k]);
+        EXPECT_EQ(a.n[k], b.n[k]);
+        EXPECT_EQ(a.sh_frame.n[k], b.sh_frame.n[k]);
+        EXPECT_EQ(a.wi[k], b.wi[k]);
+    }
+    EXPECT_EQ(a.uv.x, b.uv.x);
+    EXPECT_EQ(a.uv.y, b.uv.y);
+}
+
+/// Rays from `eye` towards a jittered grid of points of the square [-3, 3]² at z = 0, with
+/// some ranges [mint, maxt] cut short and a few directions that are not finite.
+std::vector<Ray> packet_test_rays(const Point3f &eye, uint64_t seed) {
+    PCG32 rng(seed);
+    std::vector<Ray> rays;
+    for (int j = 0; j < 12; ++j)
+        for (int i = 0; i < 12; ++i) {
+            const Point3f target(-3.f + 0.5f * (float(i) + rng.next_float()),
+                                 -3.f + 0.5f * (float(j) + rng.next_float()), 0.f);
+            Ray ray(eye, normalize(target - eye));
+            const float r = rng.next_float();
+            // Ranges that end before the ball or the floor, or start past them (the eyes are 6
+            // to 8 away from the floor).
+            if (r < 0.25f) ray.maxt = 2.f + 7.f * rng.next_float();
+            if (r > 0.75f) ray.mint = 2.f + 7.f * rng.next_float();
+            if ((i * 7 + j) % 29 == 0) ray.d = Vector3f(NAN, 0.f, -1.f);
+            rays.push_back(ray);
+        }
+    return rays;
+}
+
+/// Each ray of `rays` in packets of every size from 1 to 8: the same answers as its own query.
+void expect_packets_match_single_queries(const Scene &scene, const std::vector<Ray> &rays) {
+    size_t hits_seen = 0, misses_seen = 0;
+    for (int count = 1; count <= Scene::PacketSize; ++count)
+        for (size_t first = 0; first + size_t(count) <= rays.size(); first += size_t(count)) {
+            SurfaceInteraction sis[Scene::PacketSize];
+            bool hits[Scene::PacketSize];
+            scene.ray_intersect_packet(rays.data() + first, count, sis, hits);
+            for (int k = 0; k < count; ++k) {
+                SCOPED_TRACE(fmt::format("packet of {}, ray {}", count, first + size_t(k)));
+                SurfaceInteraction si;
+                const bool hit = scene.ray_intersect(rays[first + size_t(k)], si);
+                ASSERT_EQ(hits[k], hit);
+                (hit ? hits_seen : misses_seen) += 1;
+                if (hit) {
+                    expect_same_record(sis[k], si);
+                } else {
+                    EXPECT_EQ(sis[k].t, Infinity);
+                    EXPECT_EQ(sis[k].shape, nullptr);
+                    // wi = -d in the escaped record: NaN for a direction that is not finite.
+                    for (int c = 0; c < 3; ++c)
+                        EXPECT_TRUE(sis[k].wi[c] == si.wi[c] ||
+                                    (std::isnan(sis[k].wi[c]) && std::isnan(si.wi[c])));
+                }
+            }
+        }
+    EXPECT_GT(hits_seen, 100u);
+    EXPECT_GT(misses_seen, 20u);
+}
+} // namespace
+
+TEST(SceneQuery, PacketsGiveTheAnswersOfSingleQueries) {
+    // A mesh and a sphere (Embree's triangles and a shape of facet's own, asked through
+    // callbacks for up to eight rays at once), seen from above and from an angle.
+    Scene scene(rect_and_sphere());
+    expect_packets_match_single_queries(scene, packet_test_rays(Point3f(0.3f, -0.2f, 6.f), 1));
+    expect_packets_match_single_queries(scene, packet_test_rays(Point3f(-5.f, 4.f, 3.f), 2));
+    // Instances of a group: hits inside the group dispatch to its members.
+    Properties ball;
+    ball.set_float("radius", 0.7);
+    Properties group("shapegroup");
+    group.set_object("ball", create(ObjectType::Shape, "sphere", ball));
+    group.set_object("tile", create(ObjectType::Shape, "rectangle"));
+    auto group_obj = PluginRegistry::instance().create(ObjectType::Shape, group);
+    Properties props;
+    for (float x : {-1.5f, 1.5f}) {
+        Properties inst;
+        inst.set_object("group", group_obj);
+        inst.set_transform("to_world", Transform::translate(Vector3f(x, 0.5f * x, 0)));
+        props.set_object(fmt::format("inst{}", x), create(ObjectType::Shape, "instance", inst));
+    }
+    props.set_object("group", group_obj);
+    Scene instanced(props);
+    expect_packets_match_single_queries(instanced, packet_test_rays(Point3f(0.3f, -0.2f, 6.f), 3));
+}
