@@ -205,10 +205,12 @@ private:
         bool m_made = false;
     };
 
-    /// The camera ray's closest hit when the caller has found it (sample_from_hit()).
+    /// The camera ray's closest hit when the caller has found it (sample_from_hit()); {} (null)
+    /// when it has not. (No member initialisers: clang refuses them in a default argument of
+    /// the enclosing class.)
     struct FirstHit {
-        const SurfaceInteraction *si = nullptr;
-        bool hit = false;
+        const SurfaceInteraction *si;
+        bool hit;
     };
 
     /// The path's radiance: a colour, or in the polarized mode (Polarized) the Stokes vector of
