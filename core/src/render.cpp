@@ -207,8 +207,9 @@ private:
     /// when a stop cut it short. `lanes`: Scene::PacketSize samplers when the integrator takes
     /// the camera rays' hits (their rays are then traced in packets), else null.
     bool render_block(const SamplingIntegrator &integrator, const BlockGrid &grid, size_t index,
-                      uint32_t first, uint32_t last, Sampler &sampler, Sampler *const *lanes,
-                      std::vector<float> &aovs, ImageBlock &block, InvalidSamples &invalid) const;
+                      uint32_t first, uint32_t last, Sampler &sampler,
+                      const std::unique_ptr<Sampler> *lanes, std::vector<float> &aovs,
+                      ImageBlock &block, InvalidSamples &invalid) const;
     /// Light paths [begin, end) of the render into `block`; false when a stop cut it short.
     bool trace_paths(const LightTracer &tracer, uint64_t begin, uint64_t end, Sampler &sampler,
                      ImageBlock &block) const;
@@ -319,19 +320,15 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
         auto aovs = std::make_shared<std::vector<float>>(bands + aov_names.size() + 1, 0.f);
         // With an integrator that takes the camera rays' hits, one sampler per packet lane.
         auto lanes = std::make_shared<std::vector<std::unique_ptr<Sampler>>>();
-        auto lane_ptrs = std::make_shared<std::vector<Sampler *>>();
         if (packets)
-            for (int k = 0; k < Scene::PacketSize; ++k) {
-                lanes->push_back(m_sampler->clone());
-                lane_ptrs->push_back(lanes->back().get());
-            }
-        return [&, sampler, aovs, lanes, lane_ptrs](size_t index) {
+            for (int k = 0; k < Scene::PacketSize; ++k) lanes->push_back(m_sampler->clone());
+        return [&, sampler, aovs, lanes](size_t index) {
             const size_t pass = index / blocks;
             const uint32_t first = m_range.first + m_pass_start[pass],
                            last = m_range.first + m_pass_start[pass + 1];
             std::unique_ptr<ImageBlock> block = m_merger->acquire();
             if (!render_block(integrator, grid, index % blocks, first, last, *sampler,
-                              packets ? lane_ptrs->data() : nullptr, *aovs, *block, invalid)) {
+                              packets ? lanes->data() : nullptr, *aovs, *block, invalid)) {
                 m_merger->release(std::move(block));
                 return;
             }
@@ -359,8 +356,8 @@ RenderResult RenderJob::run_sampling(const SamplingIntegrator &integrator) {
 
 bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGrid &grid,
                              size_t index, uint32_t first, uint32_t last, Sampler &sampler,
-                             Sampler *const *lanes, std::vector<float> &aovs, ImageBlock &block,
-                             InvalidSamples &invalid) const {
+                             const std::unique_ptr<Sampler> *lanes, std::vector<float> &aovs,
+                             ImageBlock &block, InvalidSamples &invalid) const {
     const Point2i film_size = m_film.size(), offset = grid.block_offset(index);
     const Point2i size(std::min(grid.bs, film_size.x - offset.x),
                        std::min(grid.bs, film_size.y - offset.y));
@@ -383,38 +380,39 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     // the aperture if the sensor has one and, in the spectral mode, the wavelengths (drawn from
     // the film's bands or the sensor's response if there is one; the radiance at them becomes
     // the film's RGB through XYZ, times the sensor's response, or the bands).
+    // The ray itself is kept apart (the packet's rays lie side by side).
     struct CameraSample {
         Point2f pos;
-        Ray ray;
         Color3f weight, wavelength_weight;
     };
-    auto camera = [&](Sampler &s, int x, int y, CameraSample &c) {
+    auto camera = [&](Sampler &s, int x, int y, CameraSample &c, Ray &ray) {
         const Point2f u = s.draw_2d();
         c.pos = Point2f(float(x) + u.x, float(y) + u.y);
         const Point2f aperture = needs_aperture ? s.draw_2d() : Point2f(0.5f, 0.5f);
-        std::tie(c.ray, c.weight) = m_sensor.sample_ray(0.f, c.pos * inv_film_size, aperture);
+        std::tie(ray, c.weight) = m_sensor.sample_ray(0.f, c.pos * inv_film_size, aperture);
         if (spectral) {
             const float uw = s.draw_1d();
             if (bands) {
-                std::tie(c.ray.wavelengths, c.wavelength_weight) = bands->sample_wavelengths(uw);
+                std::tie(ray.wavelengths, c.wavelength_weight) = bands->sample_wavelengths(uw);
             } else if (srf) {
-                std::tie(c.ray.wavelengths, c.wavelength_weight) = srf->sample_wavelengths(uw);
-                c.wavelength_weight = c.wavelength_weight * srf->eval(0, c.ray.wavelengths);
+                std::tie(ray.wavelengths, c.wavelength_weight) = srf->sample_wavelengths(uw);
+                c.wavelength_weight = c.wavelength_weight * srf->eval(0, ray.wavelengths);
             } else {
-                std::tie(c.ray.wavelengths, c.wavelength_weight) = sample_wavelengths(uw);
+                std::tie(ray.wavelengths, c.wavelength_weight) = sample_wavelengths(uw);
             }
         }
     };
     uint64_t bad = 0, first_bad_pixel = UINT64_MAX;
-    // The radiance L of camera sample c (of pixel `pixel_index`) into the block, with the AOVs
-    // the integrator wrote; a sample that is not finite is dropped.
-    auto record = [&](const CameraSample &c, Color3f L, uint64_t pixel_index) {
+    // The radiance L of camera sample c with wavelengths `lambda` (of pixel `pixel_index`) into
+    // the block, with the AOVs the integrator wrote; a sample that is not finite is dropped.
+    auto record = [&](const CameraSample &c, const Wavelengths &lambda, Color3f L,
+                      uint64_t pixel_index) {
         bool valid = true;
         if (bands) {
-            bands->develop(L, c.ray.wavelengths, c.wavelength_weight, aovs.data());
+            bands->develop(L, lambda, c.wavelength_weight, aovs.data());
             for (int k = 0; k < band_count; ++k) valid = valid && std::isfinite(aovs[size_t(k)]);
         } else {
-            if (spectral) L = spectral_to_srgb(L, c.ray.wavelengths, c.wavelength_weight);
+            if (spectral) L = spectral_to_srgb(L, lambda, c.wavelength_weight);
             valid = L.is_finite();
         }
         for (int k = 0; k < aov_count; ++k) valid = valid && std::isfinite(aov_values[k]);
@@ -443,9 +441,9 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
         SurfaceInteraction sis[N];
         bool hits[N];
         for (int y = y0; y < y1; ++y) {
+            const uint64_t row_index = uint64_t(y) * uint64_t(film_size.x);
             for (int gx = x0 - x0 % N; gx < x1; gx += N) {
                 const int count = std::min(N, film_size.x - gx);
-                const uint64_t row_index = uint64_t(y) * uint64_t(film_size.x);
                 for (int k = 0; k < count; k += 4) {
                     uint64_t seeds[4];
                     sample_stream_seeds4(m_seed, row_index + uint64_t(gx + k), seeds);
@@ -456,8 +454,7 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                     if (m_stop()) return false;
                     for (int k = 0; k < count; ++k) {
                         lanes[k]->set_sample_index(s);
-                        camera(*lanes[k], gx + k, y, cams[k]);
-                        rays[k] = cams[k].ray;
+                        camera(*lanes[k], gx + k, y, cams[k], rays[k]);
                     }
                     for (int k = count; k < N; ++k) rays[k] = rays[0];
                     m_scene.ray_intersect_packet(rays, N, sis, hits);
@@ -466,7 +463,8 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                         if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
                         const Color3f L = integrator.sample_from_hit(m_scene, *lanes[k], rays[k],
                                                                      sis[k], hits[k], aov_values);
-                        record(cams[k], L * cams[k].weight, row_index + uint64_t(gx + k));
+                        record(cams[k], rays[k].wavelengths, L * cams[k].weight,
+                               row_index + uint64_t(gx + k));
                     }
                 }
             }
@@ -474,6 +472,7 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
     } else {
         uint64_t pixel_seeds[4]; // of the row's pixels x0 + 4i .. x0 + 4i + 3
         CameraSample cam;
+        Ray ray;
         for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; ++x) {
                 const uint64_t pixel_index = uint64_t(y) * uint64_t(film_size.x) + uint64_t(x);
@@ -486,11 +485,11 @@ bool RenderJob::render_block(const SamplingIntegrator &integrator, const BlockGr
                         if (m_stop()) return false;
                     }
                     sampler.set_sample_index(s);
-                    camera(sampler, x, y, cam);
+                    camera(sampler, x, y, cam, ray);
                     // Integrators need not write every AOV for every sample (e.g. on a miss).
                     if (aov_count > 0) std::fill_n(aov_values, aov_count, 0.f);
-                    const Color3f L = integrator.sample(m_scene, sampler, cam.ray, aov_values);
-                    record(cam, L * cam.weight, pixel_index);
+                    const Color3f L = integrator.sample(m_scene, sampler, ray, aov_values);
+                    record(cam, ray.wavelengths, L * cam.weight, pixel_index);
                 }
             }
         }
