@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <xmmintrin.h>
 
 namespace facet {
 
@@ -32,11 +33,21 @@ void ImageBlock::reset(const Point2i &offset, const Point2i &size, int border, i
     m_data.assign(size_t(s.x) * size_t(s.y) * size_t(channel_count()), 0.f);
 }
 
-bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp) {
+namespace {
+
+/// floor(x) for |x| < 2^31 without the library call: the truncation, less one below zero where
+/// x was not an integer.
+inline int floor_int(float x) {
+    const int t = int(x);
+    return t - int(x < float(t));
+}
+
+} // namespace
+
+inline bool ImageBlock::footprint_range(const Point2f &pos, float radius, Footprint &fp) const {
     // Non-finite positions, and positions far beyond any film (whose pixel indices would not
     // fit an int), reach no pixel.
     if (!(std::abs(pos.x) < 1e9f) || !(std::abs(pos.y) < 1e9f)) return false;
-    const float radius = filter.radius();
     const Point2i s = storage_size();
     // Continuous position in film pixels, with pixel centres at integers, and the film pixel of
     // storage pixel (0, 0): the filter weights do not depend on where the block lies, so the
@@ -47,10 +58,10 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
     fp.oy = m_offset.y - m_border;
     fp.px = px;
     fp.py = py;
-    fp.ux0 = int(std::ceil(px - radius)) - fp.ox;
-    fp.uy0 = int(std::ceil(py - radius)) - fp.oy;
-    fp.ux1 = int(std::floor(px + radius)) - fp.ox;
-    fp.uy1 = int(std::floor(py + radius)) - fp.oy;
+    fp.ux0 = -floor_int(radius - px) - fp.ox; // ceil(px - radius)
+    fp.uy0 = -floor_int(radius - py) - fp.oy;
+    fp.ux1 = floor_int(px + radius) - fp.ox;
+    fp.uy1 = floor_int(py + radius) - fp.oy;
     fp.x0 = std::max(0, fp.ux0);
     fp.y0 = std::max(0, fp.uy0);
     const int x1 = std::min(s.x - 1, fp.ux1);
@@ -58,16 +69,25 @@ bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filte
     if (fp.x0 > x1 || fp.y0 > y1) return false;
     fp.nx = size_t(x1 - fp.x0 + 1);
     fp.ny = size_t(y1 - fp.y0 + 1);
+    return true;
+}
+
+inline void ImageBlock::footprint_weights(const TabulatedFilter &w, Footprint &fp, float *wx,
+                                          float *wy) {
+    // The argument is the sample's offset from the pixel centre.
+    fp.sum_x = fp.sum_y = 0.f;
+    for (size_t i = 0; i < fp.nx; ++i)
+        fp.sum_x += (wx[i] = w(fp.px - float(fp.ox + fp.x0 + int(i))));
+    for (size_t j = 0; j < fp.ny; ++j)
+        fp.sum_y += (wy[j] = w(fp.py - float(fp.oy + fp.y0 + int(j))));
+}
+
+bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp) {
+    if (!footprint_range(pos, filter.radius(), fp)) return false;
     // Grows only the first time a block sees a filter of this size.
     if (m_wx.size() < fp.nx) m_wx.resize(fp.nx);
     if (m_wy.size() < fp.ny) m_wy.resize(fp.ny);
-    // The filter argument is the sample's offset from the pixel centre.
-    const TabulatedFilter &w = filter.table();
-    fp.sum_x = fp.sum_y = 0.f;
-    for (size_t i = 0; i < fp.nx; ++i)
-        fp.sum_x += (m_wx[i] = w(px - float(fp.ox + fp.x0 + int(i))));
-    for (size_t j = 0; j < fp.ny; ++j)
-        fp.sum_y += (m_wy[j] = w(py - float(fp.oy + fp.y0 + int(j))));
+    footprint_weights(filter.table(), fp, m_wx.data(), m_wy.data());
     return true;
 }
 
@@ -128,19 +148,48 @@ void ImageBlock::put(const Point2f &pos, const Color3f &L, const float *aovs,
                      const ReconstructionFilter &filter) {
     FACET_ASSERT(m_colour_count == 3);
     // The box's one pixel here; put_footprint() takes the rest, with the same weights.
-    const float c = filter.table().single_pixel_weight();
+    const TabulatedFilter &table = filter.table();
+    const float c = table.single_pixel_weight();
     if (float *p; single_pixel(pos, c, p)) {
         if (p) add_sample(p, c * c, L, aovs, m_aov_count);
         return;
     }
-    put_footprint(pos, L, aovs, filter);
+    put_footprint(pos, L, aovs, filter, table);
 }
 
 __attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, const Color3f &L,
                                                          const float *aovs,
-                                                         const ReconstructionFilter &filter) {
-    for_each_footprint_pixel(pos, filter,
-                             [&](float *p, float w) { add_sample(p, w, L, aovs, m_aov_count); });
+                                                         const ReconstructionFilter &filter,
+                                                         const TabulatedFilter &table) {
+    Footprint fp;
+    if (!footprint_range(pos, filter.radius(), fp)) return;
+    if (m_aov_count > 0 || fp.nx > SmallFootprint || fp.ny > SmallFootprint) {
+        for_each_footprint_pixel(
+            pos, filter, [&](float *p, float w) { add_sample(p, w, L, aovs, m_aov_count); });
+        return;
+    }
+    // A pixel of r, g, b and the weight, a footprint of at most SmallFootprint² pixels (every
+    // filter up to a radius of 3.5: the tent 2 x 2 or 3 x 3, the gaussian up to 5 x 5): the
+    // weights stay on the stack and a pixel takes one 4-wide product and sum, the same
+    // arithmetic as add_sample() (the weight channel gains w · 1 = w). The film's share of the
+    // Veach scene's CPU (perf): 4.8% with the general loop and the library's ceil and floor,
+    // 2.9% this way.
+    float wx[SmallFootprint], wy[SmallFootprint];
+    footprint_weights(table, fp, wx, wy);
+    const __m128 value = _mm_setr_ps(L.r, L.g, L.b, 1.f);
+    const size_t row_floats = size_t(storage_size().x) * 4;
+    float *first = m_data.data() + size_t(fp.y0) * row_floats + size_t(fp.x0) * 4;
+    for (size_t j = 0; j < fp.ny; ++j) {
+        const float wyj = wy[j];
+        if (wyj == 0.f) continue;
+        float *row = first + j * row_floats;
+        for (size_t i = 0; i < fp.nx; ++i) {
+            const float w = wx[i] * wyj;
+            if (w == 0.f) continue;
+            float *p = row + i * 4;
+            _mm_storeu_ps(p, _mm_add_ps(_mm_loadu_ps(p), _mm_mul_ps(_mm_set1_ps(w), value)));
+        }
+    }
 }
 
 void ImageBlock::put_values(const Point2f &pos, const float *values,

@@ -77,10 +77,18 @@ private:
     /// False when the sample (non-finite, beyond 1e9 pixels, or outside the block) reaches no
     /// pixel.
     bool footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp);
+    /// footprint()'s pixels, without the weights.
+    bool footprint_range(const Point2f &pos, float radius, Footprint &fp) const;
+    /// footprint()'s weights, into wx[0, nx) and wy[0, ny).
+    static void footprint_weights(const TabulatedFilter &w, Footprint &fp, float *wx, float *wy);
     /// put() of a sample that reaches more than one pixel, or outside put()'s one-pixel
-    /// shortcut: out of line, so that put()'s shortcut saves no registers.
+    /// shortcut: out of line, so that put()'s shortcut saves no registers. `table` is the
+    /// filter's.
     void put_footprint(const Point2f &pos, const Color3f &L, const float *aovs,
-                       const ReconstructionFilter &filter);
+                       const ReconstructionFilter &filter, const TabulatedFilter &table);
+    /// The widest footprint (pixels along an axis) put_footprint() takes without the general
+    /// loop.
+    static constexpr size_t SmallFootprint = 8;
     /// For a box filter of constant weight `c` (single_pixel_weight(), 0 for other filters) at
     /// an ordinary film position: true, with the one pixel the sample reaches (null: outside
     /// the block). False: the footprint decides.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numeric>
 
 using namespace facet;
@@ -231,6 +232,57 @@ TEST(ImageBlock, OffCentreGaussianWeightsFollowTheFilter) {
             float expected = g->weight(3.2f - (x + 0.5f)) * g->weight(5.9f - (y + 0.5f));
             EXPECT_NEAR(block_weight(block, x + 2, y + 2), expected, 1e-6f) << x << "," << y;
         }
+}
+
+TEST(ImageBlock, EveryFootprintAddsAsTheLoopOfBlocksWithAovs) {
+    // put() of a block of r, g, b adds a footprint of up to 8 x 8 pixels its own way; a block
+    // with an AOV takes the general loop. Their colour and weight channels must agree bit for
+    // bit for every filter (the gaussian's 5 x 5, lanczos's 7 x 7, a tent of 9 x 9 beyond the
+    // short way), at positions on and off pixel edges, across the block's edges and beyond
+    // them, with an infinite colour (a zero weight must add nothing) and NaN positions.
+    Properties wide;
+    wide.set_float("radius", 4.2);
+    Properties lobes;
+    lobes.set_int("lobes", 3);
+    const std::vector<std::shared_ptr<ReconstructionFilter>> filters = {
+        make_filter("box"),       make_filter("tent"),       make_filter("gaussian"),
+        make_filter("mitchell"),  make_filter("catmullrom"), make_filter("lanczos", lobes),
+        make_filter("tent", wide)};
+    uint32_t state = 12345u;
+    auto next = [&state] {
+        state = state * 1664525u + 1013904223u;
+        return float(state >> 8) / 16777216.f;
+    };
+    for (const auto &filter : filters) {
+        const int border = ImageBlock::border_for(*filter);
+        ImageBlock plain, with_aov;
+        plain.reset({16, 8}, {8, 6}, border);
+        with_aov.reset({16, 8}, {8, 6}, border, 1);
+        std::vector<Point2f> positions;
+        for (int k = 0; k < 400; ++k)
+            positions.push_back({12.f + 16.f * next(), 4.f + 14.f * next()});
+        for (float x = 12.f; x <= 28.f; x += 0.5f) positions.push_back({x, 11.f});
+        positions.push_back({std::nanf(""), 10.f});
+        positions.push_back({20.f, std::nanf("")});
+        for (size_t k = 0; k < positions.size(); ++k) {
+            const Color3f L = k % 50 == 7 ? Color3f(INFINITY, 1.f, 2.f)
+                                          : Color3f(next(), 2.f * next(), 0.5f + next());
+            const float aov = next();
+            plain.put(positions[k], L, *filter);
+            with_aov.put(positions[k], L, &aov, *filter);
+        }
+        const size_t pixels = size_t(plain.storage_size().x) * size_t(plain.storage_size().y);
+        ASSERT_EQ(pixels * 5, with_aov.data().size());
+        size_t differing = 0, touched = 0;
+        for (size_t i = 0; i < pixels; ++i) {
+            const float *a = plain.data().data() + 4 * i, *b = with_aov.data().data() + 5 * i;
+            const float bs[4] = {b[0], b[1], b[2], b[4]};
+            touched += a[3] != 0.f;
+            differing += std::memcmp(a, bs, sizeof bs) != 0;
+        }
+        EXPECT_EQ(differing, 0u) << filter->to_string();
+        EXPECT_GT(touched, pixels / 2) << filter->to_string();
+    }
 }
 
 TEST(ImageBlock, AOVChannels) {
