@@ -702,9 +702,13 @@ std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Intera
         if (!(ds.pdf > 0.f) || !(dot(ds.n, ds.d) < 0.f)) return result;
         weight = entry.radiance / ds.pdf;
     } else {
-        std::tie(ds, weight) = sampling == LightSampling::MIS
-                                   ? entry.emitter->sample_direction_mis(ref, u, side)
-                                   : entry.emitter->sample_direction(ref, u);
+        // The emitter's sample and weight, written straight into the result as above.
+        using Result = std::pair<DirectionSample, Color3f>;
+        static_assert(std::is_trivially_destructible_v<Result>);
+        if (sampling == LightSampling::MIS)
+            new (&result) Result(entry.emitter->sample_direction_mis(ref, u, side));
+        else
+            new (&result) Result(entry.emitter->sample_direction(ref, u));
     }
     ds.emitter = entry.emitter;
     if (!(ds.pdf > 0.f) || weight.is_black()) {
