@@ -239,7 +239,8 @@ TEST(ImageBlock, EveryFootprintAddsAsTheLoopOfBlocksWithAovs) {
     // with an AOV takes the general loop. Their colour and weight channels must agree bit for
     // bit for every filter (the gaussian's 5 x 5, lanczos's 7 x 7, a tent of 9 x 9 beyond the
     // short way), at positions on and off pixel edges, across the block's edges and beyond
-    // them, with an infinite colour (a zero weight must add nothing) and NaN positions.
+    // them, and NaN positions; then again after samples of an infinite colour (where a weight
+    // is zero they must add nothing, not NaN).
     Properties wide;
     wide.set_float("radius", 4.2);
     Properties lobes;
@@ -258,30 +259,38 @@ TEST(ImageBlock, EveryFootprintAddsAsTheLoopOfBlocksWithAovs) {
         ImageBlock plain, with_aov;
         plain.reset({16, 8}, {8, 6}, border);
         with_aov.reset({16, 8}, {8, 6}, border, 1);
-        std::vector<Point2f> positions;
-        for (int k = 0; k < 400; ++k)
-            positions.push_back({12.f + 16.f * next(), 4.f + 14.f * next()});
-        for (float x = 12.f; x <= 28.f; x += 0.5f) positions.push_back({x, 11.f});
-        positions.push_back({std::nanf(""), 10.f});
-        positions.push_back({20.f, std::nanf("")});
-        for (size_t k = 0; k < positions.size(); ++k) {
-            const Color3f L = k % 50 == 7 ? Color3f(INFINITY, 1.f, 2.f)
-                                          : Color3f(next(), 2.f * next(), 0.5f + next());
-            const float aov = next();
-            plain.put(positions[k], L, *filter);
-            with_aov.put(positions[k], L, &aov, *filter);
-        }
         const size_t pixels = size_t(plain.storage_size().x) * size_t(plain.storage_size().y);
         ASSERT_EQ(pixels * 5, with_aov.data().size());
-        size_t differing = 0, touched = 0;
-        for (size_t i = 0; i < pixels; ++i) {
-            const float *a = plain.data().data() + 4 * i, *b = with_aov.data().data() + 5 * i;
-            const float bs[4] = {b[0], b[1], b[2], b[4]};
-            touched += a[3] != 0.f;
-            differing += std::memcmp(a, bs, sizeof bs) != 0;
-        }
-        EXPECT_EQ(differing, 0u) << filter->to_string();
+        auto put = [&](const Point2f &pos, const Color3f &L) {
+            const float aov = next();
+            plain.put(pos, L, *filter);
+            with_aov.put(pos, L, &aov, *filter);
+        };
+        // Pixels whose four values differ, and pixels with weight.
+        auto compare = [&](size_t &touched) {
+            size_t differing = 0;
+            touched = 0;
+            for (size_t i = 0; i < pixels; ++i) {
+                const float *a = plain.data().data() + 4 * i, *b = with_aov.data().data() + 5 * i;
+                const float bs[4] = {b[0], b[1], b[2], b[4]};
+                touched += a[3] != 0.f;
+                differing += std::memcmp(a, bs, sizeof bs) != 0;
+            }
+            return differing;
+        };
+        for (int k = 0; k < 400; ++k)
+            put({12.f + 16.f * next(), 4.f + 14.f * next()},
+                Color3f(next(), 2.f * next(), 0.5f + next()));
+        for (float x = 12.f; x <= 28.f; x += 0.5f) put({x, 11.f}, Color3f(0.25f, 0.5f, 1.f));
+        put({std::nanf(""), 10.f}, Color3f(1.f));
+        put({20.f, std::nanf("")}, Color3f(1.f));
+        size_t touched = 0;
+        EXPECT_EQ(compare(touched), 0u) << filter->to_string();
         EXPECT_GT(touched, pixels / 2) << filter->to_string();
+        // At pixel centres: the pixels at ±radius (the tent's, the gaussian's) weigh zero.
+        put({19.5f, 12.5f}, Color3f(INFINITY, 1.f, 2.f));
+        put({21.5f, 10.5f}, Color3f(1.f, INFINITY, 2.f));
+        EXPECT_EQ(compare(touched), 0u) << filter->to_string() << " (infinite colours)";
     }
 }
 
