@@ -695,8 +695,9 @@ std::pair<DirectionSample, Color3f> Scene::sample_emitter_direction(const Intera
     } else if (entry.shape) {
         // Another shape's constant light: the shape's own sample, from its front side only,
         // written by the shape straight into the result (an assignment copied it from the
-        // stack 16 bytes at a time, reloading what the shape had just stored 4 bytes at a time:
-        // this function fell from 5.9% to 2.8% of the Veach scene's CPU, 0.987 of its time).
+        // stack 16 bytes at a time, reloading what the shape had just stored 4 bytes at a time;
+        // perf on the Veach scene: this function's own share 5.9% to 2.8%, with the emitter's
+        // pick and the shadow ray's setup 9.1% to 8.4%; 0.987 of its time).
         static_assert(std::is_trivially_destructible_v<DirectionSample>);
         new (&ds) DirectionSample(entry.shape->sample_direction(ref, u));
         if (!(ds.pdf > 0.f) || !(dot(ds.n, ds.d) < 0.f)) return result;
