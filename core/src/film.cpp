@@ -82,12 +82,16 @@ inline void ImageBlock::footprint_weights(const TabulatedFilter &w, Footprint &f
         fp.sum_y += (wy[j] = w(fp.py - float(fp.oy + fp.y0 + int(j))));
 }
 
-bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp) {
-    if (!footprint_range(pos, filter.radius(), fp)) return false;
+inline void ImageBlock::scratch_weights(const TabulatedFilter &w, Footprint &fp) {
     // Grows only the first time a block sees a filter of this size.
     if (m_wx.size() < fp.nx) m_wx.resize(fp.nx);
     if (m_wy.size() < fp.ny) m_wy.resize(fp.ny);
-    footprint_weights(filter.table(), fp, m_wx.data(), m_wy.data());
+    footprint_weights(w, fp, m_wx.data(), m_wy.data());
+}
+
+bool ImageBlock::footprint(const Point2f &pos, const ReconstructionFilter &filter, Footprint &fp) {
+    if (!footprint_range(pos, filter.radius(), fp)) return false;
+    scratch_weights(filter.table(), fp);
     return true;
 }
 
@@ -126,13 +130,11 @@ inline bool ImageBlock::single_pixel(const Point2f &pos, float c, float *&pixel)
     return true;
 }
 
-template <typename Add>
-inline void ImageBlock::for_each_footprint_pixel(const Point2f &pos,
-                                                 const ReconstructionFilter &filter, Add add) {
+template <typename Add> inline void
+ImageBlock::for_each_footprint_pixel(Footprint &fp, const TabulatedFilter &table, Add add) {
     const Point2i s = storage_size();
     const int nc = channel_count();
-    Footprint fp;
-    if (!footprint(pos, filter, fp)) return;
+    scratch_weights(table, fp);
     for (size_t j = 0; j < fp.ny; ++j) {
         const float wy = m_wy[j];
         if (wy == 0.f) continue;
@@ -165,7 +167,7 @@ __attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, con
     if (!footprint_range(pos, filter.radius(), fp)) return;
     if (m_aov_count > 0 || fp.nx > SmallFootprint || fp.ny > SmallFootprint) {
         for_each_footprint_pixel(
-            pos, filter, [&](float *p, float w) { add_sample(p, w, L, aovs, m_aov_count); });
+            fp, table, [&](float *p, float w) { add_sample(p, w, L, aovs, m_aov_count); });
         return;
     }
     // A pixel of r, g, b and the weight, a footprint of at most SmallFootprint² pixels (every
@@ -195,12 +197,15 @@ __attribute__((noinline)) void ImageBlock::put_footprint(const Point2f &pos, con
 void ImageBlock::put_values(const Point2f &pos, const float *values,
                             const ReconstructionFilter &filter) {
     const int n = m_colour_count + m_aov_count;
-    const float c = filter.table().single_pixel_weight();
+    const TabulatedFilter &table = filter.table();
+    const float c = table.single_pixel_weight();
     if (float *p; single_pixel(pos, c, p)) {
         if (p) add_values(p, c * c, values, n);
         return;
     }
-    for_each_footprint_pixel(pos, filter, [&](float *p, float w) { add_values(p, w, values, n); });
+    Footprint fp;
+    if (!footprint_range(pos, filter.radius(), fp)) return;
+    for_each_footprint_pixel(fp, table, [&](float *p, float w) { add_values(p, w, values, n); });
 }
 
 void ImageBlock::splat(const Point2f &pos, const Color3f &L, const ReconstructionFilter &filter) {

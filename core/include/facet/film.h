@@ -81,6 +81,8 @@ private:
     bool footprint_range(const Point2f &pos, float radius, Footprint &fp) const;
     /// footprint()'s weights, into wx[0, nx) and wy[0, ny).
     static void footprint_weights(const TabulatedFilter &w, Footprint &fp, float *wx, float *wy);
+    /// footprint()'s weights into m_wx and m_wy.
+    void scratch_weights(const TabulatedFilter &w, Footprint &fp);
     /// put() of a sample that reaches more than one pixel, or outside put()'s one-pixel
     /// shortcut: out of line, so that put()'s shortcut saves no registers. `table` is the
     /// filter's.
@@ -93,9 +95,10 @@ private:
     /// an ordinary film position: true, with the one pixel the sample reaches (null: outside
     /// the block). False: the footprint decides.
     bool single_pixel(const Point2f &pos, float c, float *&pixel);
-    /// add(pixel, weight) for each pixel of the sample's footprint with a non-zero weight.
+    /// add(pixel, weight) for each pixel of footprint `fp` (its range found by
+    /// footprint_range()) with a non-zero weight of the filter `table`.
     template <typename Add>
-    void for_each_footprint_pixel(const Point2f &pos, const ReconstructionFilter &filter, Add add);
+    void for_each_footprint_pixel(Footprint &fp, const TabulatedFilter &table, Add add);
 
     std::vector<float> m_wx, m_wy; ///< scratch filter weights, reused
 };
